@@ -1,0 +1,134 @@
+#include "core/config.h"
+
+#include <fstream>
+#include <iomanip>
+
+namespace foresight::config {
+
+std::string Range::Describe() const {
+  auto fmt = [](double v) {
+    std::ostringstream os;
+    os << std::setprecision(10) << v;
+    return os.str();
+  };
+  if (min && max)
+    return std::string("in ") + (min_exclusive ? "(" : "[") + fmt(*min) + ", " + fmt(*max) +
+           (max_exclusive ? ")" : "]");
+  if (min) return std::string(min_exclusive ? "> " : ">= ") + fmt(*min);
+  if (max) return std::string(max_exclusive ? "< " : "<= ") + fmt(*max);
+  return "";
+}
+
+namespace internal {
+std::string JoinPath(const std::string& prefix, const std::string& key) {
+  return prefix.empty() ? key : prefix + "." + key;
+}
+}  // namespace internal
+
+std::optional<YAML::Node> YamlReader::Take(const char* key) {
+  seen_.insert(key);
+  if (!node_.IsMap()) return std::nullopt;
+  const YAML::Node& const_node = node_;  // const lookup: never inserts the key
+  YAML::Node child = const_node[key];
+  if (!child.IsDefined() || child.IsNull()) return std::nullopt;
+  return child;
+}
+
+void YamlReader::FailAt(const std::string& path, const YAML::Node& node,
+                        const std::string& expected) const {
+  std::string text;
+  if (node.IsScalar()) text = "'" + node.Scalar() + "'";
+  else if (node.IsSequence()) text = "a list";
+  else if (node.IsMap()) text = "a mapping";
+  else text = "nothing";
+  std::string where = source_;
+  if (node.Mark().line >= 0 && source_.rfind('<', 0) != 0)
+    where += ":" + std::to_string(node.Mark().line + 1);
+  Fail(where, ": key '", path, "': value ", text, " is not ", expected);
+}
+
+void YamlReader::CheckNoUnknownKeys() const {
+  if (!node_.IsMap()) return;
+  for (const auto& kv : node_) {
+    const std::string key = kv.first.as<std::string>();
+    if (!seen_.count(key)) {
+      std::string known;
+      for (const auto& s : seen_) known += (known.empty() ? "" : ", ") + s;
+      std::string where = source_;
+      if (kv.first.Mark().line >= 0 && source_.rfind('<', 0) != 0)
+        where += ":" + std::to_string(kv.first.Mark().line + 1);
+      Fail(where, ": unknown key '", internal::JoinPath(prefix_, key), "' (known keys here: ", known,
+           ")");
+    }
+  }
+}
+
+std::string YamlWriter::FormatDouble(double v) {
+  std::ostringstream os;
+  os << std::setprecision(17) << v;
+  std::string s = os.str();
+  // Shortest representation that round-trips.
+  for (int p = 1; p <= 17; ++p) {
+    std::ostringstream t;
+    t << std::setprecision(p) << v;
+    if (std::stod(t.str()) == v) {
+      s = t.str();
+      break;
+    }
+  }
+  if (s.find_first_of(".eE") == std::string::npos && s.find("inf") == std::string::npos &&
+      s.find("nan") == std::string::npos)
+    s += ".0";
+  return s;
+}
+
+namespace {
+// yaml-cpp's Node::operator= assigns through the handle, so walk by recursion (copy-construct only).
+void SetPath(YAML::Node node, const std::vector<std::string>& keys, std::size_t i,
+             const YAML::Node& value, const std::string& assignment) {
+  if (i + 1 == keys.size()) {
+    node[keys[i]] = value;
+    return;
+  }
+  if (!node[keys[i]].IsDefined() || node[keys[i]].IsNull())
+    node[keys[i]] = YAML::Node(YAML::NodeType::Map);
+  YAML::Node child = node[keys[i]];
+  FS_THROW_UNLESS(child.IsMap(), "override '", assignment, "': '", keys[i],
+                  "' is not a mapping in the config");
+  SetPath(child, keys, i + 1, value, assignment);
+}
+}  // namespace
+
+void ApplyOverride(YAML::Node root, const std::string& assignment) {
+  const auto eq = assignment.find('=');
+  FS_THROW_UNLESS(eq != std::string::npos && eq > 0, "override '", assignment,
+                  "' is not of the form key.path=value");
+  const std::string path = assignment.substr(0, eq);
+  const std::string text = assignment.substr(eq + 1);
+  YAML::Node value = ParseYaml(text.empty() ? "''" : text, "override '" + assignment + "'");
+  std::vector<std::string> keys;
+  std::stringstream ss(path);
+  for (std::string k; std::getline(ss, k, '.');) {
+    FS_THROW_UNLESS(!k.empty(), "override '", assignment, "': empty key in path '", path, "'");
+    keys.push_back(k);
+  }
+  SetPath(root, keys, 0, value, assignment);
+}
+
+YAML::Node ParseYaml(const std::string& text, const std::string& source) {
+  try {
+    return YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    Fail(source, ":", e.mark.line + 1, ": invalid YAML: ", e.msg);
+  }
+}
+
+YAML::Node LoadYamlFile(const std::string& path) {
+  std::ifstream in(path);
+  FS_THROW_UNLESS(in.good(), path, ": cannot open config file");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ParseYaml(ss.str(), path);
+}
+
+}  // namespace foresight::config

@@ -1,0 +1,44 @@
+#pragma once
+/// Dense layers and ReLU MLPs evaluated with Eigen in float, without allocation after set-up.
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "core/h5.h"
+
+namespace foresight {
+
+struct DenseLayer {
+  Eigen::MatrixXf weight;  ///< [out x in]
+  Eigen::VectorXf bias;    ///< [out]
+};
+
+/// Layers with ReLU between them and none after the last.
+class Mlp {
+ public:
+  struct Workspace {
+    Eigen::VectorXf ping, pong;
+  };
+
+  Mlp() = default;
+  explicit Mlp(std::vector<DenseLayer> layers);
+  /// Reads `<prefix><name>/weight` and `<prefix><name>/bias` for each name, checking shapes chain.
+  static Mlp Load(const h5::File& file, const std::string& prefix,
+                  const std::vector<std::string>& names);
+
+  int input_size() const { return static_cast<int>(layers_.front().weight.cols()); }
+  int output_size() const { return static_cast<int>(layers_.back().weight.rows()); }
+  const std::vector<DenseLayer>& layers() const { return layers_; }
+
+  Workspace MakeWorkspace() const;
+  /// @param input [input_size]. @return a view of the output [output_size] inside `ws`.
+  Eigen::Ref<const Eigen::VectorXf> Forward(const Eigen::Ref<const Eigen::VectorXf>& input,
+                                            Workspace* ws) const;
+
+ private:
+  std::vector<DenseLayer> layers_;
+  int max_width_ = 0;
+};
+
+}  // namespace foresight

@@ -1,0 +1,244 @@
+#include "inference/prediction/span_predictor.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/ego_frame.h"
+#include "core/error.h"
+#include "inference/engine/artifact.h"
+
+namespace foresight {
+
+// ---------------------------------------------------------------- TrajectoryDistribution
+
+TrajectoryDistribution::TrajectoryDistribution(const TimeBasis& basis, int components)
+    : basis_(basis) {
+  const int m = basis.size();
+  alpha_ = Eigen::VectorXd::Zero(components);
+  mean_.assign(static_cast<std::size_t>(components), Eigen::MatrixXd::Zero(m, 2));
+  chol_u_.assign(static_cast<std::size_t>(components), Eigen::MatrixXd::Zero(m, m));
+  chol_v_.assign(static_cast<std::size_t>(components), Eigen::Matrix2d::Identity());
+  phi_.resize(m);
+  u_phi_.resize(m);
+  z_.resize(m, 2);
+  w_.resize(m, 2);
+}
+
+MatrixNormal TrajectoryDistribution::Component(int r) const {
+  return MatrixNormal{mean(r), chol_u(r), chol_v(r)};
+}
+
+void TrajectoryDistribution::Position(double t, int r, Eigen::Vector2d* mu, Eigen::Matrix2d* cov) const {
+  basis_.Evaluate(t, phi_);
+  const auto k = static_cast<std::size_t>(r);
+  *mu = origin_;
+  for (int j = 0; j < basis_size(); ++j) *mu += phi_[j] * mean_[k].row(j).transpose();
+  // phi' U phi = ||L_U' phi||^2 with L_U lower triangular.
+  const int m = basis_size();
+  double s = 0.0;
+  for (int j = 0; j < m; ++j) {
+    double acc = 0.0;
+    for (int i = j; i < m; ++i) acc += chol_u_[k](i, j) * phi_[i];
+    s += acc * acc;
+  }
+  const Eigen::Matrix2d& l = chol_v_[k];
+  cov->noalias() = s * (l * l.transpose());
+}
+
+Eigen::Vector2d TrajectoryDistribution::MeanPosition(double t) const {
+  basis_.Evaluate(t, phi_);
+  Eigen::Vector2d out = origin_;
+  for (int r = 0; r < components(); ++r)
+    for (int j = 0; j < basis_size(); ++j)
+      out += alpha_[r] * phi_[j] * mean_[static_cast<std::size_t>(r)].row(j).transpose();
+  return out;
+}
+
+double TrajectoryDistribution::LogDensity(double t, const Eigen::Vector2d& x) const {
+  double mx = -INFINITY;
+  double terms[64];
+  const int R = std::min(components(), 64);
+  for (int r = 0; r < R; ++r) {
+    Eigen::Vector2d mu;
+    Eigen::Matrix2d cov;
+    Position(t, r, &mu, &cov);
+    terms[r] = std::log(alpha_[r]) + LogGaussian2(x, mu, cov);
+    mx = std::max(mx, terms[r]);
+  }
+  if (!std::isfinite(mx)) return mx;
+  double sum = 0.0;
+  for (int r = 0; r < R; ++r) sum += std::exp(terms[r] - mx);
+  return mx + std::log(sum);
+}
+
+void TrajectoryDistribution::SamplePath(const Eigen::Ref<const Eigen::VectorXd>& times,
+                                        std::mt19937_64* rng,
+                                        Eigen::Ref<Eigen::Matrix<double, Eigen::Dynamic, 2>> path) const {
+  // Pick a component, then W = M + L_U Z L_V' with Z standard normal.
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  int r = 0;
+  double u = u01(*rng), acc = 0.0;
+  for (; r + 1 < components(); ++r) {
+    acc += alpha_[r];
+    if (u < acc) break;
+  }
+  const auto k = static_cast<std::size_t>(r);
+  const int m = basis_size();
+  for (int i = 0; i < m; ++i) z_(i, 0) = n01(*rng), z_(i, 1) = n01(*rng);
+  for (int i = 0; i < m; ++i) {
+    double a0 = 0.0, a1 = 0.0;  // (L_U Z)_i
+    for (int j = 0; j <= i; ++j) a0 += chol_u_[k](i, j) * z_(j, 0), a1 += chol_u_[k](i, j) * z_(j, 1);
+    const Eigen::Matrix2d& l = chol_v_[k];
+    w_(i, 0) = mean_[k](i, 0) + a0 * l(0, 0);
+    w_(i, 1) = mean_[k](i, 1) + a0 * l(1, 0) + a1 * l(1, 1);
+  }
+  for (Eigen::Index n = 0; n < times.size(); ++n) {
+    basis_.Evaluate(times[n], phi_);
+    Eigen::Vector2d o = origin_;
+    for (int j = 0; j < m; ++j) o += phi_[j] * w_.row(j).transpose();
+    path.row(n) = o.transpose();
+  }
+}
+
+// ---------------------------------------------------------------- SpanPredictor
+
+SpanPredictor SpanPredictor::Load(const std::string& path) {
+  const Artifact art = Artifact::Open(path, kSpanModelType);
+  const h5::File& f = art.file();
+  SpanPredictor p;
+  p.observed_ = static_cast<int>(f.GetIntAttr("/model", "observed"));
+  p.seconds_per_step_ = f.GetDoubleAttr("/model", "seconds_per_step");
+  p.rotate_ = f.GetIntAttr("/model", "rotate_to_heading") != 0;
+  p.layout_.basis = static_cast<int>(f.GetIntAttr("/model", "basis_size"));
+  p.layout_.components = static_cast<int>(f.GetIntAttr("/model", "components"));
+  const std::string u_param = f.GetStringAttr("/model", "u_param");
+  FS_THROW_UNLESS(u_param == "cholesky" || u_param == "diagonal", path, ": unknown u_param '",
+                  u_param, "'");
+  p.layout_.u_param = u_param == "cholesky" ? UParam::kCholesky : UParam::kDiagonal;
+  FS_THROW_UNLESS(p.observed_ >= 2 && p.layout_.basis >= 1 && p.layout_.components >= 1 &&
+                      p.layout_.components <= 64 && p.seconds_per_step_ > 0,
+                  path, ": implausible model attributes (observed ", p.observed_, ", basis ",
+                  p.layout_.basis, ", components ", p.layout_.components, ")");
+  const Eigen::MatrixXd centres = f.ReadMatrixD("/model/basis_centres", p.layout_.basis, 1);
+  p.basis_ = TimeBasis(centres.col(0), f.GetDoubleAttr("/model", "basis_gamma"));
+  const int in = 2 * p.observed_;
+  p.input_mean_ = f.ReadMatrixD("/normalisation/input_mean", in, 1).col(0);
+  p.input_std_ = f.ReadMatrixD("/normalisation/input_std", in, 1).col(0);
+  FS_THROW_UNLESS((p.input_std_.array() > 0).all() && p.input_mean_.allFinite(), path,
+                  ": /normalisation has non-positive or non-finite entries");
+  std::vector<std::string> names;
+  {
+    const std::string joined = f.GetStringAttr("/model", "dense_layers");
+    std::size_t start = 0;
+    while (start <= joined.size()) {
+      const auto comma = joined.find(',', start);
+      names.push_back(joined.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+      if (comma == std::string::npos) break;
+      start = comma + 1;
+    }
+  }
+  p.mlp_ = Mlp::Load(f, "/weights/", names);
+  FS_THROW_UNLESS(p.mlp_.input_size() == in, path, ": network takes ", p.mlp_.input_size(),
+                  " inputs, expected 2 x observed = ", in);
+  FS_THROW_UNLESS(p.mlp_.output_size() == p.layout_.Total(), path, ": network gives ",
+                  p.mlp_.output_size(), " outputs, the head layout needs ", p.layout_.Total());
+  for (const auto& l : p.mlp_.layers())
+    FS_THROW_UNLESS(l.weight.allFinite() && l.bias.allFinite(), path, ": non-finite weights");
+  return p;
+}
+
+SpanPredictor::Workspace SpanPredictor::MakeWorkspace() const {
+  return {Eigen::VectorXf::Zero(2 * observed_), mlp_.MakeWorkspace(),
+          Eigen::VectorXd::Zero(layout_.Total()),
+          Eigen::Matrix<double, Eigen::Dynamic, 2>::Zero(observed_, 2)};
+}
+
+TrajectoryDistribution SpanPredictor::MakeDistribution() const {
+  return TrajectoryDistribution(basis_, layout_.components);
+}
+
+namespace {
+EgoFrame FrameOf(const Eigen::Ref<const Eigen::Matrix<double, Eigen::Dynamic, 2>>& past, bool rotate) {
+  return EgoFrame::FromPast(static_cast<int>(past.rows()),
+                            [&](int i) { return Eigen::Vector2d(past(i, 0), past(i, 1)); }, rotate);
+}
+}  // namespace
+
+void SpanPredictor::RawOutput(const Eigen::Ref<const Eigen::Matrix<double, Eigen::Dynamic, 2>>& past,
+                              Workspace* ws) const {
+  FS_THROW_UNLESS(past.rows() == observed_, "SpanPredictor: expected ", observed_,
+                  " observed points, got ", past.rows());
+  FS_THROW_UNLESS(past.allFinite(), "SpanPredictor: observed track contains NaN or inf");
+  const EgoFrame frame = FrameOf(past, rotate_);
+  for (int i = 0; i < observed_; ++i) {
+    const Eigen::Vector2d q = frame.ToEgo(Eigen::Vector2d(past(i, 0), past(i, 1)));
+    ws->input[2 * i] = static_cast<float>((q.x() - input_mean_[2 * i]) / input_std_[2 * i]);
+    ws->input[2 * i + 1] = static_cast<float>((q.y() - input_mean_[2 * i + 1]) / input_std_[2 * i + 1]);
+  }
+  const auto out = mlp_.Forward(ws->input, &ws->mlp);
+  ws->raw = out.cast<double>();
+}
+
+void SpanPredictor::Predict(const Eigen::Ref<const Eigen::Matrix<double, Eigen::Dynamic, 2>>& past,
+                            Workspace* ws, TrajectoryDistribution* out) const {
+  RawOutput(past, ws);
+  const EgoFrame frame = FrameOf(past, rotate_);
+  const Eigen::Matrix2d& rot = frame.rotation;
+  const Eigen::VectorXd& z = ws->raw;
+  const int m = layout_.basis, R = layout_.components;
+  auto clamped_exp = [](double v) {
+    return std::exp(std::clamp(v, HeadLayout::kLogDiagMin, HeadLayout::kLogDiagMax));
+  };
+  out->origin_ = frame.origin;
+  double max_logit = -INFINITY;
+  for (int r = 0; r < R; ++r) max_logit = std::max(max_logit, z[layout_.AlphaOffset(r)]);
+  double norm = 0.0;
+  for (int r = 0; r < R; ++r) norm += out->alpha_[r] = std::exp(z[layout_.AlphaOffset(r)] - max_logit);
+  out->alpha_ /= norm;
+  for (int r = 0; r < R; ++r) {
+    const auto k = static_cast<std::size_t>(r);
+    // M_world = M_ego R'.
+    const int mo = layout_.MeanOffset(r);
+    for (int j = 0; j < m; ++j) {
+      const Eigen::Vector2d row(z[mo + 2 * j], z[mo + 2 * j + 1]);
+      out->mean_[k].row(j).noalias() = (rot * row).transpose();
+    }
+    Eigen::MatrixXd& lu = out->chol_u_[k];
+    const int uo = layout_.UOffset(r);
+    if (layout_.u_param == UParam::kDiagonal) {
+      for (int i = 0; i < m; ++i) lu(i, i) = clamped_exp(z[uo + i]);
+    } else {
+      int idx = uo;
+      for (int i = 0; i < m; ++i)
+        for (int j = 0; j <= i; ++j, ++idx) lu(i, j) = (i == j) ? clamped_exp(z[idx]) : z[idx];
+    }
+    // V_world = R V_ego R', re-factorised as a lower Cholesky factor.
+    const int vo = layout_.VOffset(r);
+    Eigen::Matrix2d lv;
+    lv << clamped_exp(z[vo]), 0.0, z[vo + 1], clamped_exp(z[vo + 2]);
+    const Eigen::Matrix2d v = rot * (lv * lv.transpose()) * rot.transpose();
+    const double l00 = std::sqrt(v(0, 0));
+    const double l10 = v(1, 0) / l00;
+    const double l11 = std::sqrt(std::max(v(1, 1) - l10 * l10, 1e-300));
+    out->chol_v_[k] << l00, 0.0, l10, l11;
+  }
+}
+
+void SpanPredictor::PredictBatch(const Eigen::Ref<const Eigen::MatrixXd>& past_rows, Workspace* ws,
+                                 std::vector<TrajectoryDistribution>* out) const {
+  FS_THROW_UNLESS(past_rows.cols() == 2 * observed_, "SpanPredictor: batch rows have ",
+                  past_rows.cols(), " entries, expected 2 x observed = ", 2 * observed_);
+  FS_THROW_UNLESS(out->size() >= static_cast<std::size_t>(past_rows.rows()),
+                  "SpanPredictor: output holds ", out->size(), " distributions for ",
+                  past_rows.rows(), " tracks");
+  for (Eigen::Index n = 0; n < past_rows.rows(); ++n) {
+    for (int i = 0; i < observed_; ++i) {
+      ws->past(i, 0) = past_rows(n, 2 * i);
+      ws->past(i, 1) = past_rows(n, 2 * i + 1);
+    }
+    Predict(ws->past, ws, &(*out)[static_cast<std::size_t>(n)]);
+  }
+}
+
+}  // namespace foresight

@@ -1,0 +1,105 @@
+#pragma once
+/// LibTorch-free engine of the SPAN pedestrian predictor (thesis ch 5; mixture head of ch 7).
+///
+///   SpanPredictor model = SpanPredictor::Load("model.h5");   // immutable, share across threads
+///   auto ws = model.MakeWorkspace();                           // one per caller
+///   auto out = model.MakeDistribution();                        // preallocated output
+///   model.Predict(past, &ws, &out);                             // no allocation
+///   out.Position(t, &mean, &cov);                                // o(t) ~ N(M' phi, (phi' U phi) V)
+
+#include <Eigen/Core>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "core/matrix_normal.h"
+#include "core/matrix_normal_head.h"
+#include "core/rbf.h"
+#include "inference/engine/dense.h"
+
+namespace foresight {
+
+inline constexpr const char* kSpanModelType = "span_predictor";
+
+/// A predicted mixture of matrix normals over future trajectory weights, in the world frame.
+/// Trajectories: o(t) = origin + W' phi(t), t (s) from the last observed point.
+class TrajectoryDistribution {
+ public:
+  TrajectoryDistribution() = default;
+  TrajectoryDistribution(const TimeBasis& basis, int components);
+
+  int components() const { return static_cast<int>(alpha_.size()); }
+  int basis_size() const { return basis_.size(); }
+  const Eigen::Vector2d& origin() const { return origin_; }
+  double alpha(int r) const { return alpha_[r]; }
+  const Eigen::MatrixXd& mean(int r) const { return mean_[static_cast<std::size_t>(r)]; }
+  const Eigen::MatrixXd& chol_u(int r) const { return chol_u_[static_cast<std::size_t>(r)]; }
+  const Eigen::Matrix2d& chol_v(int r) const { return chol_v_[static_cast<std::size_t>(r)]; }
+  /// Component r as a core::MatrixNormal over W (allocates; for tests and tools).
+  MatrixNormal Component(int r) const;
+
+  /// Mean [2] and covariance [2 x 2] of component r's position at time t (world, m).
+  void Position(double t, int r, Eigen::Vector2d* mean, Eigen::Matrix2d* cov) const;
+  /// Mixture mean position at time t (world, m).
+  Eigen::Vector2d MeanPosition(double t) const;
+  /// log density of the observed position x at time t under the mixture.
+  double LogDensity(double t, const Eigen::Vector2d& x) const;
+  /// Samples one trajectory at `times` [T] into `path` [T x 2] (preallocated; no allocation).
+  void SamplePath(const Eigen::Ref<const Eigen::VectorXd>& times, std::mt19937_64* rng,
+                  Eigen::Ref<Eigen::Matrix<double, Eigen::Dynamic, 2>> path) const;
+
+ private:
+  friend class SpanPredictor;
+  TimeBasis basis_;
+  Eigen::Vector2d origin_ = Eigen::Vector2d::Zero();
+  Eigen::VectorXd alpha_;
+  std::vector<Eigen::MatrixXd> mean_, chol_u_;
+  std::vector<Eigen::Matrix2d> chol_v_;
+  // Scratch for queries (the distribution is owned by one caller).
+  mutable Eigen::VectorXd phi_, u_phi_;
+  mutable Eigen::MatrixXd z_, w_;
+};
+
+class SpanPredictor {
+ public:
+  struct Workspace {
+    Eigen::VectorXf input;
+    Mlp::Workspace mlp;
+    Eigen::VectorXd raw;
+    Eigen::Matrix<double, Eigen::Dynamic, 2> past;  ///< batch row unpacked as [p x 2]
+  };
+
+  /// Loads an artifact written by `foresight export` (model_type "span_predictor").
+  static SpanPredictor Load(const std::string& path);
+
+  int observed() const { return observed_; }
+  double seconds_per_step() const { return seconds_per_step_; }
+  const HeadLayout& layout() const { return layout_; }
+  const TimeBasis& basis() const { return basis_; }
+  const Mlp& mlp() const { return mlp_; }
+
+  Workspace MakeWorkspace() const;
+  TrajectoryDistribution MakeDistribution() const;
+
+  /// @param past [p x 2] observed positions (world, m), oldest first, one every seconds_per_step.
+  /// Non-finite input is an Error (checked before any work).
+  void Predict(const Eigen::Ref<const Eigen::Matrix<double, Eigen::Dynamic, 2>>& past,
+               Workspace* ws, TrajectoryDistribution* out) const;
+  /// Batch form: row k of `past_rows` is x_1, y_1, ..., x_p, y_p. `out` must hold N distributions.
+  void PredictBatch(const Eigen::Ref<const Eigen::MatrixXd>& past_rows, Workspace* ws,
+                    std::vector<TrajectoryDistribution>* out) const;
+  /// Raw head outputs (before activations) for the normalised input of `past`: parity tests.
+  void RawOutput(const Eigen::Ref<const Eigen::Matrix<double, Eigen::Dynamic, 2>>& past,
+                 Workspace* ws) const;
+
+ private:
+  int observed_ = 0;
+  double seconds_per_step_ = 0.4;
+  bool rotate_ = true;
+  HeadLayout layout_;
+  TimeBasis basis_;
+  Eigen::VectorXd input_mean_, input_std_;
+  Mlp mlp_;
+};
+
+}  // namespace foresight

@@ -1,0 +1,51 @@
+#pragma once
+/// Configuration of the SPAN pedestrian predictor (thesis ch 5) and its mixture variant (ch 7).
+/// Torch-free so the config reference and the data preparation need no LibTorch.
+
+#include <vector>
+
+#include "core/config.h"
+#include "core/matrix_normal_head.h"
+
+namespace foresight {
+
+/// Continuous trajectory representation of the futures: o(t) = W' phi(t), t from the present.
+struct TrajectoryBasisConfig {
+  int num_centres = 8;        ///< m
+  double gamma = 1.0;         ///< phi(t, t') = exp(-gamma (t - t')^2), 1/s^2
+  double ridge_lambda = 1e-3;  ///< ridge penalty of the fit (thesis eq. lsuqares)
+  bool anchor_at_origin = true;  ///< include o(0) = present position in the fit
+
+  template <class A>
+  void Serialize(A* a) {
+    a->Visit("num_centres", &num_centres, config::Range::Closed(1, 64),
+             "m, basis functions evenly spaced over the prediction horizon");
+    a->Visit("gamma", &gamma, config::Range::Positive(), "RBF parameter gamma (1/s^2)");
+    a->Visit("ridge_lambda", &ridge_lambda, config::Range::NonNegative(),
+             "ridge penalty lambda of the future fit");
+    a->Visit("anchor_at_origin", &anchor_at_origin, config::Range::Any(),
+             "fit the future together with the present position (continuity at t = 0)");
+  }
+};
+
+struct SpanNetConfig {
+  std::vector<int> hidden = {100, 100, 100};  ///< widths of the ReLU layers (thesis: 3 x 100)
+  int components = 1;                         ///< R; 1 is SPAN, > 1 the mixture of ch 7
+  UParam u_param = UParam::kCholesky;
+  bool rotate_to_heading = true;  ///< express inputs and outputs in the ego frame
+
+  template <class A>
+  void Serialize(A* a) {
+    a->Visit("hidden", &hidden, config::Range::Closed(1, 4096), "hidden layer widths (ReLU)");
+    a->Visit("components", &components, config::Range::Closed(1, 32),
+             "R, matrix-normal mixture components (1 = SPAN)");
+    a->VisitEnum("u_param", &u_param,
+                 config::EnumNames<UParam>{{UParam::kCholesky, "cholesky"},
+                                           {UParam::kDiagonal, "diagonal"}},
+                 "parameterisation of the row scale U (full Cholesky or log-diagonal)");
+    a->Visit("rotate_to_heading", &rotate_to_heading, config::Range::Any(),
+             "rotate each window so the observed heading is +x (predictions rotate back exactly)");
+  }
+};
+
+}  // namespace foresight

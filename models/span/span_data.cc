@@ -1,0 +1,37 @@
+#include "models/span/span_data.h"
+
+#include "core/ego_frame.h"
+
+namespace foresight {
+
+TimeBasis MakeFutureBasis(const TrajectoryBasisConfig& c, int predicted, double dt) {
+  return TimeBasis(c.num_centres, 0.0, predicted * dt, c.gamma);
+}
+
+SpanSamples MakeSpanSamples(const WindowSet& w, const TimeBasis& basis,
+                            const TrajectoryBasisConfig& c, bool rotate) {
+  const int p = w.observed, f = w.predicted, m = basis.size();
+  const int first = c.anchor_at_origin ? 0 : 1;
+  Eigen::VectorXd times(f + 1 - first);
+  for (int k = first; k <= f; ++k) times[k - first] = k * w.seconds_per_step;
+  const RidgeProjector ridge(basis, times, c.ridge_lambda);
+
+  SpanSamples s;
+  s.inputs.resize(w.size(), 2 * p);
+  s.targets.resize(w.size(), 2 * m);
+  Eigen::MatrixXd points(times.size(), 2);
+  for (int n = 0; n < w.size(); ++n) {
+    const EgoFrame frame = EgoFrame::FromPast(p, [&](int i) { return w.Past(n, i); }, rotate);
+    for (int i = 0; i < p; ++i) s.inputs.row(n).segment<2>(2 * i) = frame.ToEgo(w.Past(n, i));
+    if (first == 0) points.row(0).setZero();
+    for (int k = 1; k <= f; ++k) points.row(k - first) = frame.ToEgo(w.Future(n, k - 1)).transpose();
+    const Eigen::MatrixXd wm = ridge.Fit(points);  // m x 2
+    for (int j = 0; j < m; ++j) {
+      s.targets(n, 2 * j) = wm(j, 0);
+      s.targets(n, 2 * j + 1) = wm(j, 1);
+    }
+  }
+  return s;
+}
+
+}  // namespace foresight

@@ -1,0 +1,25 @@
+#pragma once
+/// Training pairs (observed past, future RBF weights W) in the ego frame (core/ego_frame.h).
+
+#include <Eigen/Core>
+
+#include "core/rbf.h"
+#include "datasets/windows.h"
+#include "models/span/span_config.h"
+
+namespace foresight {
+
+/// Basis over the prediction horizon [0, f dt] (s), t = 0 at the last observed point.
+TimeBasis MakeFutureBasis(const TrajectoryBasisConfig& config, int predicted,
+                          double seconds_per_step);
+
+struct SpanSamples {
+  Eigen::MatrixXd inputs;   ///< [N x 2p] past points in the ego frame (x_1, y_1, ...)
+  Eigen::MatrixXd targets;  ///< [N x 2m] W (m x 2) row-major, ego frame (m)
+};
+
+/// Ego-frame inputs and ridge-fitted future weights (thesis eq. lsuqares) for every window.
+SpanSamples MakeSpanSamples(const WindowSet& windows, const TimeBasis& basis,
+                            const TrajectoryBasisConfig& config, bool rotate);
+
+}  // namespace foresight

@@ -1,0 +1,60 @@
+#pragma once
+/// The complete config of a SPAN predictor experiment (configs/quickstart.yaml,
+/// configs/span/*.yaml). Torch-free: used by the CLI, the docs generator and the engine tools.
+
+#include <cstdint>
+#include <string>
+
+#include "core/config.h"
+#include "datasets/pedestrian_data.h"
+#include "datasets/windows.h"
+#include "models/span/span_config.h"
+#include "training/train_config.h"
+
+namespace foresight {
+
+struct SpanEvalConfig {
+  int num_samples = 20;             ///< samples for best-of-N metrics
+  std::int64_t sample_seed = 7;     ///< seed of the evaluation sampler
+  int plot_tracks = 6;              ///< windows drawn in plots/samples.png
+  int max_windows = 0;              ///< evaluate at most this many test windows (0: all)
+
+  template <class A>
+  void Serialize(A* a) {
+    a->Visit("num_samples", &num_samples, config::Range::Closed(1, 1000), "N of best-of-N ADE/FDE");
+    a->Visit("sample_seed", &sample_seed, config::Range::Any(), "seed of the evaluation sampler");
+    a->Visit("plot_tracks", &plot_tracks, config::Range::Closed(0, 64), "windows drawn in the PNG");
+    a->Visit("max_windows", &max_windows, config::Range::AtLeast(0),
+             "cap on evaluated test windows (0: all)");
+  }
+};
+
+struct SpanExperimentConfig {
+  std::string model = "span_predictor";
+  std::int64_t seed = 0;
+  PedestrianDataConfig data;
+  WindowConfig windows;
+  TrajectoryBasisConfig basis;
+  SpanNetConfig network;
+  TrainConfig train;
+  SpanEvalConfig eval;
+
+  template <class A>
+  void Serialize(A* a) {
+    a->Visit("model", &model, config::Range::Any(), "model type (span_predictor)");
+    a->Visit("seed", &seed, config::Range::Any(), "seed of initialisation, shuffling and splits");
+    a->Visit("data", &data, config::Range::Any(), "pedestrian tracks");
+    a->Visit("windows", &windows, config::Range::Any(), "observation / prediction windows");
+    a->Visit("basis", &basis, config::Range::Any(), "RBF trajectory representation of futures");
+    a->Visit("network", &network, config::Range::Any(), "predictor network and head");
+    a->Visit("train", &train, config::Range::Any(), "trainer");
+    a->Visit("eval", &eval, config::Range::Any(), "evaluation");
+  }
+};
+
+/// Loads and validates (errors name the file and key).
+SpanExperimentConfig LoadSpanConfig(const std::string& path, const std::vector<std::string>& overrides);
+SpanExperimentConfig SpanConfigFromYaml(const std::string& yaml_text, const std::string& source,
+                                        const std::vector<std::string>& overrides = {});
+
+}  // namespace foresight

@@ -1,0 +1,196 @@
+#include "training/span_pipeline.h"
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "core/error.h"
+#include "core/h5.h"
+#include "core/log.h"
+#include "inference/engine/artifact.h"
+#include "inference/prediction/span_predictor.h"
+#include "models/span/span_data.h"
+#include "models/span/span_net.h"
+
+namespace foresight {
+namespace fs = std::filesystem;
+
+namespace {
+
+HeadLayout LayoutOf(const SpanExperimentConfig& c) {
+  HeadLayout l;
+  l.basis = c.basis.num_centres;
+  l.components = c.network.components;
+  l.u_param = c.network.u_param;
+  return l;
+}
+
+torch::Tensor ToTensor(const Eigen::MatrixXd& m) {
+  Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> rm = m.cast<float>();
+  return torch::from_blob(rm.data(), {rm.rows(), rm.cols()}, torch::kFloat32).clone();
+}
+
+struct Normalisation {
+  Eigen::VectorXd mean, std;
+  Eigen::MatrixXd Apply(const Eigen::MatrixXd& x) const {
+    return (x.rowwise() - mean.transpose()).array().rowwise() / std.transpose().array();
+  }
+};
+
+Normalisation FitNormalisation(const Eigen::MatrixXd& x) {
+  Normalisation n;
+  n.mean = x.colwise().mean().transpose();
+  n.std = ((x.rowwise() - n.mean.transpose()).array().square().colwise().mean()).sqrt().transpose();
+  for (Eigen::Index i = 0; i < n.std.size(); ++i)
+    if (!(n.std[i] > 1e-6)) n.std[i] = 1.0;  // constant features (the ego origin) pass through
+  return n;
+}
+
+void WriteNormalisation(const std::string& path, const Normalisation& n) {
+  h5::File f = h5::File::Create(path);
+  f.WriteMatrix("/input_mean", n.mean);
+  f.WriteMatrix("/input_std", n.std);
+}
+
+Normalisation ReadNormalisation(const std::string& path) {
+  h5::File f = h5::File::Open(path);
+  return {f.ReadMatrixD("/input_mean").col(0), f.ReadMatrixD("/input_std").col(0)};
+}
+
+class SpanTask : public TrainingTask {
+ public:
+  SpanTask(SpanNet net, const HeadLayout& layout, torch::Tensor x_train, torch::Tensor w_train,
+           torch::Tensor x_val, torch::Tensor w_val)
+      : net_(std::move(net)), layout_(layout), x_train_(std::move(x_train)), w_train_(std::move(w_train)),
+        x_val_(std::move(x_val)), w_val_(std::move(w_val)) {}
+
+  torch::nn::Module& module() override { return *net_; }
+  std::int64_t num_train() const override { return x_train_.size(0); }
+
+  torch::Tensor BatchLoss(const torch::Tensor& idx) override {
+    const auto raw = net_->forward(x_train_.index_select(0, idx));
+    return MixtureNll(DecodeHead(raw, layout_), w_train_.index_select(0, idx), layout_).mean();
+  }
+
+  double ValidationLoss() override {
+    double sum = 0;
+    const std::int64_t n = x_val_.size(0);
+    if (n == 0) return 0.0;
+    for (std::int64_t b = 0; b < n; b += 4096) {
+      const std::int64_t len = std::min<std::int64_t>(4096, n - b);
+      const auto raw = net_->forward(x_val_.narrow(0, b, len));
+      sum += MixtureNll(DecodeHead(raw, layout_), w_val_.narrow(0, b, len), layout_).sum().item<double>();
+    }
+    return sum / static_cast<double>(n);
+  }
+
+ private:
+  SpanNet net_;
+  HeadLayout layout_;
+  torch::Tensor x_train_, w_train_, x_val_, w_val_;
+};
+
+std::string ReadText(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+}  // namespace
+
+TrainingSummary TrainSpan(const SpanExperimentConfig& c, const std::string& run_dir, bool resume) {
+  fs::create_directories(run_dir);
+  const std::string config_path = run_dir + "/config.yaml";
+  const std::string resolved = config::ToYaml(c);
+  if (resume) {
+    FS_THROW_UNLESS(fs::exists(config_path), run_dir, ": no config.yaml to resume from");
+    FS_THROW_UNLESS(ReadText(config_path) == resolved, config_path,
+                    ": the resolved config differs from the one this run started with; "
+                    "resume with the same config and overrides");
+  } else {
+    std::ofstream(config_path) << resolved;
+  }
+  log::SetFile(run_dir + "/log.txt");
+  log::Info(resume ? "resuming" : "training", " span_predictor in ", run_dir, " (seed ", c.seed, ")");
+
+  const TrackSplit split = LoadPedestrianSplits(c.data, static_cast<std::uint64_t>(c.seed));
+  const WindowSet train_w = MakeWindows(split.train, c.windows);
+  const WindowSet val_w = MakeWindows(split.val, c.windows);
+  log::Info("windows: ", train_w.size(), " train, ", val_w.size(), " val");
+  FS_THROW_UNLESS(train_w.size() > 0, "no training windows of ", c.windows.observed + c.windows.predicted,
+                  " points in the training tracks");
+  const TimeBasis basis = MakeFutureBasis(c.basis, c.windows.predicted, train_w.seconds_per_step);
+  const SpanSamples train_s = MakeSpanSamples(train_w, basis, c.basis, c.network.rotate_to_heading);
+  const SpanSamples val_s = MakeSpanSamples(val_w, basis, c.basis, c.network.rotate_to_heading);
+
+  const std::string norm_path = run_dir + "/normalisation.h5";
+  const Normalisation norm = resume ? ReadNormalisation(norm_path) : FitNormalisation(train_s.inputs);
+  if (!resume) WriteNormalisation(norm_path, norm);
+
+  const HeadLayout layout = LayoutOf(c);
+  torch::manual_seed(static_cast<std::uint64_t>(c.seed));
+  SpanNet net(2 * c.windows.observed, c.network, layout);
+  const std::int64_t m = layout.basis;
+  auto w_train = ToTensor(train_s.targets).view({-1, m, 2});
+  auto w_val = ToTensor(val_s.targets).view({-1, m, 2});
+  SpanTask task(net, layout, ToTensor(norm.Apply(train_s.inputs)), w_train,
+                ToTensor(norm.Apply(val_s.inputs)), w_val);
+  return Train(&task, c.train, RunPaths{run_dir}, static_cast<std::uint64_t>(c.seed), resume);
+}
+
+void WriteSpanArtifact(const SpanExperimentConfig& c, const std::string& checkpoint,
+                       const std::string& normalisation_file, const std::string& artifact_path) {
+  const HeadLayout layout = LayoutOf(c);
+  SpanNet net(2 * c.windows.observed, c.network, layout);
+  LoadCheckpointModel(checkpoint, net.ptr().get());
+  const Normalisation norm = ReadNormalisation(normalisation_file);
+  const double dt = SecondsPerStep(c.data);
+  const TimeBasis basis = MakeFutureBasis(c.basis, c.windows.predicted, dt);
+  const std::string tmp = artifact_path + ".tmp";
+  {
+    h5::File f = h5::File::Create(tmp);
+    Artifact::WriteHeader(&f, kSpanModelType, config::ToYaml(c), c.seed);
+    f.WriteString("/model/description", "SPAN predictor: MLP -> mixture of matrix normals over RBF trajectory weights");
+    f.SetAttr("/model", "observed", static_cast<std::int64_t>(c.windows.observed));
+    f.SetAttr("/model", "predicted", static_cast<std::int64_t>(c.windows.predicted));
+    f.SetAttr("/model", "seconds_per_step", dt);
+    f.SetAttr("/model", "rotate_to_heading", static_cast<std::int64_t>(c.network.rotate_to_heading));
+    f.SetAttr("/model", "basis_size", static_cast<std::int64_t>(layout.basis));
+    f.SetAttr("/model", "components", static_cast<std::int64_t>(layout.components));
+    f.SetAttr("/model", "u_param", std::string(UParamName(layout.u_param)));
+    f.SetAttr("/model", "basis_gamma", basis.gamma());
+    f.WriteMatrix("/model/basis_centres", basis.centres());
+    f.WriteMatrix("/normalisation/input_mean", norm.mean);
+    f.WriteMatrix("/normalisation/input_std", norm.std);
+    std::string names;
+    for (const auto& name : net->DenseLayerNames()) names += (names.empty() ? "" : ",") + name;
+    f.SetAttr("/model", "dense_layers", names);
+    for (const auto& item : net->named_parameters()) {
+      const auto t = item.value().detach().contiguous().to(torch::kFloat32);
+      std::vector<std::size_t> shape(t.sizes().begin(), t.sizes().end());
+      f.Write("/weights/" + item.key().substr(0, item.key().rfind('.')) + "/" +
+                  item.key().substr(item.key().rfind('.') + 1),
+              t.data_ptr<float>(), shape);
+    }
+  }
+  FS_THROW_UNLESS(std::rename(tmp.c_str(), artifact_path.c_str()) == 0, artifact_path,
+                  ": cannot move the artifact into place");
+}
+
+std::string ExportSpan(const std::string& run_dir) {
+  const std::string config_path = run_dir + "/config.yaml";
+  FS_THROW_UNLESS(fs::exists(config_path), run_dir, ": not a run directory (no config.yaml)");
+  const SpanExperimentConfig c = LoadSpanConfig(config_path, {});
+  RunPaths run{run_dir};
+  const std::string ckpt = fs::exists(run.BestCheckpoint()) ? run.BestCheckpoint() : run.Checkpoint();
+  FS_THROW_UNLESS(fs::exists(ckpt), run_dir, ": no checkpoint to export (train first)");
+  const std::string out = run_dir + "/model.h5";
+  WriteSpanArtifact(c, ckpt, run_dir + "/normalisation.h5", out);
+  // Prove the artifact loads in the engine before reporting success.
+  (void)SpanPredictor::Load(out);
+  log::Info("exported ", ckpt, " -> ", out);
+  return out;
+}
+
+}  // namespace foresight

@@ -1,0 +1,24 @@
+#pragma once
+/// The SPAN predictor through the one pipeline:
+///   data -> windows -> ridge targets -> train (LibTorch) -> export (.h5) -> eval (Eigen engine).
+/// Run directory: config.yaml, log.txt, metrics.csv, normalisation.h5, checkpoints/, model.h5,
+/// eval.json, plots/samples.png.
+
+#include <string>
+
+#include "training/span_config.h"
+#include "training/trainer.h"
+
+namespace foresight {
+
+/// Trains (or resumes) into `run_dir`; writes the resolved config and the normalisation first.
+TrainingSummary TrainSpan(const SpanExperimentConfig& config, const std::string& run_dir, bool resume);
+
+/// Writes `run_dir`/model.h5 from the best checkpoint. @return the artifact path.
+std::string ExportSpan(const std::string& run_dir);
+
+/// Writes the artifact of a SpanNet checkpoint at `checkpoint` (used by export and tests).
+void WriteSpanArtifact(const SpanExperimentConfig& config, const std::string& checkpoint,
+                       const std::string& normalisation_file, const std::string& artifact_path);
+
+}  // namespace foresight

@@ -1,0 +1,269 @@
+#include "training/trainer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <numeric>
+#include <random>
+#include <sstream>
+
+#include "core/error.h"
+#include "core/log.h"
+#include "training/progress.h"
+
+namespace foresight {
+namespace fs = std::filesystem;
+
+double LearningRateAt(const TrainConfig& c, int epoch) {
+  switch (c.schedule) {
+    case LrSchedule::kConstant:
+      return c.learning_rate;
+    case LrSchedule::kStep:
+      return c.learning_rate * std::pow(c.step_factor, epoch / c.step_every);
+    case LrSchedule::kCosine: {
+      const double progress = c.epochs > 1 ? static_cast<double>(epoch) / (c.epochs - 1) : 0.0;
+      const double lo = c.min_lr_ratio;
+      return c.learning_rate * (lo + (1.0 - lo) * 0.5 * (1.0 + std::cos(M_PI * progress)));
+    }
+  }
+  return c.learning_rate;
+}
+
+const char* ToString(TerminationReason r) {
+  switch (r) {
+    case TerminationReason::kMaxEpochs: return "max_epochs";
+    case TerminationReason::kEarlyStopped: return "early_stopped";
+    case TerminationReason::kNonFiniteLoss: return "non_finite_loss";
+    case TerminationReason::kAlreadyComplete: return "already_complete";
+  }
+  return "";
+}
+
+std::string TrainingSummary::BriefReport() const {
+  std::ostringstream os;
+  os << "training " << ToString(reason) << " after " << epochs_completed << " epochs; best val loss "
+     << best_val_loss << " at epoch " << best_epoch << "; " << seconds << " s, "
+     << std::lround(samples_per_second) << " samples/s";
+  return os.str();
+}
+
+namespace {
+
+/// Trainer state saved with every checkpoint.
+struct State {
+  int epoch = 0;  ///< completed epochs
+  int best_epoch = -1;
+  double best_val = INFINITY;
+  int bad_epochs = 0;
+};
+
+void SaveCheckpoint(const std::string& path, torch::nn::Module& module, torch::optim::Optimizer& opt,
+                    const State& s) {
+  torch::serialize::OutputArchive archive;
+  torch::serialize::OutputArchive model_archive, opt_archive;
+  module.save(model_archive);
+  opt.save(opt_archive);
+  archive.write("model", model_archive);
+  archive.write("optimizer", opt_archive);
+  archive.write("state/epoch", torch::tensor(static_cast<int64_t>(s.epoch)));
+  archive.write("state/best_epoch", torch::tensor(static_cast<int64_t>(s.best_epoch)));
+  archive.write("state/best_val", torch::tensor(s.best_val, torch::kFloat64));
+  archive.write("state/bad_epochs", torch::tensor(static_cast<int64_t>(s.bad_epochs)));
+  const std::string tmp = path + ".tmp";
+  archive.save_to(tmp);
+  FS_THROW_UNLESS(std::rename(tmp.c_str(), path.c_str()) == 0, path, ": cannot move checkpoint into place");
+}
+
+torch::serialize::InputArchive OpenCheckpoint(const std::string& path) {
+  FS_THROW_UNLESS(fs::exists(path), path, ": checkpoint not found");
+  torch::serialize::InputArchive archive;
+  try {
+    archive.load_from(path);
+  } catch (const std::exception& e) {
+    Fail(path, ": corrupt or truncated checkpoint (", std::string(e.what()).substr(0, 120), ")");
+  }
+  return archive;
+}
+
+void ReadModel(const std::string& path, torch::serialize::InputArchive& archive,
+               torch::nn::Module* module) {
+  try {
+    torch::serialize::InputArchive model_archive;
+    archive.read("model", model_archive);
+    module->load(model_archive);
+  } catch (const std::exception& e) {
+    Fail(path, ": checkpoint does not match the model (", std::string(e.what()).substr(0, 120), ")");
+  }
+}
+
+State LoadCheckpoint(const std::string& path, torch::nn::Module* module, torch::optim::Optimizer* opt) {
+  auto archive = OpenCheckpoint(path);
+  ReadModel(path, archive, module);
+  State s;
+  try {
+    torch::serialize::InputArchive opt_archive;
+    archive.read("optimizer", opt_archive);
+    opt->load(opt_archive);
+    torch::Tensor t;
+    archive.read("state/epoch", t);
+    s.epoch = static_cast<int>(t.item<int64_t>());
+    archive.read("state/best_epoch", t);
+    s.best_epoch = static_cast<int>(t.item<int64_t>());
+    archive.read("state/best_val", t);
+    s.best_val = t.item<double>();
+    archive.read("state/bad_epochs", t);
+    s.bad_epochs = static_cast<int>(t.item<int64_t>());
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {
+    Fail(path, ": checkpoint is missing trainer state (", std::string(e.what()).substr(0, 120), ")");
+  }
+  return s;
+}
+
+/// Keeps the metrics rows of epochs 1..epoch (a resumed run rewrites later ones).
+void TruncateMetrics(const std::string& path, int epoch) {
+  std::ifstream in(path);
+  if (!in.good()) return;
+  std::vector<std::string> keep;
+  std::string line;
+  while (std::getline(in, line)) {
+    if (keep.empty()) {
+      keep.push_back(line);
+      continue;
+    }
+    if (std::stoi(line.substr(0, line.find(','))) <= epoch) keep.push_back(line);
+  }
+  in.close();
+  std::ofstream out(path, std::ios::trunc);
+  for (const auto& l : keep) out << l << "\n";
+}
+
+void SetLearningRate(torch::optim::Adam* opt, double lr) {
+  for (auto& group : opt->param_groups())
+    static_cast<torch::optim::AdamOptions&>(group.options()).lr(lr);
+}
+
+}  // namespace
+
+void LoadCheckpointModel(const std::string& path, torch::nn::Module* module) {
+  auto archive = OpenCheckpoint(path);
+  ReadModel(path, archive, module);
+}
+
+TrainingSummary Train(TrainingTask* task, const TrainConfig& c, const RunPaths& run,
+                      std::uint64_t seed, bool resume) {
+  torch::set_num_threads(c.threads);
+  fs::create_directories(run.dir + "/checkpoints");
+  torch::nn::Module& module = task->module();
+  torch::optim::Adam opt(module.parameters(),
+                         torch::optim::AdamOptions(c.learning_rate).weight_decay(c.weight_decay));
+  State state;
+  if (resume) {
+    state = LoadCheckpoint(run.Checkpoint(), &module, &opt);
+    TruncateMetrics(run.Metrics(), state.epoch);
+    log::Info("resuming ", run.Checkpoint(), " after epoch ", state.epoch);
+  } else {
+    std::ofstream(run.Metrics(), std::ios::trunc)
+        << "epoch,train_loss,val_loss,learning_rate,seconds,samples_per_second\n";
+  }
+
+  TrainingSummary summary;
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::int64_t n = task->num_train();
+  FS_THROW_UNLESS(n > 0, "training set is empty");
+  Progress progress(c.progress, c.epochs, "samples");
+  double items = 0;
+  bool stop = false;
+  if (state.epoch >= c.epochs || (c.patience > 0 && state.bad_epochs >= c.patience)) {
+    summary.reason = TerminationReason::kAlreadyComplete;
+    stop = true;
+  }
+  std::vector<std::int64_t> order(static_cast<std::size_t>(n));
+  while (!stop) {
+    const int epoch = state.epoch;  // 0-based index of the epoch being run
+    const auto e0 = std::chrono::steady_clock::now();
+    const double lr = LearningRateAt(c, epoch);
+    SetLearningRate(&opt, lr);
+    // The shuffle depends only on (seed, epoch): a resumed run sees the same batches.
+    std::iota(order.begin(), order.end(), 0);
+    std::mt19937_64 rng(seed * 0x9E3779B97F4A7C15ULL + static_cast<std::uint64_t>(epoch));
+    std::shuffle(order.begin(), order.end(), rng);
+    module.train();
+    double loss_sum = 0;
+    std::int64_t seen = 0;
+    bool finite = true;
+    for (std::int64_t b = 0; b < n; b += c.batch_size) {
+      const std::int64_t len = std::min<std::int64_t>(c.batch_size, n - b);
+      const auto idx = torch::from_blob(order.data() + b, {len}, torch::kInt64).clone();
+      opt.zero_grad();
+      torch::Tensor loss = task->BatchLoss(idx);
+      const double value = loss.item<double>();
+      if (!std::isfinite(value)) {
+        finite = false;
+        break;
+      }
+      loss.backward();
+      if (c.grad_clip_norm > 0) torch::nn::utils::clip_grad_norm_(module.parameters(), c.grad_clip_norm);
+      opt.step();
+      loss_sum += value * static_cast<double>(len);
+      seen += len;
+      items += static_cast<double>(len);
+      progress.Update(epoch, static_cast<double>(seen) / static_cast<double>(n), items,
+                      loss_sum / static_cast<double>(seen));
+    }
+    double val = NAN;
+    if (finite) {
+      module.eval();
+      torch::NoGradGuard no_grad;
+      val = task->ValidationLoss();
+      finite = std::isfinite(val);
+    }
+    if (!finite) {
+      summary.reason = TerminationReason::kNonFiniteLoss;
+      log::Warn("non-finite loss in epoch ", epoch + 1, "; stopping and keeping the checkpoint of epoch ",
+                state.epoch);
+      if (fs::exists(run.Checkpoint())) LoadCheckpointModel(run.Checkpoint(), &module);
+      break;
+    }
+    const double train_loss = loss_sum / static_cast<double>(seen);
+    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - e0).count();
+    state.epoch = epoch + 1;
+    if (val < state.best_val - c.min_delta) {
+      state.best_val = val;
+      state.best_epoch = state.epoch;
+      state.bad_epochs = 0;
+      SaveCheckpoint(run.BestCheckpoint(), module, opt, state);
+    } else {
+      ++state.bad_epochs;
+    }
+    SaveCheckpoint(run.Checkpoint(), module, opt, state);
+    std::ofstream(run.Metrics(), std::ios::app)
+        << state.epoch << "," << train_loss << "," << val << "," << lr << "," << secs << ","
+        << static_cast<double>(seen) / std::max(secs, 1e-9) << "\n";
+    std::ostringstream line;
+    line << "train " << train_loss << " val " << val << (state.best_epoch == state.epoch ? " *" : "")
+         << " lr " << lr;
+    progress.EndStep(epoch, line.str());
+    summary.last_train_loss = train_loss;
+    if (state.epoch >= c.epochs) {
+      summary.reason = TerminationReason::kMaxEpochs;
+      stop = true;
+    } else if (c.patience > 0 && state.bad_epochs >= c.patience) {
+      summary.reason = TerminationReason::kEarlyStopped;
+      stop = true;
+    }
+  }
+  progress.Finish();
+  summary.epochs_completed = state.epoch;
+  summary.best_epoch = state.best_epoch;
+  summary.best_val_loss = state.best_val;
+  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  summary.samples_per_second = items / std::max(summary.seconds, 1e-9);
+  log::Info(summary.BriefReport());
+  return summary;
+}
+
+}  // namespace foresight

@@ -1,0 +1,57 @@
+#pragma once
+/// A config-driven minibatch trainer for any LibTorch model: Adam, learning-rate schedule,
+/// gradient clipping, early stopping on the validation loss, non-finite loss detection,
+/// atomic per-epoch checkpoints, bit-identical --resume, progress display and metrics.csv.
+
+#include <torch/torch.h>
+
+#include <string>
+
+#include "training/train_config.h"
+
+namespace foresight {
+
+/// What the trainer trains: a module, a batch loss and a validation loss.
+class TrainingTask {
+ public:
+  virtual ~TrainingTask() = default;
+  virtual torch::nn::Module& module() = 0;
+  virtual std::int64_t num_train() const = 0;
+  /// Mean loss over the training samples `indices` [B] (int64), with autograd.
+  virtual torch::Tensor BatchLoss(const torch::Tensor& indices) = 0;
+  /// Mean validation loss (evaluated without gradients).
+  virtual double ValidationLoss() = 0;
+};
+
+enum class TerminationReason { kMaxEpochs, kEarlyStopped, kNonFiniteLoss, kAlreadyComplete };
+const char* ToString(TerminationReason reason);
+
+/// Outcome of a training run (expected outcomes are values, not exceptions).
+struct TrainingSummary {
+  TerminationReason reason = TerminationReason::kMaxEpochs;
+  int epochs_completed = 0;  ///< including epochs of a resumed run
+  int best_epoch = -1;       ///< 1-based epoch of the best validation loss
+  double best_val_loss = 0;
+  double last_train_loss = 0;
+  double seconds = 0;        ///< wall time of this invocation
+  double samples_per_second = 0;
+  std::string BriefReport() const;
+};
+
+/// Files of a run directory.
+struct RunPaths {
+  std::string dir;
+  std::string Checkpoint() const { return dir + "/checkpoints/last.pt"; }
+  std::string BestCheckpoint() const { return dir + "/checkpoints/best.pt"; }
+  std::string Metrics() const { return dir + "/metrics.csv"; }
+};
+
+/// Trains `task` in `run`. With `resume`, continues from run.Checkpoint() (an Error if it is
+/// missing or corrupt) and produces the same parameters as an uninterrupted run.
+TrainingSummary Train(TrainingTask* task, const TrainConfig& config, const RunPaths& run,
+                      std::uint64_t seed, bool resume);
+
+/// Loads the model parameters of a checkpoint into `module`; corrupt files are an Error.
+void LoadCheckpointModel(const std::string& path, torch::nn::Module* module);
+
+}  // namespace foresight
