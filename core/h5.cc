@@ -119,8 +119,23 @@ std::vector<std::string> File::List(const std::string& group) const {
 }
 
 namespace {
+void EnsureGroup(hid_t file, const std::string& path, const std::string& group) {
+  if (group.empty() || group == "/") return;
+  std::size_t pos = 0;
+  while (true) {
+    pos = group.find('/', pos + 1);
+    const std::string prefix = group.substr(0, pos);
+    if (!prefix.empty() && prefix != "/" && H5Lexists(file, prefix.c_str(), H5P_DEFAULT) <= 0) {
+      Handle g(H5Gcreate2(file, prefix.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
+      FS_THROW_UNLESS(g.ok(), path, ": cannot create group '", prefix, "'");
+    }
+    if (pos == std::string::npos) return;
+  }
+}
+
 void WriteAttrRaw(hid_t file, const std::string& path, const std::string& object,
                   const std::string& name, hid_t type, const void* data) {
+  EnsureGroup(file, path, ObjectName(object));
   Handle obj(H5Oopen(file, ObjectName(object).c_str(), H5P_DEFAULT), H5Oclose);
   FS_THROW_UNLESS(obj.ok(), path, ": no object '", object, "' for attribute '", name, "'");
   if (H5Aexists(obj.get(), name.c_str()) > 0) H5Adelete(obj.get(), name.c_str());

@@ -36,7 +36,7 @@ class File {
   /// Names of the members of a group ("/" for the root), sorted.
   std::vector<std::string> List(const std::string& group) const;
 
-  // Attributes on an object ("/" is the root group).
+  // Attributes on an object ("/" is the root group); a missing object is created as a group.
   void SetAttr(const std::string& object, const std::string& name, const std::string& value);
   void SetAttr(const std::string& object, const std::string& name, std::int64_t value);
   void SetAttr(const std::string& object, const std::string& name, double value);

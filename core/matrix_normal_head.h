@@ -20,8 +20,9 @@ struct HeadLayout {
   int components = 1;  ///< R
   UParam u_param = UParam::kCholesky;
 
-  /// Bounds on the log-diagonal of the Cholesky factors (keeps exp finite).
-  static constexpr double kLogDiagMin = -12.0;
+  /// Bounds on the log-diagonal of the Cholesky factors: exp stays finite, and the scales cannot
+  /// collapse onto directions the ridge targets happen to pin down (NLL -> -inf otherwise).
+  static constexpr double kLogDiagMin = -5.0;
   static constexpr double kLogDiagMax = 8.0;
 
   int UBlock() const { return u_param == UParam::kCholesky ? basis * (basis + 1) / 2 : basis; }

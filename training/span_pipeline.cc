@@ -99,7 +99,8 @@ std::string ReadText(const std::string& path) {
 
 }  // namespace
 
-TrainingSummary TrainSpan(const SpanExperimentConfig& c, const std::string& run_dir, bool resume) {
+TrainingSummary TrainSpan(const SpanExperimentConfig& c, const std::string& run_dir, bool resume,
+                          const TrainHooks& hooks) {
   fs::create_directories(run_dir);
   const std::string config_path = run_dir + "/config.yaml";
   const std::string resolved = config::ToYaml(c);
@@ -136,7 +137,7 @@ TrainingSummary TrainSpan(const SpanExperimentConfig& c, const std::string& run_
   auto w_val = ToTensor(val_s.targets).view({-1, m, 2});
   SpanTask task(net, layout, ToTensor(norm.Apply(train_s.inputs)), w_train,
                 ToTensor(norm.Apply(val_s.inputs)), w_val);
-  return Train(&task, c.train, RunPaths{run_dir}, static_cast<std::uint64_t>(c.seed), resume);
+  return Train(&task, c.train, RunPaths{run_dir}, static_cast<std::uint64_t>(c.seed), resume, hooks);
 }
 
 void WriteSpanArtifact(const SpanExperimentConfig& c, const std::string& checkpoint,
@@ -151,7 +152,6 @@ void WriteSpanArtifact(const SpanExperimentConfig& c, const std::string& checkpo
   {
     h5::File f = h5::File::Create(tmp);
     Artifact::WriteHeader(&f, kSpanModelType, config::ToYaml(c), c.seed);
-    f.WriteString("/model/description", "SPAN predictor: MLP -> mixture of matrix normals over RBF trajectory weights");
     f.SetAttr("/model", "observed", static_cast<std::int64_t>(c.windows.observed));
     f.SetAttr("/model", "predicted", static_cast<std::int64_t>(c.windows.predicted));
     f.SetAttr("/model", "seconds_per_step", dt);

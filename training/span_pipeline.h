@@ -12,7 +12,8 @@
 namespace foresight {
 
 /// Trains (or resumes) into `run_dir`; writes the resolved config and the normalisation first.
-TrainingSummary TrainSpan(const SpanExperimentConfig& config, const std::string& run_dir, bool resume);
+TrainingSummary TrainSpan(const SpanExperimentConfig& config, const std::string& run_dir, bool resume,
+                          const TrainHooks& hooks = {});
 
 /// Writes `run_dir`/model.h5 from the best checkpoint. @return the artifact path.
 std::string ExportSpan(const std::string& run_dir);

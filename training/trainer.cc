@@ -36,6 +36,7 @@ const char* ToString(TerminationReason r) {
     case TerminationReason::kMaxEpochs: return "max_epochs";
     case TerminationReason::kEarlyStopped: return "early_stopped";
     case TerminationReason::kNonFiniteLoss: return "non_finite_loss";
+    case TerminationReason::kInterrupted: return "interrupted";
     case TerminationReason::kAlreadyComplete: return "already_complete";
   }
   return "";
@@ -50,6 +51,13 @@ std::string TrainingSummary::BriefReport() const {
 }
 
 namespace {
+
+/// First line of a (LibTorch) exception message, shortened: our errors are one line.
+std::string Brief(const std::exception& e) {
+  std::string s = e.what();
+  s = s.substr(0, s.find('\n'));
+  return s.size() > 160 ? s.substr(0, 160) + "..." : s;
+}
 
 /// Trainer state saved with every checkpoint.
 struct State {
@@ -82,7 +90,7 @@ torch::serialize::InputArchive OpenCheckpoint(const std::string& path) {
   try {
     archive.load_from(path);
   } catch (const std::exception& e) {
-    Fail(path, ": corrupt or truncated checkpoint (", std::string(e.what()).substr(0, 120), ")");
+    Fail(path, ": corrupt or truncated checkpoint (", Brief(e), ")");
   }
   return archive;
 }
@@ -94,7 +102,7 @@ void ReadModel(const std::string& path, torch::serialize::InputArchive& archive,
     archive.read("model", model_archive);
     module->load(model_archive);
   } catch (const std::exception& e) {
-    Fail(path, ": checkpoint does not match the model (", std::string(e.what()).substr(0, 120), ")");
+    Fail(path, ": checkpoint does not match the model (", Brief(e), ")");
   }
 }
 
@@ -118,7 +126,7 @@ State LoadCheckpoint(const std::string& path, torch::nn::Module* module, torch::
   } catch (const Error&) {
     throw;
   } catch (const std::exception& e) {
-    Fail(path, ": checkpoint is missing trainer state (", std::string(e.what()).substr(0, 120), ")");
+    Fail(path, ": checkpoint is missing trainer state (", Brief(e), ")");
   }
   return s;
 }
@@ -154,7 +162,7 @@ void LoadCheckpointModel(const std::string& path, torch::nn::Module* module) {
 }
 
 TrainingSummary Train(TrainingTask* task, const TrainConfig& c, const RunPaths& run,
-                      std::uint64_t seed, bool resume) {
+                      std::uint64_t seed, bool resume, const TrainHooks& hooks) {
   torch::set_num_threads(c.threads);
   fs::create_directories(run.dir + "/checkpoints");
   torch::nn::Module& module = task->module();
@@ -195,7 +203,12 @@ TrainingSummary Train(TrainingTask* task, const TrainConfig& c, const RunPaths& 
     double loss_sum = 0;
     std::int64_t seen = 0;
     bool finite = true;
+    bool interrupted = false;
     for (std::int64_t b = 0; b < n; b += c.batch_size) {
+      if (hooks.interrupt && hooks.interrupt->load()) {
+        interrupted = true;
+        break;
+      }
       const std::int64_t len = std::min<std::int64_t>(c.batch_size, n - b);
       const auto idx = torch::from_blob(order.data() + b, {len}, torch::kInt64).clone();
       opt.zero_grad();
@@ -213,6 +226,13 @@ TrainingSummary Train(TrainingTask* task, const TrainConfig& c, const RunPaths& 
       items += static_cast<double>(len);
       progress.Update(epoch, static_cast<double>(seen) / static_cast<double>(n), items,
                       loss_sum / static_cast<double>(seen));
+    }
+    if (interrupted) {
+      summary.reason = TerminationReason::kInterrupted;
+      log::Warn("interrupted in epoch ", epoch + 1, "; the checkpoint of epoch ", state.epoch,
+                " is kept (continue with --resume)");
+      if (fs::exists(run.Checkpoint())) LoadCheckpointModel(run.Checkpoint(), &module);
+      break;
     }
     double val = NAN;
     if (finite) {
@@ -253,6 +273,9 @@ TrainingSummary Train(TrainingTask* task, const TrainConfig& c, const RunPaths& 
       stop = true;
     } else if (c.patience > 0 && state.bad_epochs >= c.patience) {
       summary.reason = TerminationReason::kEarlyStopped;
+      stop = true;
+    } else if (hooks.continue_after_epoch && !hooks.continue_after_epoch(state.epoch)) {
+      summary.reason = TerminationReason::kInterrupted;
       stop = true;
     }
   }

@@ -5,6 +5,8 @@
 
 #include <torch/torch.h>
 
+#include <atomic>
+#include <functional>
 #include <string>
 
 #include "training/train_config.h"
@@ -23,7 +25,7 @@ class TrainingTask {
   virtual double ValidationLoss() = 0;
 };
 
-enum class TerminationReason { kMaxEpochs, kEarlyStopped, kNonFiniteLoss, kAlreadyComplete };
+enum class TerminationReason { kMaxEpochs, kEarlyStopped, kNonFiniteLoss, kInterrupted, kAlreadyComplete };
 const char* ToString(TerminationReason reason);
 
 /// Outcome of a training run (expected outcomes are values, not exceptions).
@@ -46,10 +48,18 @@ struct RunPaths {
   std::string Metrics() const { return dir + "/metrics.csv"; }
 };
 
+/// Ways to stop a run from outside; the last checkpoint stays valid (resume continues from it).
+struct TrainHooks {
+  /// Polled between batches (e.g. set by SIGINT); a partial epoch is discarded.
+  const std::atomic<bool>* interrupt = nullptr;
+  /// Called after each completed epoch with the number completed; false stops the run.
+  std::function<bool(int)> continue_after_epoch;
+};
+
 /// Trains `task` in `run`. With `resume`, continues from run.Checkpoint() (an Error if it is
 /// missing or corrupt) and produces the same parameters as an uninterrupted run.
 TrainingSummary Train(TrainingTask* task, const TrainConfig& config, const RunPaths& run,
-                      std::uint64_t seed, bool resume);
+                      std::uint64_t seed, bool resume, const TrainHooks& hooks = {});
 
 /// Loads the model parameters of a checkpoint into `module`; corrupt files are an Error.
 void LoadCheckpointModel(const std::string& path, torch::nn::Module* module);

@@ -13,14 +13,19 @@ namespace foresight {
 struct TrajectoryBasisConfig {
   int num_centres = 8;        ///< m
   double gamma = 1.0;         ///< phi(t, t') = exp(-gamma (t - t')^2), 1/s^2
-  double ridge_lambda = 1e-3;  ///< ridge penalty of the fit (thesis eq. lsuqares)
-  bool anchor_at_origin = true;  ///< include o(0) = present position in the fit
+  double margin = 1.0;        ///< centres span [-margin, T + margin] (s): edges fit without bias
+  double ridge_lambda = 1e-4;  ///< ridge penalty of the fit (thesis eq. lsuqares)
+  /// Include o(0) = present position in the fit. Off by default: the anchor makes phi(0)' W = 0
+  /// hold exactly, a degenerate direction of the weight distribution that the NLL exploits.
+  bool anchor_at_origin = false;
 
   template <class A>
   void Serialize(A* a) {
     a->Visit("num_centres", &num_centres, config::Range::Closed(1, 64),
              "m, basis functions evenly spaced over the prediction horizon");
     a->Visit("gamma", &gamma, config::Range::Positive(), "RBF parameter gamma (1/s^2)");
+    a->Visit("margin", &margin, config::Range::NonNegative(),
+             "centres extend this far (s) before t = 0 and beyond the horizon; 0 = on [0, T]");
     a->Visit("ridge_lambda", &ridge_lambda, config::Range::NonNegative(),
              "ridge penalty lambda of the future fit");
     a->Visit("anchor_at_origin", &anchor_at_origin, config::Range::Any(),

@@ -9,7 +9,8 @@
 
 namespace foresight {
 
-/// Basis over the prediction horizon [0, f dt] (s), t = 0 at the last observed point.
+/// Basis over the prediction horizon [0, f dt] (s), t = 0 at the last observed point; centres on
+/// [-margin, f dt + margin].
 TimeBasis MakeFutureBasis(const TrajectoryBasisConfig& config, int predicted,
                           double seconds_per_step);
 

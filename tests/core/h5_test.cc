@@ -1,0 +1,71 @@
+#include "core/h5.h"
+
+#include <gtest/gtest.h>
+
+#include "tests/test_util.h"
+
+namespace foresight {
+namespace {
+
+TEST(H5, RoundTripsArraysAttributesAndStrings) {
+  testing::TempDir dir;
+  const std::string path = dir.File("a.h5");
+  Eigen::MatrixXd m(2, 3);
+  m << 1, 2, 3, 4, 5, 6;
+  Eigen::MatrixXf mf = m.cast<float>() * 0.5f;
+  std::vector<std::int64_t> ints{3, -1, 7};
+  {
+    h5::File f = h5::File::Create(path);
+    f.WriteMatrix("/g/h/m", m);
+    f.WriteMatrix("/g/mf", mf);
+    f.Write("/ints", ints.data(), {3});
+    f.WriteString("/text", "hello: world\n");
+    f.SetAttr("/", "name", std::string("x"));
+    f.SetAttr("/g", "count", std::int64_t{42});
+    f.SetAttr("/g/h/m", "scale", 2.5);
+  }
+  h5::File f = h5::File::Open(path);
+  EXPECT_TRUE(f.ReadMatrixD("/g/h/m", 2, 3).isApprox(m));
+  EXPECT_TRUE(f.ReadMatrixF("/g/mf").isApprox(mf));
+  EXPECT_EQ(f.ReadInt("/ints").data, ints);
+  EXPECT_EQ(f.ReadString("/text"), "hello: world\n");
+  EXPECT_EQ(f.GetStringAttr("/", "name"), "x");
+  EXPECT_EQ(f.GetIntAttr("/g", "count"), 42);
+  EXPECT_DOUBLE_EQ(f.GetDoubleAttr("/g/h/m", "scale"), 2.5);
+  EXPECT_EQ(f.List("/g"), (std::vector<std::string>{"h", "mf"}));
+  EXPECT_TRUE(f.Exists("/g/h/m"));
+  EXPECT_FALSE(f.Exists("/g/nope/m"));
+}
+
+TEST(H5, ErrorsNameFileAndObject) {
+  testing::TempDir dir;
+  const std::string path = dir.File("b.h5");
+  {
+    h5::File f = h5::File::Create(path);
+    Eigen::MatrixXd m = Eigen::MatrixXd::Ones(4, 4);
+    f.WriteMatrix("/m", m);
+  }
+  h5::File f = h5::File::Open(path);
+  testing::ExpectErrorContains([&] { f.ReadDouble("/missing"); }, {path, "missing dataset '/missing'"});
+  testing::ExpectErrorContains([&] { f.ReadMatrixD("/m", 3, 4); }, {path, "'/m'", "4x4", "expected 3x4"});
+  testing::ExpectErrorContains([&] { f.GetIntAttr("/", "nope"); }, {path, "missing attribute 'nope'"});
+  testing::ExpectErrorContains([&] { f.ReadInt("/m"); }, {"wrong element type"});
+  testing::ExpectErrorContains([] { h5::File::Open("/nonexistent/file.h5"); }, {"/nonexistent/file.h5", "not found"});
+}
+
+TEST(H5, TruncatedAndForeignFilesAreClearErrors) {
+  testing::TempDir dir;
+  const std::string path = dir.File("c.h5");
+  {
+    h5::File f = h5::File::Create(path);
+    Eigen::MatrixXd m = Eigen::MatrixXd::Random(200, 200);
+    f.WriteMatrix("/m", m);
+  }
+  testing::Truncate(path, 3000);
+  testing::ExpectErrorContains([&] { h5::File::Open(path).ReadDouble("/m"); }, {path});
+  testing::WriteText(dir.File("text.h5"), "this is not hdf5\n");
+  testing::ExpectErrorContains([&] { h5::File::Open(dir.File("text.h5")); }, {"text.h5", "not a readable HDF5 file"});
+}
+
+}  // namespace
+}  // namespace foresight

@@ -1,0 +1,229 @@
+// Engine tests that need no LibTorch: artifacts are written with random weights.
+
+#include "inference/prediction/span_predictor.h"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <new>
+
+#include "core/h5.h"
+#include "inference/engine/artifact.h"
+#include "tests/test_util.h"
+
+// Counts heap allocations while armed (the no-allocation proof).
+namespace {
+std::atomic<bool> g_counting{false};
+std::atomic<long> g_allocations{0};
+}  // namespace
+#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
+void* operator new(std::size_t n) {
+  if (g_counting) ++g_allocations;
+  if (void* p = std::malloc(n ? n : 1)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void* operator new[](std::size_t n) { return operator new(n); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+
+namespace foresight {
+namespace {
+
+Eigen::Matrix<double, Eigen::Dynamic, 2> Walk(int p, double heading, double speed, Eigen::Vector2d start) {
+  Eigen::Matrix<double, Eigen::Dynamic, 2> past(p, 2);
+  for (int i = 0; i < p; ++i)
+    past.row(i) = (start + 0.4 * i * speed * Eigen::Vector2d(std::cos(heading), std::sin(heading)) +
+                   0.02 * Eigen::Vector2d(std::sin(3.0 * i), std::cos(5.0 * i)))
+                      .transpose();
+  return past;
+}
+
+class SpanEngine : public ::testing::TestWithParam<testing::RandomSpanSpec> {
+ protected:
+  void SetUp() override {
+    path_ = dir_.File("model.h5");
+    testing::WriteRandomSpanArtifact(path_, GetParam());
+  }
+  testing::TempDir dir_;
+  std::string path_;
+};
+
+TEST_P(SpanEngine, EvaluationAllocatesNothingAfterSetUp) {
+  const SpanPredictor model = SpanPredictor::Load(path_);
+  auto ws = model.MakeWorkspace();
+  auto dist = model.MakeDistribution();
+  const auto past = Walk(model.observed(), 0.7, 1.2, {1, 2});
+  Eigen::VectorXd times = Eigen::VectorXd::LinSpaced(12, 0.4, 4.8);
+  Eigen::Matrix<double, Eigen::Dynamic, 2> path(12, 2);
+  std::mt19937_64 rng(1);
+  std::vector<TrajectoryDistribution> outs(4, model.MakeDistribution());
+  Eigen::MatrixXd batch(4, 2 * model.observed());
+  for (int k = 0; k < 4; ++k)
+    for (int i = 0; i < model.observed(); ++i) batch.row(k).segment<2>(2 * i) = past.row(i) + Eigen::RowVector2d(k, 0);
+  model.Predict(past, &ws, &dist);  // warm-up
+  g_allocations = 0;
+  g_counting = true;
+  double sink = 0;
+  for (int rep = 0; rep < 10; ++rep) {
+    model.Predict(past, &ws, &dist);
+    Eigen::Vector2d mu;
+    Eigen::Matrix2d cov;
+    dist.Position(2.0, 0, &mu, &cov);
+    sink += mu.sum() + cov.sum() + dist.MeanPosition(1.0).sum() + dist.LogDensity(3.0, mu);
+    dist.SamplePath(times, &rng, path);
+    model.PredictBatch(batch, &ws, &outs);
+  }
+  g_counting = false;
+  EXPECT_EQ(g_allocations.load(), 0) << "heap allocations on the evaluation path";
+  EXPECT_TRUE(std::isfinite(sink));
+}
+
+TEST_P(SpanEngine, PredictionsAreRotationAndTranslationEquivariant) {
+  if (!GetParam().rotate) GTEST_SKIP() << "model is not in the ego frame";
+  const SpanPredictor model = SpanPredictor::Load(path_);
+  auto ws = model.MakeWorkspace();
+  auto a = model.MakeDistribution(), b = model.MakeDistribution();
+  const auto past = Walk(model.observed(), 0.3, 1.1, {0, 0});
+  const double angle = 1.1;
+  Eigen::Matrix2d rot;
+  rot << std::cos(angle), -std::sin(angle), std::sin(angle), std::cos(angle);
+  const Eigen::Vector2d shift(5, -3);
+  Eigen::Matrix<double, Eigen::Dynamic, 2> moved = past;
+  for (int i = 0; i < past.rows(); ++i) moved.row(i) = (rot * past.row(i).transpose() + shift).transpose();
+  model.Predict(past, &ws, &a);
+  model.Predict(moved, &ws, &b);
+  for (double t : {0.4, 2.0, 4.8}) {
+    for (int r = 0; r < a.components(); ++r) {
+      Eigen::Vector2d ma, mb;
+      Eigen::Matrix2d ca, cb;
+      a.Position(t, r, &ma, &ca);
+      b.Position(t, r, &mb, &cb);
+      EXPECT_LT((rot * ma + shift - mb).norm(), 1e-4);
+      EXPECT_LT((rot * ca * rot.transpose() - cb).norm(), 1e-4 * (1 + ca.norm()));
+    }
+  }
+}
+
+TEST_P(SpanEngine, PositionAndSamplesAgreeWithTheMatrixNormal) {
+  const SpanPredictor model = SpanPredictor::Load(path_);
+  auto ws = model.MakeWorkspace();
+  auto dist = model.MakeDistribution();
+  model.Predict(Walk(model.observed(), -2.0, 0.9, {3, 3}), &ws, &dist);
+  double alpha_sum = 0;
+  for (int r = 0; r < dist.components(); ++r) alpha_sum += dist.alpha(r);
+  EXPECT_NEAR(alpha_sum, 1.0, 1e-12);
+  const double t = 2.4;
+  const Eigen::VectorXd phi = model.basis().Evaluate(t);
+  // Per component: engine Position == core MatrixNormal::Position (+ origin).
+  for (int r = 0; r < dist.components(); ++r) {
+    Eigen::Vector2d mu, mu_ref;
+    Eigen::Matrix2d cov, cov_ref;
+    dist.Position(t, r, &mu, &cov);
+    dist.Component(r).Position(phi, &mu_ref, &cov_ref);
+    EXPECT_LT((mu - (mu_ref + dist.origin())).norm(), 1e-12);
+    EXPECT_LT((cov - cov_ref).norm(), 1e-12 * (1 + cov.norm()));
+  }
+  // Sampled positions match the mixture's first two moments.
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d second = Eigen::Matrix2d::Zero();
+  for (int r = 0; r < dist.components(); ++r) {
+    Eigen::Vector2d mu;
+    Eigen::Matrix2d cov;
+    dist.Position(t, r, &mu, &cov);
+    mean += dist.alpha(r) * mu;
+    second += dist.alpha(r) * (cov + mu * mu.transpose());
+  }
+  const Eigen::Matrix2d cov_mix = second - mean * mean.transpose();
+  std::mt19937_64 rng(5);
+  Eigen::VectorXd times(1);
+  times << t;
+  Eigen::Matrix<double, Eigen::Dynamic, 2> path(1, 2);
+  const int n = 40000;
+  Eigen::Vector2d s1 = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d s2 = Eigen::Matrix2d::Zero();
+  for (int i = 0; i < n; ++i) {
+    dist.SamplePath(times, &rng, path);
+    const Eigen::Vector2d x = path.row(0).transpose();
+    s1 += x;
+    s2 += x * x.transpose();
+  }
+  const Eigen::Vector2d emp_mean = s1 / n;
+  const Eigen::Matrix2d emp_cov = s2 / n - emp_mean * emp_mean.transpose();
+  const double scale = std::sqrt(cov_mix.trace());
+  EXPECT_LT((emp_mean - mean).norm(), 0.03 * scale + 1e-9);
+  EXPECT_LT((emp_cov - cov_mix).norm(), 0.05 * cov_mix.norm() + 1e-12);
+  EXPECT_LT((dist.MeanPosition(t) - mean).norm(), 1e-9);
+}
+
+TEST_P(SpanEngine, BatchEqualsSingleCalls) {
+  const SpanPredictor model = SpanPredictor::Load(path_);
+  auto ws = model.MakeWorkspace();
+  const int p = model.observed();
+  Eigen::MatrixXd batch(3, 2 * p);
+  std::vector<Eigen::Matrix<double, Eigen::Dynamic, 2>> pasts;
+  for (int k = 0; k < 3; ++k) {
+    pasts.push_back(Walk(p, 0.5 * k, 1.0 + 0.1 * k, {k, -k}));
+    for (int i = 0; i < p; ++i) batch.row(k).segment<2>(2 * i) = pasts.back().row(i);
+  }
+  std::vector<TrajectoryDistribution> outs(3, model.MakeDistribution());
+  model.PredictBatch(batch, &ws, &outs);
+  auto single = model.MakeDistribution();
+  for (int k = 0; k < 3; ++k) {
+    model.Predict(pasts[static_cast<std::size_t>(k)], &ws, &single);
+    EXPECT_EQ(single.MeanPosition(3.0), outs[static_cast<std::size_t>(k)].MeanPosition(3.0));
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Heads, SpanEngine,
+    ::testing::Values(testing::RandomSpanSpec{},
+                      testing::RandomSpanSpec{8, 12, 6, 3, UParam::kDiagonal, {16}, 0.4, true, 4},
+                      testing::RandomSpanSpec{5, 10, 4, 2, UParam::kCholesky, {8, 8, 8}, 0.1, false, 9}),
+    [](const ::testing::TestParamInfo<testing::RandomSpanSpec>& info) {
+      return "R" + std::to_string(info.param.components) + "_" + UParamName(info.param.u_param) +
+             (info.param.rotate ? "_ego" : "_world");
+    });
+
+TEST(SpanEngineErrors, BadInputIsAClearError) {
+  testing::TempDir dir;
+  const std::string path = dir.File("model.h5");
+  testing::WriteRandomSpanArtifact(path, {});
+  const SpanPredictor model = SpanPredictor::Load(path);
+  auto ws = model.MakeWorkspace();
+  auto dist = model.MakeDistribution();
+  Eigen::Matrix<double, Eigen::Dynamic, 2> past = Walk(8, 0, 1, {0, 0});
+  past(3, 1) = NAN;
+  testing::ExpectErrorContains([&] { model.Predict(past, &ws, &dist); }, {"NaN"});
+  testing::ExpectErrorContains([&] { model.Predict(Walk(5, 0, 1, {0, 0}), &ws, &dist); }, {"expected 8 observed points, got 5"});
+}
+
+TEST(SpanEngineErrors, TruncatedForeignAndWrongTypeArtifacts) {
+  testing::TempDir dir;
+  const std::string path = dir.File("model.h5");
+  testing::WriteRandomSpanArtifact(path, {8, 12, 6, 1, UParam::kCholesky, {256, 256}, 0.4, true, 1});
+  {
+    std::string copy = dir.File("copy.h5");
+    std::filesystem::copy_file(path, copy);
+    testing::Truncate(copy, std::filesystem::file_size(copy) / 2);
+    EXPECT_THROW(SpanPredictor::Load(copy), Error);
+  }
+  testing::WriteText(dir.File("text.h5"), "not an artifact");
+  testing::ExpectErrorContains([&] { SpanPredictor::Load(dir.File("text.h5")); }, {"text.h5"});
+  {
+    h5::File f = h5::File::Create(dir.File("map.h5"));
+    Artifact::WriteHeader(&f, "fast_bhm", "model: fast_bhm\n", 0);
+  }
+  testing::ExpectErrorContains([&] { SpanPredictor::Load(dir.File("map.h5")); },
+                               {"map.h5", "'fast_bhm'", "expected 'span_predictor'"});
+  {
+    h5::File f = h5::File::Create(dir.File("future.h5"));
+    Artifact::WriteHeader(&f, kSpanModelType, "", 0);
+    f.SetAttr("/", "format_version", std::int64_t{99});
+  }
+  testing::ExpectErrorContains([&] { SpanPredictor::Load(dir.File("future.h5")); }, {"format_version 99"});
+}
+
+}  // namespace
+}  // namespace foresight

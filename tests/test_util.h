@@ -1,0 +1,70 @@
+#pragma once
+/// Shared test utilities: error-message checks, temporary directories, finite differences,
+/// a random SPAN artifact writer (torch-free) and the path of ../shared/data.
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "core/error.h"
+#include "core/matrix_normal_head.h"
+
+namespace foresight::testing {
+
+/// Expects `fn` to throw foresight::Error whose message contains every `parts` entry.
+inline void ExpectErrorContains(const std::function<void()>& fn, const std::vector<std::string>& parts) {
+  try {
+    fn();
+    ADD_FAILURE() << "expected foresight::Error";
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    for (const auto& p : parts) EXPECT_NE(what.find(p), std::string::npos) << "'" << p << "' not in: " << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << "error message is not one line: " << what;
+  }
+}
+
+/// A fresh empty directory under the system temp dir, removed at scope exit.
+class TempDir {
+ public:
+  TempDir() {
+    std::random_device rd;
+    path_ = std::filesystem::temp_directory_path() / ("foresight_test_" + std::to_string(rd()) + std::to_string(rd()));
+    std::filesystem::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path_, ec);
+  }
+  std::string File(const std::string& name) const { return (path_ / name).string(); }
+  std::string path() const { return path_.string(); }
+
+ private:
+  std::filesystem::path path_;
+};
+
+/// Writes `text` to `path`.
+void WriteText(const std::string& path, const std::string& text);
+/// Keeps the first `bytes` bytes of `path`.
+void Truncate(const std::string& path, std::size_t bytes);
+
+/// ../shared/data relative to the source tree, or empty when absent (tests then skip).
+std::string SharedDataDir();
+
+/// Writes a span_predictor artifact with random weights (no LibTorch needed).
+struct RandomSpanSpec {
+  int observed = 8, predicted = 12, basis = 6, components = 1;
+  UParam u_param = UParam::kCholesky;
+  std::vector<int> hidden = {32, 32};
+  double seconds_per_step = 0.4;
+  bool rotate = true;
+  std::uint64_t seed = 3;
+};
+void WriteRandomSpanArtifact(const std::string& path, const RandomSpanSpec& spec);
+
+}  // namespace foresight::testing

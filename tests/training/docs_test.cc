@@ -1,0 +1,32 @@
+// docs/config_reference.md is generated: it must match what the code generates now.
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include "training/span_config.h"
+
+namespace foresight {
+namespace {
+
+TEST(Docs, ConfigReferenceIsCurrent) {
+  const char* src = std::getenv("FORESIGHT_SOURCE_DIR");
+  ASSERT_NE(src, nullptr);
+  std::ifstream in(std::string(src) + "/docs/config_reference.md");
+  ASSERT_TRUE(in.good()) << "docs/config_reference.md missing: run `foresight docs config -o docs/config_reference.md`";
+  std::stringstream ss;
+  ss << in.rdbuf();
+  EXPECT_NE(ss.str().find(config::ReferenceTable<SpanExperimentConfig>()), std::string::npos)
+      << "docs/config_reference.md is stale: run `build/bin/foresight docs config -o docs/config_reference.md`";
+}
+
+TEST(Docs, ShippedConfigsLoad) {
+  const std::string src = std::getenv("FORESIGHT_SOURCE_DIR");
+  for (const char* name : {"quickstart", "span/eth_ucy_eth", "span/eth_ucy_hotel", "span/eth_ucy_univ", "span/eth_ucy_zara1"})
+    EXPECT_NO_THROW(LoadSpanConfig(src + "/configs/" + name + ".yaml", {})) << name;
+}
+
+}  // namespace
+}  // namespace foresight

@@ -1,0 +1,143 @@
+#include "training/trainer.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "models/span/span_net.h"
+#include "tests/test_util.h"
+#include "training/span_pipeline.h"
+
+namespace foresight {
+namespace {
+
+SpanExperimentConfig TinyConfig() {
+  SpanExperimentConfig c;
+  c.data.synthetic.num_tracks = 120;
+  c.network.hidden = {16, 16};
+  c.basis.num_centres = 5;
+  c.train.epochs = 4;
+  c.train.batch_size = 64;
+  c.train.progress = ProgressStyle::kNone;
+  c.train.patience = 0;
+  return c;
+}
+
+std::vector<torch::Tensor> Parameters(const std::string& checkpoint, const SpanExperimentConfig& c) {
+  SpanNet net(2 * c.windows.observed, c.network, HeadLayout{c.basis.num_centres, c.network.components, c.network.u_param});
+  LoadCheckpointModel(checkpoint, net.ptr().get());
+  std::vector<torch::Tensor> out;
+  for (const auto& p : net->parameters()) out.push_back(p.detach().clone());
+  return out;
+}
+
+/// Epoch, train and validation loss columns of metrics.csv (timings differ run to run).
+std::string LossColumns(const std::string& path) {
+  std::ifstream in(path);
+  std::string line, out;
+  while (std::getline(in, line)) {
+    std::size_t third = line.find(',', line.find(',', line.find(',') + 1) + 1);
+    out += line.substr(0, third) + "\n";
+  }
+  return out;
+}
+
+TEST(Trainer, ResumeAfterAnInterruptionIsBitIdentical) {
+  testing::TempDir dir;
+  const SpanExperimentConfig c = TinyConfig();
+  const auto full = TrainSpan(c, dir.File("full"), false);
+  EXPECT_EQ(full.reason, TerminationReason::kMaxEpochs);
+  EXPECT_EQ(full.epochs_completed, 4);
+
+  TrainHooks stop_after_two;
+  stop_after_two.continue_after_epoch = [](int completed) { return completed < 2; };
+  const auto first = TrainSpan(c, dir.File("resumed"), false, stop_after_two);
+  EXPECT_EQ(first.reason, TerminationReason::kInterrupted);
+  EXPECT_EQ(first.epochs_completed, 2);
+  const auto second = TrainSpan(c, dir.File("resumed"), true);
+  EXPECT_EQ(second.reason, TerminationReason::kMaxEpochs);
+  EXPECT_EQ(second.epochs_completed, 4);
+
+  const auto a = Parameters(dir.File("full") + "/checkpoints/last.pt", c);
+  const auto b = Parameters(dir.File("resumed") + "/checkpoints/last.pt", c);
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) EXPECT_TRUE(torch::equal(a[i], b[i])) << "parameter " << i;
+  EXPECT_EQ(LossColumns(dir.File("full") + "/metrics.csv"), LossColumns(dir.File("resumed") + "/metrics.csv"));
+}
+
+TEST(Trainer, ResumeRefusesADifferentConfig) {
+  testing::TempDir dir;
+  SpanExperimentConfig c = TinyConfig();
+  c.train.epochs = 1;
+  TrainSpan(c, dir.path(), false);
+  c.train.learning_rate = 0.5;
+  testing::ExpectErrorContains([&] { TrainSpan(c, dir.path(), true); }, {"config.yaml", "differs"});
+}
+
+/// A task whose loss turns NaN in its third epoch.
+class ExplodingTask : public TrainingTask {
+ public:
+  ExplodingTask() : linear_(torch::nn::Linear(2, 1)) {}
+  torch::nn::Module& module() override { return *linear_; }
+  std::int64_t num_train() const override { return 8; }
+  torch::Tensor BatchLoss(const torch::Tensor& idx) override {
+    ++calls_;
+    auto loss = linear_->forward(torch::ones({idx.size(0), 2})).square().mean();
+    return calls_ > 4 ? loss * std::numeric_limits<float>::quiet_NaN() : loss;  // batch 4 of 2 per epoch
+  }
+  double ValidationLoss() override { return linear_->forward(torch::ones({1, 2})).square().item<double>(); }
+
+ private:
+  torch::nn::Linear linear_;
+  int calls_ = 0;
+};
+
+TEST(Trainer, NonFiniteLossStopsCleanlyAndKeepsTheLastGoodCheckpoint) {
+  testing::TempDir dir;
+  torch::manual_seed(0);
+  ExplodingTask task;
+  TrainConfig c;
+  c.epochs = 10;
+  c.batch_size = 4;
+  c.progress = ProgressStyle::kNone;
+  const auto s = Train(&task, c, RunPaths{dir.path()}, 0, false);
+  EXPECT_EQ(s.reason, TerminationReason::kNonFiniteLoss);
+  EXPECT_EQ(s.epochs_completed, 2);
+  for (const auto& p : task.module().parameters()) EXPECT_TRUE(torch::isfinite(p).all().item<bool>());
+  // The checkpoint on disk is the epoch-2 one and loads.
+  ExplodingTask other;
+  LoadCheckpointModel(dir.File("checkpoints/last.pt"), &other.module());
+}
+
+TEST(Trainer, CorruptOrMissingCheckpointIsAClearError) {
+  testing::TempDir dir;
+  SpanExperimentConfig c = TinyConfig();
+  c.train.epochs = 1;
+  TrainSpan(c, dir.path(), false);
+  const std::string ckpt = dir.File("checkpoints/last.pt");
+  testing::Truncate(ckpt, std::filesystem::file_size(ckpt) / 3);
+  testing::ExpectErrorContains([&] { TrainSpan(c, dir.path(), true); }, {ckpt, "corrupt or truncated checkpoint"});
+  testing::TempDir empty;
+  testing::ExpectErrorContains([&] { TrainSpan(c, empty.path(), true); }, {"no config.yaml to resume from"});
+}
+
+TEST(Trainer, LearningRateSchedules) {
+  TrainConfig c;
+  c.epochs = 11;
+  c.learning_rate = 1.0;
+  c.schedule = LrSchedule::kCosine;
+  c.min_lr_ratio = 0.1;
+  EXPECT_DOUBLE_EQ(LearningRateAt(c, 0), 1.0);
+  EXPECT_NEAR(LearningRateAt(c, 5), 0.55, 1e-12);
+  EXPECT_NEAR(LearningRateAt(c, 10), 0.1, 1e-12);
+  c.schedule = LrSchedule::kStep;
+  c.step_every = 3;
+  c.step_factor = 0.5;
+  EXPECT_DOUBLE_EQ(LearningRateAt(c, 2), 1.0);
+  EXPECT_DOUBLE_EQ(LearningRateAt(c, 7), 0.25);
+}
+
+}  // namespace
+}  // namespace foresight
