@@ -6,15 +6,21 @@
 #include <random>
 
 #include "core/error.h"
+#include "core/log.h"
 
 namespace foresight {
 
 WindowSet MakeWindows(const TrackSet& set, const WindowConfig& c) {
   const int len = c.observed + c.predicted;
   const double dt = set.seconds_per_step;
-  int count = 0;
-  for (const Track& t : set.tracks)
+  int count = 0, short_tracks = 0;
+  for (const Track& t : set.tracks) {
     if (t.size() >= len) count += (t.size() - len) / c.stride + 1;
+    else ++short_tracks;
+  }
+  if (short_tracks > 0)
+    log::Info(set.source, ": ", short_tracks, " of ", set.tracks.size(), " tracks are shorter than ", len,
+              " points and give no window");
   WindowSet w;
   w.seconds_per_step = dt;
   w.observed = c.observed;

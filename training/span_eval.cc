@@ -81,7 +81,11 @@ std::string SpanEvalReport::ToJson(int num_samples) const {
      << "  \"cv_ade\": " << Num(cv.ade) << ",\n  \"cv_fde\": " << Num(cv.fde) << ",\n"
      << "  \"cv_nll\": " << Num(cv.nll) << ",\n"
      << "  \"cv_best_of_20_ade\": " << Num(cv.best_of_n_ade) << ",\n"
-     << "  \"cv_best_of_20_fde\": " << Num(cv.best_of_n_fde) << "\n}\n";
+     << "  \"cv_best_of_20_fde\": " << Num(cv.best_of_n_fde) << ",\n"
+     << "  \"val\": {\"windows\": " << val_windows << ", \"ade\": " << Num(val_model.ade)
+     << ", \"fde\": " << Num(val_model.fde) << ", \"nll\": " << Num(val_model.nll)
+     << ", \"cv_ade\": " << Num(val_cv.ade) << ", \"cv_fde\": " << Num(val_cv.fde)
+     << ", \"cv_nll\": " << Num(val_cv.nll) << "}\n}\n";
   return os.str();
 }
 
@@ -157,7 +161,14 @@ SpanEvalReport EvaluateSpan(const SpanExperimentConfig& c, const std::string& ar
   const WindowSet test = MakeWindows(split.test, c.windows);
   FS_THROW_UNLESS(test.size() > 0, "no test windows: the test tracks are shorter than ",
                   c.windows.observed + c.windows.predicted, " points");
-  const SpanEvalReport rep = EvaluateSpanOn(artifact, train, test, c.eval);
+  SpanEvalReport rep = EvaluateSpanOn(artifact, train, test, c.eval);
+  const WindowSet val = MakeWindows(split.val, c.windows);
+  if (val.size() > 0) {
+    const SpanEvalReport v = EvaluateSpanOn(artifact, train, val, c.eval);
+    rep.val_windows = v.windows;
+    rep.val_model = v.model;
+    rep.val_cv = v.cv;
+  }
   fs::create_directories(out_dir + "/plots");
   std::ofstream(out_dir + "/eval.json") << rep.ToJson(c.eval.num_samples);
   if (c.eval.plot_tracks > 0)

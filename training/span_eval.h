@@ -18,6 +18,9 @@ struct SpanMetrics {
 struct SpanEvalReport {
   int windows = 0;
   SpanMetrics model, cv;
+  /// The same metrics on the validation windows (for choosing hyper-parameters; never the test).
+  int val_windows = 0;
+  SpanMetrics val_model, val_cv;
   std::string ToJson(int num_samples) const;
 };
 

@@ -181,9 +181,9 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(testing::RandomSpanSpec{},
                       testing::RandomSpanSpec{8, 12, 6, 3, UParam::kDiagonal, {16}, 0.4, true, 4},
                       testing::RandomSpanSpec{5, 10, 4, 2, UParam::kCholesky, {8, 8, 8}, 0.1, false, 9}),
-    [](const ::testing::TestParamInfo<testing::RandomSpanSpec>& info) {
-      return "R" + std::to_string(info.param.components) + "_" + UParamName(info.param.u_param) +
-             (info.param.rotate ? "_ego" : "_world");
+    [](const ::testing::TestParamInfo<testing::RandomSpanSpec>& p) {
+      return "R" + std::to_string(p.param.components) + "_" + UParamName(p.param.u_param) +
+             (p.param.rotate ? "_ego" : "_world");
     });
 
 TEST(SpanEngineErrors, BadInputIsAClearError) {

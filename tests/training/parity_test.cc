@@ -97,8 +97,8 @@ TEST_P(Parity, EngineMatchesLibTorchOnRandomInputs) {
 
 INSTANTIATE_TEST_SUITE_P(Heads, Parity,
                          ::testing::Values(std::make_pair(1, UParam::kCholesky), std::make_pair(3, UParam::kDiagonal)),
-                         [](const auto& info) {
-                           return "R" + std::to_string(info.param.first) + "_" + UParamName(info.param.second);
+                         [](const auto& p) {
+                           return "R" + std::to_string(p.param.first) + "_" + UParamName(p.param.second);
                          });
 
 TEST(Pipeline, TrainExportEvalWritesEveryKey) {
