@@ -29,6 +29,7 @@ void WriteRandomSpanArtifact(const std::string& path, const RandomSpanSpec& s) {
   f.SetAttr("/model", "predicted", static_cast<std::int64_t>(s.predicted));
   f.SetAttr("/model", "seconds_per_step", s.seconds_per_step);
   f.SetAttr("/model", "rotate_to_heading", static_cast<std::int64_t>(s.rotate));
+  f.SetAttr("/model", "residual_to_constant_velocity", static_cast<std::int64_t>(s.residual_cv));
   f.SetAttr("/model", "basis_size", static_cast<std::int64_t>(s.basis));
   f.SetAttr("/model", "components", static_cast<std::int64_t>(s.components));
   f.SetAttr("/model", "u_param", std::string(UParamName(s.u_param)));

@@ -64,6 +64,7 @@ struct RandomSpanSpec {
   double seconds_per_step = 0.4;
   bool rotate = true;
   std::uint64_t seed = 3;
+  bool residual_cv = false;
 };
 void WriteRandomSpanArtifact(const std::string& path, const RandomSpanSpec& spec);
 

@@ -122,8 +122,10 @@ TrainingSummary TrainSpan(const SpanExperimentConfig& c, const std::string& run_
   FS_THROW_UNLESS(train_w.size() > 0, "no training windows of ", c.windows.observed + c.windows.predicted,
                   " points in the training tracks");
   const TimeBasis basis = MakeFutureBasis(c.basis, c.windows.predicted, train_w.seconds_per_step);
-  const SpanSamples train_s = MakeSpanSamples(train_w, basis, c.basis, c.network.rotate_to_heading);
-  const SpanSamples val_s = MakeSpanSamples(val_w, basis, c.basis, c.network.rotate_to_heading);
+  const SpanSamples train_s = MakeSpanSamples(train_w, basis, c.basis, c.network.rotate_to_heading,
+                                              c.network.residual_to_constant_velocity);
+  const SpanSamples val_s = MakeSpanSamples(val_w, basis, c.basis, c.network.rotate_to_heading,
+                                            c.network.residual_to_constant_velocity);
 
   const std::string norm_path = run_dir + "/normalisation.h5";
   const Normalisation norm = resume ? ReadNormalisation(norm_path) : FitNormalisation(train_s.inputs);
@@ -156,6 +158,8 @@ void WriteSpanArtifact(const SpanExperimentConfig& c, const std::string& checkpo
     f.SetAttr("/model", "predicted", static_cast<std::int64_t>(c.windows.predicted));
     f.SetAttr("/model", "seconds_per_step", dt);
     f.SetAttr("/model", "rotate_to_heading", static_cast<std::int64_t>(c.network.rotate_to_heading));
+    f.SetAttr("/model", "residual_to_constant_velocity",
+              static_cast<std::int64_t>(c.network.residual_to_constant_velocity));
     f.SetAttr("/model", "basis_size", static_cast<std::int64_t>(layout.basis));
     f.SetAttr("/model", "components", static_cast<std::int64_t>(layout.components));
     f.SetAttr("/model", "u_param", std::string(UParamName(layout.u_param)));

@@ -31,7 +31,7 @@ MatrixNormal TrajectoryDistribution::Component(int r) const {
 void TrajectoryDistribution::Position(double t, int r, Eigen::Vector2d* mu, Eigen::Matrix2d* cov) const {
   basis_.Evaluate(t, phi_);
   const auto k = static_cast<std::size_t>(r);
-  *mu = origin_;
+  *mu = origin_ + t * velocity_;
   for (int j = 0; j < basis_size(); ++j) *mu += phi_[j] * mean_[k].row(j).transpose();
   // phi' U phi = ||L_U' phi||^2 with L_U lower triangular.
   const int m = basis_size();
@@ -47,7 +47,7 @@ void TrajectoryDistribution::Position(double t, int r, Eigen::Vector2d* mu, Eige
 
 Eigen::Vector2d TrajectoryDistribution::MeanPosition(double t) const {
   basis_.Evaluate(t, phi_);
-  Eigen::Vector2d out = origin_;
+  Eigen::Vector2d out = origin_ + t * velocity_;
   for (int r = 0; r < components(); ++r)
     for (int j = 0; j < basis_size(); ++j)
       out += alpha_[r] * phi_[j] * mean_[static_cast<std::size_t>(r)].row(j).transpose();
@@ -95,7 +95,7 @@ void TrajectoryDistribution::SamplePath(const Eigen::Ref<const Eigen::VectorXd>&
   }
   for (Eigen::Index n = 0; n < times.size(); ++n) {
     basis_.Evaluate(times[n], phi_);
-    Eigen::Vector2d o = origin_;
+    Eigen::Vector2d o = origin_ + times[n] * velocity_;
     for (int j = 0; j < m; ++j) o += phi_[j] * w_.row(j).transpose();
     path.row(n) = o.transpose();
   }
@@ -110,6 +110,8 @@ SpanPredictor SpanPredictor::Load(const std::string& path) {
   p.observed_ = static_cast<int>(f.GetIntAttr("/model", "observed"));
   p.seconds_per_step_ = f.GetDoubleAttr("/model", "seconds_per_step");
   p.rotate_ = f.GetIntAttr("/model", "rotate_to_heading") != 0;
+  p.residual_cv_ = f.HasAttr("/model", "residual_to_constant_velocity") &&
+                   f.GetIntAttr("/model", "residual_to_constant_velocity") != 0;
   p.layout_.basis = static_cast<int>(f.GetIntAttr("/model", "basis_size"));
   p.layout_.components = static_cast<int>(f.GetIntAttr("/model", "components"));
   const std::string u_param = f.GetStringAttr("/model", "u_param");
@@ -191,6 +193,13 @@ void SpanPredictor::Predict(const Eigen::Ref<const Eigen::Matrix<double, Eigen::
     return std::exp(std::clamp(v, HeadLayout::kLogDiagMin, HeadLayout::kLogDiagMax));
   };
   out->origin_ = frame.origin;
+  if (residual_cv_) {
+    const int p = observed_;
+    out->velocity_ = Eigen::Vector2d(past(p - 1, 0) - past(p - 2, 0), past(p - 1, 1) - past(p - 2, 1)) /
+                     seconds_per_step_;
+  } else {
+    out->velocity_.setZero();
+  }
   double max_logit = -INFINITY;
   for (int r = 0; r < R; ++r) max_logit = std::max(max_logit, z[layout_.AlphaOffset(r)]);
   double norm = 0.0;

@@ -22,7 +22,8 @@ namespace foresight {
 inline constexpr const char* kSpanModelType = "span_predictor";
 
 /// A predicted mixture of matrix normals over future trajectory weights, in the world frame.
-/// Trajectories: o(t) = origin + W' phi(t), t (s) from the last observed point.
+/// Trajectories: o(t) = origin + v t + W' phi(t), t (s) from the last observed point; v is the
+/// constant-velocity offset of models trained with residual_to_constant_velocity (else zero).
 class TrajectoryDistribution {
  public:
   TrajectoryDistribution() = default;
@@ -31,6 +32,7 @@ class TrajectoryDistribution {
   int components() const { return static_cast<int>(alpha_.size()); }
   int basis_size() const { return basis_.size(); }
   const Eigen::Vector2d& origin() const { return origin_; }
+  const Eigen::Vector2d& velocity() const { return velocity_; }
   double alpha(int r) const { return alpha_[r]; }
   const Eigen::MatrixXd& mean(int r) const { return mean_[static_cast<std::size_t>(r)]; }
   const Eigen::MatrixXd& chol_u(int r) const { return chol_u_[static_cast<std::size_t>(r)]; }
@@ -52,6 +54,7 @@ class TrajectoryDistribution {
   friend class SpanPredictor;
   TimeBasis basis_;
   Eigen::Vector2d origin_ = Eigen::Vector2d::Zero();
+  Eigen::Vector2d velocity_ = Eigen::Vector2d::Zero();
   Eigen::VectorXd alpha_;
   std::vector<Eigen::MatrixXd> mean_, chol_u_;
   std::vector<Eigen::Matrix2d> chol_v_;
@@ -96,6 +99,7 @@ class SpanPredictor {
   int observed_ = 0;
   double seconds_per_step_ = 0.4;
   bool rotate_ = true;
+  bool residual_cv_ = false;
   HeadLayout layout_;
   TimeBasis basis_;
   Eigen::VectorXd input_mean_, input_std_;

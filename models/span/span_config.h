@@ -38,6 +38,9 @@ struct SpanNetConfig {
   int components = 1;                         ///< R; 1 is SPAN, > 1 the mixture of ch 7
   UParam u_param = UParam::kCholesky;
   bool rotate_to_heading = true;  ///< express inputs and outputs in the ego frame
+  /// Model the future relative to constant velocity: o(t) = origin + v t + W' phi(t), with v the
+  /// last observed step's velocity (an extension of the thesis, which has v = 0).
+  bool residual_to_constant_velocity = false;
 
   template <class A>
   void Serialize(A* a) {
@@ -50,6 +53,8 @@ struct SpanNetConfig {
                  "parameterisation of the row scale U (full Cholesky or log-diagonal)");
     a->Visit("rotate_to_heading", &rotate_to_heading, config::Range::Any(),
              "rotate each window so the observed heading is +x (predictions rotate back exactly)");
+    a->Visit("residual_to_constant_velocity", &residual_to_constant_velocity, config::Range::Any(),
+             "W models the deviation from constant velocity (o(t) = origin + v t + W' phi(t))");
   }
 };
 

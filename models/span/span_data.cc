@@ -11,7 +11,7 @@ TimeBasis MakeFutureBasis(const TrajectoryBasisConfig& c, int predicted, double 
 }
 
 SpanSamples MakeSpanSamples(const WindowSet& w, const TimeBasis& basis,
-                            const TrajectoryBasisConfig& c, bool rotate) {
+                            const TrajectoryBasisConfig& c, bool rotate, bool residual) {
   const int p = w.observed, f = w.predicted, m = basis.size();
   const int first = c.anchor_at_origin ? 0 : 1;
   Eigen::VectorXd times(f + 1 - first);
@@ -25,8 +25,13 @@ SpanSamples MakeSpanSamples(const WindowSet& w, const TimeBasis& basis,
   for (int n = 0; n < w.size(); ++n) {
     const EgoFrame frame = EgoFrame::FromPast(p, [&](int i) { return w.Past(n, i); }, rotate);
     for (int i = 0; i < p; ++i) s.inputs.row(n).segment<2>(2 * i) = frame.ToEgo(w.Past(n, i));
+    const Eigen::Vector2d v =
+        residual ? Eigen::Vector2d(frame.rotation.transpose() * (w.Past(n, p - 1) - w.Past(n, p - 2)) /
+                                   w.seconds_per_step)
+                 : Eigen::Vector2d::Zero();
     if (first == 0) points.row(0).setZero();
-    for (int k = 1; k <= f; ++k) points.row(k - first) = frame.ToEgo(w.Future(n, k - 1)).transpose();
+    for (int k = 1; k <= f; ++k)
+      points.row(k - first) = (frame.ToEgo(w.Future(n, k - 1)) - v * times[k - first]).transpose();
     const Eigen::MatrixXd wm = ridge.Fit(points);  // m x 2
     for (int j = 0; j < m; ++j) {
       s.targets(n, 2 * j) = wm(j, 0);

@@ -122,7 +122,7 @@ TEST_P(SpanEngine, PositionAndSamplesAgreeWithTheMatrixNormal) {
     Eigen::Matrix2d cov, cov_ref;
     dist.Position(t, r, &mu, &cov);
     dist.Component(r).Position(phi, &mu_ref, &cov_ref);
-    EXPECT_LT((mu - (mu_ref + dist.origin())).norm(), 1e-12);
+    EXPECT_LT((mu - (mu_ref + dist.origin() + t * dist.velocity())).norm(), 1e-12);
     EXPECT_LT((cov - cov_ref).norm(), 1e-12 * (1 + cov.norm()));
   }
   // Sampled positions match the mixture's first two moments.
@@ -179,11 +179,11 @@ TEST_P(SpanEngine, BatchEqualsSingleCalls) {
 INSTANTIATE_TEST_SUITE_P(
     Heads, SpanEngine,
     ::testing::Values(testing::RandomSpanSpec{},
-                      testing::RandomSpanSpec{8, 12, 6, 3, UParam::kDiagonal, {16}, 0.4, true, 4},
+                      testing::RandomSpanSpec{8, 12, 6, 3, UParam::kDiagonal, {16}, 0.4, true, 4, true},
                       testing::RandomSpanSpec{5, 10, 4, 2, UParam::kCholesky, {8, 8, 8}, 0.1, false, 9}),
     [](const ::testing::TestParamInfo<testing::RandomSpanSpec>& p) {
       return "R" + std::to_string(p.param.components) + "_" + UParamName(p.param.u_param) +
-             (p.param.rotate ? "_ego" : "_world");
+             (p.param.rotate ? "_ego" : "_world") + (p.param.residual_cv ? "_cv" : "");
     });
 
 TEST(SpanEngineErrors, BadInputIsAClearError) {
