@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/parse.h"
 
 namespace foresight::config {
 
@@ -152,31 +153,18 @@ class YamlReader {
       else if (s == "false" || s == "False") v = false;
       else FailAt(path, n, "true or false");
     } else if constexpr (std::is_integral_v<T>) {
-      const std::string& s = n.Scalar();
-      std::size_t used = 0;
-      long long parsed = 0;
-      try {
-        parsed = std::stoll(s, &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (used == 0 || used != s.size()) FailAt(path, n, ExpectText<T>(range));
+      const std::optional<long long> maybe = ParseInteger(n.Scalar());
+      if (!maybe) FailAt(path, n, ExpectText<T>(range));
+      const long long parsed = *maybe;
       if (parsed < static_cast<long long>(std::numeric_limits<T>::lowest()) ||
           parsed > static_cast<long long>(std::numeric_limits<T>::max()))
         FailAt(path, n, ExpectText<T>(range));
       v = static_cast<T>(parsed);
       if (!range.Contains(static_cast<double>(v))) FailAt(path, n, ExpectText<T>(range));
     } else {
-      const std::string& s = n.Scalar();
-      std::size_t used = 0;
-      double parsed = 0;
-      try {
-        parsed = std::stod(s, &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (used == 0 || used != s.size() || !std::isfinite(parsed))
-        FailAt(path, n, ExpectText<T>(range));
+      const std::optional<double> maybe = ParseDouble(n.Scalar());
+      if (!maybe || !std::isfinite(*maybe)) FailAt(path, n, ExpectText<T>(range));
+      const double parsed = *maybe;
       v = static_cast<T>(parsed);
       if (!range.Contains(parsed)) FailAt(path, n, ExpectText<T>(range));
     }

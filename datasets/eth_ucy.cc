@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/parse.h"
 #include "core/log.h"
 
 namespace foresight {
@@ -19,15 +20,10 @@ struct Row {
 
 double ParseField(const std::string& token, const std::string& path, std::size_t line,
                   const char* column) {
-  std::size_t used = 0;
-  double v = 0;
-  try {
-    v = std::stod(token, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  FS_THROW_UNLESS(used == token.size() && used > 0, path, ":", line, ": column '", column,
+  const std::optional<double> parsed = ParseDouble(token);
+  FS_THROW_UNLESS(parsed.has_value(), path, ":", line, ": column '", column,
                   "' is not a number: '", token, "'");
+  const double v = *parsed;
   FS_THROW_UNLESS(std::isfinite(v), path, ":", line, ": column '", column,
                   "' is not finite: '", token, "'");
   return v;
