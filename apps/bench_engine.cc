@@ -151,6 +151,7 @@ void AddBenchCommands(CLI::App* app) {
   engine->add_flag("--json", args->json, "print one JSON object");
   engine->add_option("--calls", args->calls, "timed calls")->check(CLI::Range(100, 10000000));
   engine->callback([args] { RunEngineBench(*args); });
+  AddBenchMapCommand(bench);
 }
 
 }  // namespace foresight::app

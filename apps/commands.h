@@ -3,10 +3,23 @@
 
 #include <CLI/CLI.hpp>
 
+#include <string>
+#include <vector>
+
 namespace foresight::app {
 
 void AddDataCommands(CLI::App* app);
 void AddBenchCommands(CLI::App* app);
 void AddTrainCommands(CLI::App* app);  // train, export, eval, docs (needs LibTorch)
+void AddMapCommands(CLI::App* app);    // map fuse, map info
+void AddBenchMapCommand(CLI::App* bench);  // bench map (under `bench`)
+/// `train` for builds without LibTorch: occupancy configs only.
+void AddOccupancyOnlyTrainCommand(CLI::App* app);
+
+/// True when the YAML file's `model` is occupancy.* (so `train` runs the occupancy pipeline).
+bool IsOccupancyConfig(const std::string& path);
+/// Trains, exports and evaluates an occupancy map into run_dir (refuses a used run_dir).
+void TrainOccupancy(const std::string& config_path, const std::vector<std::string>& overrides,
+                    const std::string& run_dir, bool resume);
 
 }  // namespace foresight::app

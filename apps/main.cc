@@ -10,8 +10,11 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   foresight::app::AddDataCommands(&app);
   foresight::app::AddBenchCommands(&app);
+  foresight::app::AddMapCommands(&app);
 #ifdef FORESIGHT_WITH_TORCH
   foresight::app::AddTrainCommands(&app);
+#else
+  foresight::app::AddOccupancyOnlyTrainCommand(&app);
 #endif
   try {
     app.parse(argc, argv);

@@ -1,5 +1,7 @@
 #include "datasets/pedestrian_data.h"
 
+#include "datasets/data_root.h"
+
 #include <cstdlib>
 #include <filesystem>
 
@@ -12,13 +14,7 @@ namespace foresight {
 namespace fs = std::filesystem;
 
 std::string ResolveDataPath(const PedestrianDataConfig& c, const std::string& file) {
-  if (fs::path(file).is_absolute()) return file;
-  std::string root = c.root;
-  if (root.empty()) {
-    const char* env = std::getenv("FORESIGHT_DATA");
-    root = (env && *env) ? env : "../shared/data";
-  }
-  return (fs::path(root) / file).string();
+  return ResolveDataFile(c.root, file);
 }
 
 bool DataFilesPresent(const PedestrianDataConfig& c) {
