@@ -6,9 +6,11 @@ set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BIN="$ROOT/build/bin/foresight"
 OUT="$ROOT/results"
-mkdir -p "$OUT"
+mkdir -p "$OUT" "$ROOT/runs"
 cd "$ROOT"
 for scene in eth hotel univ zara1; do
+  # A fresh run per scene (train refuses to mix runs in one directory), unless resuming.
+  [[ " $* " == *" --resume "* ]] || rm -rf "runs/span_$scene"
   "$BIN" train "configs/span/eth_ucy_$scene.yaml" --run-dir "runs/span_$scene" train.progress=lines "$@" \
     > "runs/span_$scene.out" 2>&1
 done
