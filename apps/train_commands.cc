@@ -1,7 +1,5 @@
 // `foresight train | export | eval | docs`
 
-#include <atomic>
-#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -31,17 +29,6 @@ std::string DefaultRunDir(const std::string& config_path) {
   return "runs/" + stem;
 }
 
-std::atomic<bool> g_interrupt{false};
-extern "C" void OnInterrupt(int) { g_interrupt = true; }
-
-void WriteSummary(const std::string& path, const TrainingSummary& s) {
-  std::ofstream(path) << "{\"reason\": \"" << ToString(s.reason) << "\", \"epochs_completed\": "
-                      << s.epochs_completed << ", \"best_epoch\": " << s.best_epoch
-                      << ", \"best_val_loss\": " << s.best_val_loss << ", \"last_train_loss\": "
-                      << s.last_train_loss << ", \"seconds\": " << s.seconds
-                      << ", \"samples_per_second\": " << s.samples_per_second << "}\n";
-}
-
 struct TrainArgs {
   std::string config, run_dir;
   std::vector<std::string> overrides;
@@ -61,14 +48,19 @@ void AddTrainCommands(CLI::App* app) {
   train->callback([targs] {
     const SpanExperimentConfig c = LoadConfig(targs->config, targs->overrides);
     const std::string run_dir = targs->run_dir.empty() ? DefaultRunDir(targs->config) : targs->run_dir;
-    // Ctrl-C ends the current epoch early; the last checkpoint stays valid for --resume.
-    std::signal(SIGINT, OnInterrupt);
-    std::signal(SIGTERM, OnInterrupt);
-    TrainHooks hooks;
-    hooks.interrupt = &g_interrupt;
-    const TrainingSummary s = TrainSpan(c, run_dir, targs->resume, hooks);
-    WriteSummary(run_dir + "/training_summary.json", s);
+    TrainingSummary s;
+    {
+      // Ctrl-C ends the current epoch early; the last checkpoint stays valid for --resume. Export
+      // and eval afterwards get the previous handlers back.
+      const ScopedInterruptFlag interrupt;
+      TrainHooks hooks;
+      hooks.interrupt = interrupt.flag();
+      s = TrainSpan(c, run_dir, targs->resume, hooks);
+    }
+    std::ofstream(run_dir + "/training_summary.json") << s.ToJson();
     std::cout << s.BriefReport() << "\n";
+    if (s.reason == TerminationReason::kInterrupted && s.epochs_completed == 0)
+      Fail("interrupted in epoch 1 before the first checkpoint; nothing was saved to resume from");
     if (s.reason == TerminationReason::kInterrupted)
       Fail("interrupted after epoch ", s.epochs_completed, "; continue with --resume --run-dir ", run_dir);
     if (s.best_epoch < 0) Fail(run_dir, ": training produced no usable checkpoint (", ToString(s.reason), ")");

@@ -28,6 +28,7 @@ class Handle {
   ~Handle() {
     if (id_ >= 0) closer_(id_);
   }
+  Handle(Handle&& other) noexcept : id_(other.id_), closer_(other.closer_) { other.id_ = -1; }
   Handle(const Handle&) = delete;
   Handle& operator=(const Handle&) = delete;
   hid_t get() const { return id_; }
@@ -154,7 +155,13 @@ Handle OpenAttr(hid_t file, const std::string& path, const std::string& object,
                   "' on '", object, "'");
   hid_t a = H5Aopen(obj.get(), name.c_str(), H5P_DEFAULT);
   FS_THROW_UNLESS(a >= 0, path, ": cannot open attribute '", name, "' on '", object, "'");
-  return Handle(a, H5Aclose);
+  Handle attr(a, H5Aclose);
+  // The scalar readers have room for one element: an array attribute is an error, not an overflow.
+  Handle space(H5Aget_space(attr.get()), H5Sclose);
+  const hssize_t count = space.ok() ? H5Sget_simple_extent_npoints(space.get()) : -1;
+  FS_THROW_UNLESS(count == 1, path, ": attribute '", name, "' on '", object, "' holds ", count,
+                  " elements, expected a single value");
+  return attr;
 }
 }  // namespace
 
@@ -331,6 +338,10 @@ std::string File::ReadString(const std::string& name) const {
   Handle type(H5Dget_type(ds.get()), H5Tclose);
   FS_THROW_UNLESS(H5Tget_class(type.get()) == H5T_STRING && H5Tis_variable_str(type.get()) <= 0,
                   path_, ": dataset '", name, "' is not a fixed-length string");
+  Handle space(H5Dget_space(ds.get()), H5Sclose);
+  const hssize_t count = space.ok() ? H5Sget_simple_extent_npoints(space.get()) : -1;
+  FS_THROW_UNLESS(count == 1, path_, ": string dataset '", name, "' holds ", count,
+                  " elements, expected a single string");
   std::string out(H5Tget_size(type.get()), '\0');
   FS_THROW_UNLESS(H5Dread(ds.get(), type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()) >= 0,
                   path_, ": cannot read dataset '", name, "' (file truncated or corrupt?)");

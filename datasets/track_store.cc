@@ -54,12 +54,17 @@ TrackSet ReadTrackStore(const std::string& path) {
                   path, ": /tracks/offsets is inconsistent with /tracks/agent_id and /tracks/time");
   FS_THROW_UNLESS(xy.shape.size() == 2 && xy.shape[1] == 2 && xy.shape[0] == time.Size(), path,
                   ": /tracks/xy must have shape [", time.Size(), ", 2]");
+  const auto num_points = static_cast<std::int64_t>(time.Size());
+  for (std::size_t k = 0; k < ids.Size(); ++k) {
+    const std::int64_t begin = offsets.data[k], end = offsets.data[k + 1];
+    FS_THROW_UNLESS(0 <= begin && begin <= end && end <= num_points, path, ": /tracks/offsets of track ",
+                    k, " is [", begin, ", ", end, "), expected 0 <= begin <= end <= ", num_points);
+  }
   for (std::size_t k = 0; k < ids.Size(); ++k) {
     Track t;
     t.agent_id = ids.data[k];
     const auto b = static_cast<std::size_t>(offsets.data[k]);
     const auto e = static_cast<std::size_t>(offsets.data[k + 1]);
-    FS_THROW_UNLESS(e >= b, path, ": /tracks/offsets decreases at track ", k);
     t.positions.resize(static_cast<Eigen::Index>(e - b), 2);
     for (std::size_t i = b; i < e; ++i) {
       FS_THROW_UNLESS(std::isfinite(time.data[i]) && std::isfinite(xy.data[2 * i]) &&

@@ -6,5 +6,8 @@ source "$(dirname "${BASH_SOURCE[0]}")/setup.sh"
 install_missing
 configure_and_build "$ROOT/build"
 cd "$ROOT"
+# Each run of the main job starts afresh (train refuses to start a new run in a directory that
+# holds one), unless it continues the last one with --resume.
+[[ " $* " == *" --resume "* ]] || rm -rf runs/quickstart
 ./build/bin/foresight train default --run-dir runs/quickstart "$@"
 ./build/bin/foresight bench engine --artifact runs/quickstart/model.h5

@@ -18,6 +18,13 @@ expect_error() {  # expect_error "substring" args...
   [ "$(grep -c 'error' "$TMP/err")" -eq 1 ] || { cat "$TMP/err"; fail "error of '$*' is not one line"; }
 }
 
+check_json() {  # check_json FILE: strict JSON, no NaN or Infinity (when python3 is there)
+  if command -v python3 >/dev/null; then
+    python3 -c 'import json, sys; json.load(open(sys.argv[1]), parse_constant=lambda c: sys.exit(c))' "$1" ||
+      fail "$1 is not valid JSON"
+  fi
+}
+
 "$BIN" --help >/dev/null
 "$BIN" data generate -o "$TMP/tracks.h5" num_tracks=30 seed=4 >/dev/null
 "$BIN" data info "$TMP/tracks.h5" | grep -q "30 tracks" || fail "data info"
@@ -41,9 +48,31 @@ if [ "${FORESIGHT_WITH_TORCH:-1}" = "1" ] || [ "${FORESIGHT_WITH_TORCH}" = "ON" 
   for k in ade fde nll best_of_20_ade best_of_20_fde cv_ade cv_fde cv_nll; do
     grep -q "\"$k\"" "$RUN/eval.json" || fail "eval.json lacks $k"
   done
+  for f in eval.json training_summary.json; do check_json "$RUN/$f"; done
   "$BIN" train default "${TINY[@]}" train.epochs=3 --run-dir "$RUN" --resume >/dev/null 2>&1 && fail "resume with another config must fail"
+  expect_error "--resume" train default "${TINY[@]}" --run-dir "$RUN"  # a fresh start does not mix runs
   "$BIN" export "$RUN" >/dev/null
   "$BIN" eval default "${TINY[@]}" --run-dir "$RUN" | grep -q '"cv_nll"' || fail "eval"
+  expect_error "data.synthetic.num_tracks = 120, not 100" eval default "${TINY[@]}" data.synthetic.num_tracks=100 --run-dir "$RUN"
+  # A loss that is non-finite in epoch 1: no checkpoint, and a summary that is still valid JSON.
+  expect_error "no usable checkpoint" train default "${TINY[@]}" train.learning_rate=1e30 --run-dir "$TMP/nan_run"
+  check_json "$TMP/nan_run/training_summary.json"
+  grep -q '"best_val_loss": null' "$TMP/nan_run/training_summary.json" || fail "best_val_loss of no epoch is not null"
+  # Ctrl-C in epoch 1 (a long one) stops cleanly, without suggesting --resume: nothing was saved.
+  INT_RUN="$TMP/int_run"
+  "$BIN" train default data.synthetic.num_tracks=600 network.hidden=[16,16] train.batch_size=1 train.progress=none \
+    --run-dir "$INT_RUN" >/dev/null 2>"$TMP/int.err" &
+  PID=$!
+  for _ in $(seq 1 1200); do grep -q "windows:" "$INT_RUN/log.txt" 2>/dev/null && break; sleep 0.05; done
+  kill -INT "$PID"
+  set +e
+  wait "$PID"
+  rc=$?
+  set -e
+  [ $rc -ne 0 ] || fail "interrupted training exits with 0"
+  grep -q "before the first checkpoint" "$TMP/int.err" || { cat "$TMP/int.err"; fail "interrupt in epoch 1"; }
+  grep -q -- "--resume" "$TMP/int.err" && { cat "$TMP/int.err"; fail "interrupt in epoch 1 suggests --resume"; }
+  [ ! -e "$INT_RUN/checkpoints/last.pt" ] || fail "interrupt in epoch 1 left a checkpoint"
   "$BIN" bench engine --artifact "$RUN/model.h5" --json --calls 500 > "$TMP/bench.json"
   for k in engine_us libtorch_us ratio train_windows_per_s; do
     grep -q "\"$k\"" "$TMP/bench.json" || fail "bench lacks $k"

@@ -12,6 +12,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "core/matrix_normal.h"
+#include "inference/engine/artifact.h"
 #include "inference/prediction/span_predictor.h"
 #include "training/plots.h"
 
@@ -32,6 +33,8 @@ struct ConstantVelocity {
   static ConstantVelocity Fit(const WindowSet& train) {
     ConstantVelocity cv;
     const int f = train.predicted, p = train.observed;
+    FS_THROW_UNLESS(train.size() > 0, "constant-velocity baseline: no training windows of ", p + f,
+                    " points to fit its Gaussian to");
     cv.cov_ego.assign(static_cast<std::size_t>(f), Eigen::Matrix2d::Zero());
     for (int n = 0; n < train.size(); ++n) {
       const EgoFrame frame = FrameOfWindow(train, n);
@@ -43,7 +46,7 @@ struct ConstantVelocity {
       }
     }
     for (auto& c : cv.cov_ego) {
-      c /= std::max(1, train.size());
+      c /= train.size();
       c += 1e-6 * Eigen::Matrix2d::Identity();
     }
     return cv;
@@ -63,10 +66,53 @@ double Fde(const Eigen::Matrix<double, Eigen::Dynamic, 2>& path, const WindowSet
   return (path.row(w.predicted - 1).transpose() - w.Future(n, w.predicted - 1)).norm();
 }
 
+/// A JSON number, or null for NaN and inf (which JSON cannot hold).
 std::string Num(double v) {
   std::ostringstream os;
   os << std::setprecision(6) << v;
   return std::isfinite(v) ? os.str() : "null";
+}
+
+/// `node` as one line of YAML flow text.
+std::string Flow(const YAML::Node& node) {
+  YAML::Emitter e;
+  e.SetSeqFormat(YAML::Flow);
+  e.SetMapFormat(YAML::Flow);
+  e << node;
+  return e.c_str();
+}
+
+/// "key.path = trained, not given" for the first leaf where `trained` and `given` differ, else "".
+/// Both come from the same config struct, so they have the same keys.
+std::string FirstDifference(const YAML::Node& trained, const YAML::Node& given, const std::string& path) {
+  if (trained.IsMap() && given.IsMap()) {
+    for (const auto& kv : trained) {
+      const std::string key = kv.first.as<std::string>();
+      const std::string d = FirstDifference(kv.second, given[key], path + "." + key);
+      if (!d.empty()) return d;
+    }
+    return "";
+  }
+  return Flow(trained) == Flow(given) ? "" : path + " = " + Flow(trained) + ", not " + Flow(given);
+}
+
+/// The test split is held out only when the tracks, windows and seed are the training run's: the
+/// data, windows and seed sections of `config` must equal those stored in the artifact's /config
+/// (data.root, where the files are, may differ).
+void CheckSameDataAsTraining(const SpanExperimentConfig& config, const std::string& artifact) {
+  const SpanExperimentConfig trained =
+      SpanConfigFromYaml(Artifact::Open(artifact, kSpanModelType).config_yaml(), artifact + ":/config");
+  const auto tree = [](SpanExperimentConfig c) {
+    c.data.root.clear();
+    return config::ParseYaml(config::ToYaml(c), "resolved config");
+  };
+  const YAML::Node t = tree(trained), g = tree(config);
+  for (const char* section : {"data", "windows", "seed"}) {
+    const std::string d = FirstDifference(t[section], g[section], section);
+    FS_THROW_UNLESS(d.empty(), artifact, ": the model was trained with ", d,
+                    " as given; evaluate with the run's config.yaml (the data, windows and seed "
+                    "sections must match training, or the test split is not held out)");
+  }
 }
 
 }  // namespace
@@ -82,10 +128,15 @@ std::string SpanEvalReport::ToJson(int num_samples) const {
      << "  \"cv_nll\": " << Num(cv.nll) << ",\n"
      << "  \"cv_best_of_20_ade\": " << Num(cv.best_of_n_ade) << ",\n"
      << "  \"cv_best_of_20_fde\": " << Num(cv.best_of_n_fde) << ",\n"
-     << "  \"val\": {\"windows\": " << val_windows << ", \"ade\": " << Num(val_model.ade)
-     << ", \"fde\": " << Num(val_model.fde) << ", \"nll\": " << Num(val_model.nll)
-     << ", \"cv_ade\": " << Num(val_cv.ade) << ", \"cv_fde\": " << Num(val_cv.fde)
-     << ", \"cv_nll\": " << Num(val_cv.nll) << "}\n}\n";
+     << "  \"val\": ";
+  if (val_windows > 0) {
+    os << "{\"windows\": " << val_windows << ", \"ade\": " << Num(val_model.ade)
+       << ", \"fde\": " << Num(val_model.fde) << ", \"nll\": " << Num(val_model.nll)
+       << ", \"cv_ade\": " << Num(val_cv.ade) << ", \"cv_fde\": " << Num(val_cv.fde)
+       << ", \"cv_nll\": " << Num(val_cv.nll) << "}\n}\n";
+  } else {
+    os << "null\n}\n";  // no validation windows
+  }
   return os.str();
 }
 
@@ -97,6 +148,7 @@ SpanEvalReport EvaluateSpanOn(const std::string& artifact, const WindowSet& trai
   FS_THROW_UNLESS(std::abs(model.seconds_per_step() - test.seconds_per_step) < 1e-9, artifact,
                   ": model was trained at ", model.seconds_per_step(), " s per step, data has ",
                   test.seconds_per_step);
+  FS_THROW_UNLESS(test.size() > 0, artifact, ": no windows to evaluate on");
   const ConstantVelocity cv = ConstantVelocity::Fit(train);
   auto ws = model.MakeWorkspace();
   auto dist = model.MakeDistribution();
@@ -148,7 +200,7 @@ SpanEvalReport EvaluateSpanOn(const std::string& artifact, const WindowSet& trai
     rep.cv.best_of_n_fde += cv_best_fde;
   }
   for (SpanMetrics* m : {&rep.model, &rep.cv}) {
-    const double d = std::max(count, 1);
+    const double d = count;
     m->ade /= d, m->fde /= d, m->nll /= d, m->best_of_n_ade /= d, m->best_of_n_fde /= d;
   }
   return rep;
@@ -156,11 +208,17 @@ SpanEvalReport EvaluateSpanOn(const std::string& artifact, const WindowSet& trai
 
 SpanEvalReport EvaluateSpan(const SpanExperimentConfig& c, const std::string& artifact,
                             const std::string& out_dir) {
+  CheckSameDataAsTraining(c, artifact);
   const TrackSplit split = LoadPedestrianSplits(c.data, static_cast<std::uint64_t>(c.seed));
   const WindowSet train = MakeWindows(split.train, c.windows);
   const WindowSet test = MakeWindows(split.test, c.windows);
-  FS_THROW_UNLESS(test.size() > 0, "no test windows: the test tracks are shorter than ",
-                  c.windows.observed + c.windows.predicted, " points");
+  const int length = c.windows.observed + c.windows.predicted;
+  FS_THROW_UNLESS(test.size() > 0, "no test windows: no test track has windows.observed + ",
+                  "windows.predicted = ", length, " points (",
+                  c.data.test_files.empty() ? "raise data.test_fraction" : "check data.test_files", ")");
+  FS_THROW_UNLESS(train.size() > 0, "no training windows for the constant-velocity baseline: no ",
+                  "training track has windows.observed + windows.predicted = ", length,
+                  " points (data.train_files, data.val_fraction, data.test_fraction)");
   SpanEvalReport rep = EvaluateSpanOn(artifact, train, test, c.eval);
   const WindowSet val = MakeWindows(split.val, c.windows);
   if (val.size() > 0) {

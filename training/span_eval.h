@@ -21,15 +21,19 @@ struct SpanEvalReport {
   /// The same metrics on the validation windows (for choosing hyper-parameters; never the test).
   int val_windows = 0;
   SpanMetrics val_model, val_cv;
+  /// Valid JSON: non-finite metrics are null, and so is "val" without validation windows.
   std::string ToJson(int num_samples) const;
 };
 
 /// Evaluates `artifact` on the test windows of `config`; writes `out_dir`/eval.json and
-/// `out_dir`/plots/samples.png.
+/// `out_dir`/plots/samples.png. The data, windows and seed sections of `config` must be those the
+/// artifact was trained with (its /config; data.root may differ), else an Error names the first
+/// differing key. No test or training windows is an Error naming the keys that control the split.
 SpanEvalReport EvaluateSpan(const SpanExperimentConfig& config, const std::string& artifact,
                             const std::string& out_dir);
 
-/// Same on given windows, the CV Gaussian fitted on `train` (no files written).
+/// Same on given windows, the CV Gaussian fitted on `train` (no files written); empty `train` or
+/// `test` is an Error.
 SpanEvalReport EvaluateSpanOn(const std::string& artifact, const WindowSet& train,
                               const WindowSet& test, const SpanEvalConfig& eval);
 

@@ -75,7 +75,7 @@ class SpanTask : public TrainingTask {
   double ValidationLoss() override {
     double sum = 0;
     const std::int64_t n = x_val_.size(0);
-    if (n == 0) return 0.0;
+    FS_THROW_UNLESS(n > 0, "no validation windows to compute the validation loss on");
     for (std::int64_t b = 0; b < n; b += 4096) {
       const std::int64_t len = std::min<std::int64_t>(4096, n - b);
       const auto raw = net_->forward(x_val_.narrow(0, b, len));
@@ -97,10 +97,22 @@ std::string ReadText(const std::string& path) {
   return ss.str();
 }
 
+/// The file of `run_dir` that shows it holds a run a fresh start would mix with, or "".
+std::string PreviousRunFile(const std::string& run_dir) {
+  const std::string checkpoints = run_dir + "/checkpoints";
+  if (fs::is_directory(checkpoints) && !fs::is_empty(checkpoints)) return "checkpoints/";
+  for (const char* name : {"model.h5", "eval.json", "metrics.csv"})
+    if (fs::exists(run_dir + "/" + name)) return name;
+  return "";
+}
+
 }  // namespace
 
 TrainingSummary TrainSpan(const SpanExperimentConfig& c, const std::string& run_dir, bool resume,
                           const TrainHooks& hooks) {
+  const std::string previous = resume ? "" : PreviousRunFile(run_dir);
+  FS_THROW_UNLESS(previous.empty(), run_dir, ": already holds a run (", previous,
+                  "); continue it with --resume, or train into a new or empty --run-dir");
   fs::create_directories(run_dir);
   const std::string config_path = run_dir + "/config.yaml";
   const std::string resolved = config::ToYaml(c);
@@ -119,8 +131,13 @@ TrainingSummary TrainSpan(const SpanExperimentConfig& c, const std::string& run_
   const WindowSet train_w = MakeWindows(split.train, c.windows);
   const WindowSet val_w = MakeWindows(split.val, c.windows);
   log::Info("windows: ", train_w.size(), " train, ", val_w.size(), " val");
-  FS_THROW_UNLESS(train_w.size() > 0, "no training windows of ", c.windows.observed + c.windows.predicted,
-                  " points in the training tracks");
+  const int length = c.windows.observed + c.windows.predicted;
+  FS_THROW_UNLESS(train_w.size() > 0, "no training windows of ", length, " points in the training tracks");
+  // The validation loss chooses the best checkpoint and drives early stopping (train.patience).
+  FS_THROW_UNLESS(val_w.size() > 0, "no validation windows: no validation track has windows.observed + "
+                  "windows.predicted = ", length, " points (",
+                  c.data.val_files.empty() ? "raise data.val_fraction" : "check data.val_files",
+                  "); the validation loss chooses the best checkpoint and drives early stopping");
   const TimeBasis basis = MakeFutureBasis(c.basis, c.windows.predicted, train_w.seconds_per_step);
   const SpanSamples train_s = MakeSpanSamples(train_w, basis, c.basis, c.network.rotate_to_heading,
                                               c.network.residual_to_constant_velocity);
@@ -135,8 +152,8 @@ TrainingSummary TrainSpan(const SpanExperimentConfig& c, const std::string& run_
   torch::manual_seed(static_cast<std::uint64_t>(c.seed));
   SpanNet net(2 * c.windows.observed, c.network, layout);
   const std::int64_t m = layout.basis;
-  auto w_train = ToTensor(train_s.targets).view({-1, m, 2});
-  auto w_val = ToTensor(val_s.targets).view({-1, m, 2});
+  auto w_train = ToTensor(train_s.targets).view({train_s.targets.rows(), m, 2});
+  auto w_val = ToTensor(val_s.targets).view({val_s.targets.rows(), m, 2});
   SpanTask task(net, layout, ToTensor(norm.Apply(train_s.inputs)), w_train,
                 ToTensor(norm.Apply(val_s.inputs)), w_val);
   return Train(&task, c.train, RunPaths{run_dir}, static_cast<std::uint64_t>(c.seed), resume, hooks);

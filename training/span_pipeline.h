@@ -12,6 +12,8 @@
 namespace foresight {
 
 /// Trains (or resumes) into `run_dir`; writes the resolved config and the normalisation first.
+/// A fresh start (not `resume`) refuses a directory that already holds checkpoints, metrics.csv,
+/// model.h5 or eval.json. No training or validation windows is an Error naming the split keys.
 TrainingSummary TrainSpan(const SpanExperimentConfig& config, const std::string& run_dir, bool resume,
                           const TrainHooks& hooks = {});
 

@@ -1,8 +1,12 @@
 #include "training/trainer.h"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <numeric>
@@ -11,6 +15,7 @@
 
 #include "core/error.h"
 #include "core/log.h"
+#include "core/parse.h"
 #include "training/progress.h"
 
 namespace foresight {
@@ -51,6 +56,52 @@ std::string TrainingSummary::BriefReport() const {
 }
 
 namespace {
+/// A JSON number, or null for NaN and inf (which JSON cannot hold).
+std::string JsonNumber(double v) {
+  std::ostringstream os;
+  os << v;
+  return std::isfinite(v) ? os.str() : "null";
+}
+}  // namespace
+
+std::string TrainingSummary::ToJson() const {
+  std::ostringstream os;
+  os << "{\"reason\": \"" << ToString(reason) << "\", \"epochs_completed\": " << epochs_completed
+     << ", \"best_epoch\": " << best_epoch << ", \"best_val_loss\": " << JsonNumber(best_val_loss)
+     << ", \"last_train_loss\": " << JsonNumber(last_train_loss) << ", \"seconds\": " << JsonNumber(seconds)
+     << ", \"samples_per_second\": " << JsonNumber(samples_per_second) << "}\n";
+  return os.str();
+}
+
+namespace {
+std::atomic<bool> g_interrupted{false};
+extern "C" void SetInterrupted(int) { g_interrupted = true; }
+}  // namespace
+
+ScopedInterruptFlag::ScopedInterruptFlag() {
+  g_interrupted = false;
+  previous_int_ = std::signal(SIGINT, SetInterrupted);
+  previous_term_ = std::signal(SIGTERM, SetInterrupted);
+}
+
+ScopedInterruptFlag::~ScopedInterruptFlag() {
+  if (previous_int_ != SIG_ERR) std::signal(SIGINT, previous_int_);
+  if (previous_term_ != SIG_ERR) std::signal(SIGTERM, previous_term_);
+}
+
+const std::atomic<bool>* ScopedInterruptFlag::flag() const { return &g_interrupted; }
+
+namespace {
+
+constexpr const char* kMetricsHeader = "epoch,train_loss,val_loss,learning_rate,seconds,samples_per_second";
+
+/// Flushes the file or directory `path` to disk; `required` failures are an Error.
+void Sync(const std::string& path, bool required) {
+  const int fd = ::open(path.c_str(), O_RDONLY);
+  const bool ok = fd >= 0 && ::fsync(fd) == 0;
+  if (fd >= 0) ::close(fd);
+  FS_THROW_UNLESS(ok || !required, path, ": cannot flush to disk");
+}
 
 /// First line of a (LibTorch) exception message, shortened: our errors are one line.
 std::string Brief(const std::exception& e) {
@@ -81,7 +132,9 @@ void SaveCheckpoint(const std::string& path, torch::nn::Module& module, torch::o
   archive.write("state/bad_epochs", torch::tensor(static_cast<int64_t>(s.bad_epochs)));
   const std::string tmp = path + ".tmp";
   archive.save_to(tmp);
+  Sync(tmp, true);  // the data is on disk before the rename makes it the checkpoint
   FS_THROW_UNLESS(std::rename(tmp.c_str(), path.c_str()) == 0, path, ": cannot move checkpoint into place");
+  Sync(fs::path(path).parent_path().string(), false);
 }
 
 torch::serialize::InputArchive OpenCheckpoint(const std::string& path) {
@@ -131,22 +184,35 @@ State LoadCheckpoint(const std::string& path, torch::nn::Module* module, torch::
   return s;
 }
 
-/// Keeps the metrics rows of epochs 1..epoch (a resumed run rewrites later ones).
+/// Keeps the metrics rows of epochs 1..epoch (a resumed run rewrites later ones). A missing file
+/// stays missing (AppendMetrics starts it with the header).
 void TruncateMetrics(const std::string& path, int epoch) {
   std::ifstream in(path);
   if (!in.good()) return;
-  std::vector<std::string> keep;
+  std::vector<std::string> keep{kMetricsHeader};
   std::string line;
-  while (std::getline(in, line)) {
-    if (keep.empty()) {
-      keep.push_back(line);
-      continue;
-    }
-    if (std::stoi(line.substr(0, line.find(','))) <= epoch) keep.push_back(line);
+  for (int number = 1; std::getline(in, line); ++number) {
+    if (number == 1 || line.empty()) continue;  // line 1 is the header (kept as kMetricsHeader)
+    const auto row_epoch = ParseInteger(line.substr(0, line.find(',')));
+    FS_THROW_UNLESS(row_epoch.has_value(), path, ":", number, ": row does not start with an epoch number");
+    if (*row_epoch <= epoch) keep.push_back(line);
   }
   in.close();
   std::ofstream out(path, std::ios::trunc);
   for (const auto& l : keep) out << l << "\n";
+  out.close();
+  FS_THROW_UNLESS(out.good(), path, ": cannot rewrite the metrics");
+}
+
+/// Appends one row (starting the file with the header when it is missing) and flushes it to disk.
+void AppendMetrics(const std::string& path, const std::string& row) {
+  const bool start = !fs::exists(path);
+  std::ofstream out(path, std::ios::app);
+  if (start) out << kMetricsHeader << "\n";
+  out << row << "\n";
+  out.close();
+  FS_THROW_UNLESS(out.good(), path, ": cannot append to the metrics");
+  Sync(path, true);
 }
 
 void SetLearningRate(torch::optim::Adam* opt, double lr) {
@@ -174,8 +240,7 @@ TrainingSummary Train(TrainingTask* task, const TrainConfig& c, const RunPaths& 
     TruncateMetrics(run.Metrics(), state.epoch);
     log::Info("resuming ", run.Checkpoint(), " after epoch ", state.epoch);
   } else {
-    std::ofstream(run.Metrics(), std::ios::trunc)
-        << "epoch,train_loss,val_loss,learning_rate,seconds,samples_per_second\n";
+    fs::remove(run.Metrics());  // started with the first row: an epoch-less run leaves none
   }
 
   TrainingSummary summary;
@@ -229,8 +294,11 @@ TrainingSummary Train(TrainingTask* task, const TrainConfig& c, const RunPaths& 
     }
     if (interrupted) {
       summary.reason = TerminationReason::kInterrupted;
-      log::Warn("interrupted in epoch ", epoch + 1, "; the checkpoint of epoch ", state.epoch,
-                " is kept (continue with --resume)");
+      if (state.epoch == 0)
+        log::Warn("interrupted in epoch 1 before the first checkpoint; nothing was saved");
+      else
+        log::Warn("interrupted in epoch ", epoch + 1, "; the checkpoint of epoch ", state.epoch,
+                  " is kept (continue with --resume)");
       if (fs::exists(run.Checkpoint())) LoadCheckpointModel(run.Checkpoint(), &module);
       break;
     }
@@ -243,14 +311,23 @@ TrainingSummary Train(TrainingTask* task, const TrainConfig& c, const RunPaths& 
     }
     if (!finite) {
       summary.reason = TerminationReason::kNonFiniteLoss;
-      log::Warn("non-finite loss in epoch ", epoch + 1, "; stopping and keeping the checkpoint of epoch ",
-                state.epoch);
+      if (state.epoch == 0)
+        log::Warn("non-finite loss in epoch 1; stopping before the first checkpoint");
+      else
+        log::Warn("non-finite loss in epoch ", epoch + 1, "; stopping and keeping the checkpoint of epoch ",
+                  state.epoch);
       if (fs::exists(run.Checkpoint())) LoadCheckpointModel(run.Checkpoint(), &module);
       break;
     }
     const double train_loss = loss_sum / static_cast<double>(seen);
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - e0).count();
     state.epoch = epoch + 1;
+    // The row goes first: a run killed before its checkpoint resumes from the previous epoch and
+    // drops the row (TruncateMetrics), so no row is lost or duplicated.
+    std::ostringstream row;
+    row << state.epoch << "," << train_loss << "," << val << "," << lr << "," << secs << ","
+        << static_cast<double>(seen) / std::max(secs, 1e-9);
+    AppendMetrics(run.Metrics(), row.str());
     if (val < state.best_val - c.min_delta) {
       state.best_val = val;
       state.best_epoch = state.epoch;
@@ -260,9 +337,6 @@ TrainingSummary Train(TrainingTask* task, const TrainConfig& c, const RunPaths& 
       ++state.bad_epochs;
     }
     SaveCheckpoint(run.Checkpoint(), module, opt, state);
-    std::ofstream(run.Metrics(), std::ios::app)
-        << state.epoch << "," << train_loss << "," << val << "," << lr << "," << secs << ","
-        << static_cast<double>(seen) / std::max(secs, 1e-9) << "\n";
     std::ostringstream line;
     line << "train " << train_loss << " val " << val << (state.best_epoch == state.epoch ? " *" : "")
          << " lr " << lr;

@@ -38,6 +38,8 @@ struct TrainingSummary {
   double seconds = 0;        ///< wall time of this invocation
   double samples_per_second = 0;
   std::string BriefReport() const;
+  /// One JSON object (training_summary.json); non-finite numbers (no epoch completed) are null.
+  std::string ToJson() const;
 };
 
 /// Files of a run directory.
@@ -56,8 +58,25 @@ struct TrainHooks {
   std::function<bool(int)> continue_after_epoch;
 };
 
+/// While alive, SIGINT and SIGTERM set flag() (for TrainHooks::interrupt) instead of ending the
+/// process; the handlers that were there before are restored on destruction. One at a time.
+class ScopedInterruptFlag {
+ public:
+  ScopedInterruptFlag();
+  ~ScopedInterruptFlag();
+  ScopedInterruptFlag(const ScopedInterruptFlag&) = delete;
+  ScopedInterruptFlag& operator=(const ScopedInterruptFlag&) = delete;
+  const std::atomic<bool>* flag() const;
+
+ private:
+  using Handler = void (*)(int);
+  Handler previous_int_, previous_term_;
+};
+
 /// Trains `task` in `run`. With `resume`, continues from run.Checkpoint() (an Error if it is
-/// missing or corrupt) and produces the same parameters as an uninterrupted run.
+/// missing or corrupt) and produces the same parameters as an uninterrupted run. Each epoch
+/// appends its metrics.csv row, then replaces the checkpoints (fsynced, atomic rename); a resume
+/// drops rows after the checkpoint's epoch.
 TrainingSummary Train(TrainingTask* task, const TrainConfig& config, const RunPaths& run,
                       std::uint64_t seed, bool resume, const TrainHooks& hooks = {});
 

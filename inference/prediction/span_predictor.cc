@@ -161,6 +161,14 @@ TrajectoryDistribution SpanPredictor::MakeDistribution() const {
 }
 
 namespace {
+/// `out` must come from MakeDistribution() of a model with this layout (Predict writes in place).
+void CheckOutput(const TrajectoryDistribution& out, const HeadLayout& layout) {
+  FS_THROW_UNLESS(out.components() == layout.components && out.basis_size() == layout.basis,
+                  "SpanPredictor: the output distribution has ", out.components(), " components over ",
+                  out.basis_size(), " basis functions, the model predicts ", layout.components, " over ",
+                  layout.basis, " (make it with MakeDistribution())");
+}
+
 EgoFrame FrameOf(const Eigen::Ref<const Eigen::Matrix<double, Eigen::Dynamic, 2>>& past, bool rotate) {
   return EgoFrame::FromPast(static_cast<int>(past.rows()),
                             [&](int i) { return Eigen::Vector2d(past(i, 0), past(i, 1)); }, rotate);
@@ -184,6 +192,7 @@ void SpanPredictor::RawOutput(const Eigen::Ref<const Eigen::Matrix<double, Eigen
 
 void SpanPredictor::Predict(const Eigen::Ref<const Eigen::Matrix<double, Eigen::Dynamic, 2>>& past,
                             Workspace* ws, TrajectoryDistribution* out) const {
+  CheckOutput(*out, layout_);
   RawOutput(past, ws);
   const EgoFrame frame = FrameOf(past, rotate_);
   const Eigen::Matrix2d& rot = frame.rotation;
@@ -241,6 +250,8 @@ void SpanPredictor::PredictBatch(const Eigen::Ref<const Eigen::MatrixXd>& past_r
   FS_THROW_UNLESS(out->size() >= static_cast<std::size_t>(past_rows.rows()),
                   "SpanPredictor: output holds ", out->size(), " distributions for ",
                   past_rows.rows(), " tracks");
+  for (Eigen::Index n = 0; n < past_rows.rows(); ++n)
+    CheckOutput((*out)[static_cast<std::size_t>(n)], layout_);
   for (Eigen::Index n = 0; n < past_rows.rows(); ++n) {
     for (int i = 0; i < observed_; ++i) {
       ws->past(i, 0) = past_rows(n, 2 * i);

@@ -1,6 +1,7 @@
 #include "core/h5.h"
 
 #include <gtest/gtest.h>
+#include <hdf5.h>
 
 #include "tests/test_util.h"
 
@@ -51,6 +52,46 @@ TEST(H5, ErrorsNameFileAndObject) {
   testing::ExpectErrorContains([&] { f.GetIntAttr("/", "nope"); }, {path, "missing attribute 'nope'"});
   testing::ExpectErrorContains([&] { f.ReadInt("/m"); }, {"wrong element type"});
   testing::ExpectErrorContains([] { h5::File::Open("/nonexistent/file.h5"); }, {"/nonexistent/file.h5", "not found"});
+}
+
+TEST(H5, ScalarReadsRefuseArrays) {
+  testing::TempDir dir;
+  const std::string path = dir.File("arrays.h5");
+  {
+    h5::File f = h5::File::Create(path);
+    f.SetAttr("/g", "marker", std::int64_t{1});
+  }
+  {  // Arrays written by another tool, where this reader expects single values.
+    const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    const hid_t group = H5Gopen2(file, "/g", H5P_DEFAULT);
+    const hsize_t three = 3;
+    const hid_t space = H5Screate_simple(1, &three, nullptr);
+    const std::int64_t ints[3] = {1, 2, 3};
+    const double doubles[3] = {1, 2, 3};
+    const hid_t str = H5Tcopy(H5T_C_S1);
+    H5Tset_size(str, 4);
+    const char strings[12] = {'a', 'b', 'c', 0, 'd', 'e', 'f', 0, 'g', 'h', 'i', 0};
+    const hid_t a1 = H5Acreate2(group, "ints", H5T_NATIVE_INT64, space, H5P_DEFAULT, H5P_DEFAULT);
+    H5Awrite(a1, H5T_NATIVE_INT64, ints);
+    const hid_t a2 = H5Acreate2(group, "doubles", H5T_NATIVE_DOUBLE, space, H5P_DEFAULT, H5P_DEFAULT);
+    H5Awrite(a2, H5T_NATIVE_DOUBLE, doubles);
+    const hid_t a3 = H5Acreate2(group, "strings", str, space, H5P_DEFAULT, H5P_DEFAULT);
+    H5Awrite(a3, str, strings);
+    const hid_t ds = H5Dcreate2(file, "/texts", str, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    H5Dwrite(ds, str, H5S_ALL, H5S_ALL, H5P_DEFAULT, strings);
+    for (hid_t a : {a1, a2, a3}) H5Aclose(a);
+    H5Dclose(ds);
+    H5Tclose(str);
+    H5Sclose(space);
+    H5Gclose(group);
+    H5Fclose(file);
+  }
+  h5::File f = h5::File::Open(path);
+  EXPECT_EQ(f.GetIntAttr("/g", "marker"), 1);
+  testing::ExpectErrorContains([&] { f.GetIntAttr("/g", "ints"); }, {path, "'ints'", "'/g'", "3 elements"});
+  testing::ExpectErrorContains([&] { f.GetDoubleAttr("/g", "doubles"); }, {path, "'doubles'", "'/g'", "3 elements"});
+  testing::ExpectErrorContains([&] { f.GetStringAttr("/g", "strings"); }, {path, "'strings'", "'/g'", "3 elements"});
+  testing::ExpectErrorContains([&] { f.ReadString("/texts"); }, {path, "'/texts'", "3 elements"});
 }
 
 TEST(H5, TruncatedAndForeignFilesAreClearErrors) {

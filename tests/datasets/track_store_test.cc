@@ -41,6 +41,34 @@ TEST(TrackStore, RejectsForeignAndCorruptFiles) {
   EXPECT_THROW(ReadTrackStore(dir.File("t.h5")), Error);
 }
 
+/// A track store of three tracks over five points whose offsets are `offsets`.
+void WriteStoreWithOffsets(const std::string& path, const std::vector<std::int64_t>& offsets) {
+  const std::vector<std::int64_t> ids{1, 2, 3};
+  const std::vector<double> time{0, 0.4, 0.8, 1.2, 1.6}, xy(10, 0.0);
+  h5::File f = h5::File::Create(path);
+  f.SetAttr("/", "kind", std::string(kTrackStoreKind));
+  f.SetAttr("/", "format_version", kTrackStoreVersion);
+  f.SetAttr("/", "source", std::string("test"));
+  f.SetAttr("/", "seconds_per_step", 0.4);
+  f.Write("/tracks/agent_id", ids.data(), {ids.size()});
+  f.Write("/tracks/offsets", offsets.data(), {offsets.size()});
+  f.Write("/tracks/time", time.data(), {time.size()});
+  f.Write("/tracks/xy", xy.data(), {time.size(), 2});
+}
+
+TEST(TrackStore, RejectsOffsetsOutsideThePoints) {
+  testing::TempDir dir;
+  const std::string path = dir.File("offsets.h5");
+  WriteStoreWithOffsets(path, {0, 2, 2, 5});
+  EXPECT_EQ(ReadTrackStore(path).tracks[1].size(), 0);  // an empty track is allowed
+  WriteStoreWithOffsets(path, {0, 7, 3, 5});  // track 0 runs past the last point
+  testing::ExpectErrorContains([&] { ReadTrackStore(path); }, {path, "/tracks/offsets", "track 0", "[0, 7)"});
+  WriteStoreWithOffsets(path, {0, -2, 4, 5});
+  testing::ExpectErrorContains([&] { ReadTrackStore(path); }, {path, "track 0", "[0, -2)"});
+  WriteStoreWithOffsets(path, {0, 3, 2, 5});
+  testing::ExpectErrorContains([&] { ReadTrackStore(path); }, {path, "track 1", "[3, 2)"});
+}
+
 TEST(Synthetic, IsDeterministicAndPlausible) {
   SyntheticPedestrianConfig cfg;
   cfg.num_tracks = 50;

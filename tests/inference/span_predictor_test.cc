@@ -199,6 +199,27 @@ TEST(SpanEngineErrors, BadInputIsAClearError) {
   testing::ExpectErrorContains([&] { model.Predict(Walk(5, 0, 1, {0, 0}), &ws, &dist); }, {"expected 8 observed points, got 5"});
 }
 
+TEST(SpanEngineErrors, OutputOfAnotherLayoutIsAnError) {
+  testing::TempDir dir;
+  testing::WriteRandomSpanArtifact(dir.File("a.h5"), {8, 12, 6, 1});
+  testing::WriteRandomSpanArtifact(dir.File("b.h5"), {8, 12, 6, 3});
+  testing::WriteRandomSpanArtifact(dir.File("c.h5"), {8, 12, 4, 1});
+  const SpanPredictor a = SpanPredictor::Load(dir.File("a.h5"));
+  auto ws = a.MakeWorkspace();
+  const auto past = Walk(8, 0, 1, {0, 0});
+  for (const char* other : {"b.h5", "c.h5"}) {
+    auto dist = SpanPredictor::Load(dir.File(other)).MakeDistribution();
+    testing::ExpectErrorContains([&] { a.Predict(past, &ws, &dist); },
+                                 {"output distribution has", "the model predicts 1 over 6"});
+    std::vector<TrajectoryDistribution> outs{a.MakeDistribution(), dist};
+    Eigen::MatrixXd batch(2, 16);
+    batch.row(0) = batch.row(1) = Eigen::Map<const Eigen::RowVectorXd>(Eigen::MatrixXd(past.transpose()).data(), 16);
+    testing::ExpectErrorContains([&] { a.PredictBatch(batch, &ws, &outs); }, {"output distribution has"});
+  }
+  TrajectoryDistribution empty;
+  testing::ExpectErrorContains([&] { a.Predict(past, &ws, &empty); }, {"0 components over 0 basis functions"});
+}
+
 TEST(SpanEngineErrors, TruncatedForeignAndWrongTypeArtifacts) {
   testing::TempDir dir;
   const std::string path = dir.File("model.h5");

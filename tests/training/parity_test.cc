@@ -7,6 +7,7 @@
 
 #include "core/ego_frame.h"
 #include "core/h5.h"
+#include "datasets/synthetic_pedestrians.h"
 #include "inference/engine/artifact.h"
 #include "inference/prediction/span_predictor.h"
 #include "models/span/span_net.h"
@@ -118,6 +119,71 @@ TEST(Pipeline, TrainExportEvalWritesEveryKey) {
   const Artifact art = Artifact::Open(t->artifact, kSpanModelType);
   EXPECT_EQ(art.config_yaml(), config::ToYaml(t->config));
   EXPECT_EQ(art.seed(), t->config.seed);
+}
+
+TEST(Pipeline, EvalRefusesDataWindowsOrSeedOtherThanTrainedWith) {
+  const auto t = TrainTiny(1, UParam::kCholesky);
+  SpanExperimentConfig c = t->config;
+  c.data.synthetic.num_tracks = 100;
+  testing::ExpectErrorContains([&] { EvaluateSpan(c, t->artifact, t->dir.path()); },
+                               {t->artifact, "data.synthetic.num_tracks = 150, not 100", "config.yaml"});
+  c = t->config;
+  c.windows.predicted = 10;
+  testing::ExpectErrorContains([&] { EvaluateSpan(c, t->artifact, t->dir.path()); }, {"windows.predicted = 12, not 10"});
+  c = t->config;
+  c.seed = 5;
+  testing::ExpectErrorContains([&] { EvaluateSpan(c, t->artifact, t->dir.path()); }, {"seed = 0, not 5"});
+  // Where the files are and how to evaluate may differ.
+  c = t->config;
+  c.data.root = "/elsewhere";
+  c.eval.num_samples = 5;
+  c.eval.plot_tracks = 0;
+  EXPECT_GT(EvaluateSpan(c, t->artifact, t->dir.path()).windows, 0);
+}
+
+SpanEvalReport ReportWith(double value, int val_windows) {
+  SpanEvalReport r;
+  r.windows = 10;
+  for (SpanMetrics* m : {&r.model, &r.cv, &r.val_model, &r.val_cv})
+    m->ade = m->fde = m->nll = m->best_of_n_ade = m->best_of_n_fde = value;
+  r.val_windows = val_windows;
+  return r;
+}
+
+TEST(EvalJson, HasTheDocumentedKeysAndNoNonFiniteNumbers) {
+  const std::string json = ReportWith(1.5, 4).ToJson(20);
+  for (const char* key : {"ade", "fde", "nll", "best_of_20_ade", "best_of_20_fde", "cv_ade", "cv_fde", "cv_nll",
+                          "cv_best_of_20_ade", "cv_best_of_20_fde"})
+    EXPECT_NE(json.find("\n  \"" + std::string(key) + "\": 1.5,"), std::string::npos) << key << " in " << json;
+  EXPECT_NE(json.find("\"val\": {\"windows\": 4, \"ade\": 1.5"), std::string::npos) << json;
+  for (double bad : {double(NAN), double(INFINITY), -double(INFINITY)}) {
+    const std::string b = ReportWith(bad, 4).ToJson(20);
+    EXPECT_NE(b.find("\"ade\": null"), std::string::npos) << b;
+    EXPECT_EQ(b.find("nan"), std::string::npos) << b;
+    EXPECT_EQ(b.find("inf"), std::string::npos) << b;
+  }
+  // No validation windows: the val block is null, not zeros.
+  EXPECT_NE(ReportWith(1.5, 0).ToJson(20).find("\"val\": null"), std::string::npos);
+}
+
+TEST(EvalJson, EmptySplitsAreErrors) {
+  testing::TempDir dir;
+  const std::string artifact = dir.File("model.h5");
+  testing::WriteRandomSpanArtifact(artifact, {});
+  SyntheticPedestrianConfig tracks;
+  tracks.num_tracks = 20;
+  const WindowSet windows = MakeWindows(GenerateSyntheticPedestrians(tracks), WindowConfig{});
+  ASSERT_GT(windows.size(), 0);
+  WindowSet empty = windows;
+  empty.past.resize(0, empty.past.cols());
+  empty.future.resize(0, empty.future.cols());
+  empty.track.clear();
+  SpanEvalConfig ec;
+  ec.num_samples = 2;
+  EXPECT_GT(EvaluateSpanOn(artifact, windows, windows, ec).windows, 0);
+  testing::ExpectErrorContains([&] { EvaluateSpanOn(artifact, windows, empty, ec); }, {artifact, "no windows"});
+  testing::ExpectErrorContains([&] { EvaluateSpanOn(artifact, empty, windows, ec); },
+                               {"constant-velocity", "no training windows"});
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -65,6 +66,136 @@ TEST(Trainer, ResumeAfterAnInterruptionIsBitIdentical) {
   ASSERT_EQ(a.size(), b.size());
   for (std::size_t i = 0; i < a.size(); ++i) EXPECT_TRUE(torch::equal(a[i], b[i])) << "parameter " << i;
   EXPECT_EQ(LossColumns(dir.File("full") + "/metrics.csv"), LossColumns(dir.File("resumed") + "/metrics.csv"));
+}
+
+std::vector<std::string> Lines(const std::string& path) {
+  std::ifstream in(path);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+/// Stops a run after `epochs` completed epochs.
+TrainHooks StopAfter(int epochs) {
+  TrainHooks hooks;
+  hooks.continue_after_epoch = [epochs](int completed) { return completed < epochs; };
+  return hooks;
+}
+
+TEST(Trainer, MetricsRowPrecedesItsCheckpointAndResumeRewritesIt) {
+  testing::TempDir dir;
+  const SpanExperimentConfig c = TinyConfig();
+  TrainSpan(c, dir.File("full"), false);
+  // The checkpoint of epoch 3 cannot be written (its temporary file is taken by a directory).
+  const std::string run = dir.File("failed");
+  TrainHooks hooks;
+  hooks.continue_after_epoch = [&](int completed) {
+    if (completed == 2) std::filesystem::create_directories(run + "/checkpoints/last.pt.tmp");
+    return true;
+  };
+  EXPECT_ANY_THROW(TrainSpan(c, run, false, hooks));
+  EXPECT_EQ(Lines(run + "/metrics.csv").size(), 4u) << "header and the rows of epochs 1-3";
+  std::filesystem::remove(run + "/checkpoints/last.pt.tmp");
+  const auto resumed = TrainSpan(c, run, true);  // from the checkpoint of epoch 2
+  EXPECT_EQ(resumed.epochs_completed, 4);
+  EXPECT_EQ(LossColumns(dir.File("full") + "/metrics.csv"), LossColumns(run + "/metrics.csv"));
+}
+
+TEST(Trainer, ResumeRestartsAMissingMetricsFileWithItsHeader) {
+  testing::TempDir dir;
+  const SpanExperimentConfig c = TinyConfig();
+  TrainSpan(c, dir.path(), false, StopAfter(2));
+  const auto header = Lines(dir.File("metrics.csv")).at(0);
+  std::filesystem::remove(dir.File("metrics.csv"));
+  TrainSpan(c, dir.path(), true);
+  const auto lines = Lines(dir.File("metrics.csv"));
+  ASSERT_EQ(lines.size(), 3u);
+  EXPECT_EQ(lines[0], header);
+  EXPECT_EQ(lines[1].substr(0, 2), "3,");
+  EXPECT_EQ(lines[2].substr(0, 2), "4,");
+}
+
+TEST(Trainer, CorruptMetricsIsAClearErrorOnResume) {
+  testing::TempDir dir;
+  const SpanExperimentConfig c = TinyConfig();
+  TrainSpan(c, dir.path(), false, StopAfter(1));
+  testing::WriteText(dir.File("metrics.csv"), "epoch,train_loss\nfirst,1.0\n");
+  testing::ExpectErrorContains([&] { TrainSpan(c, dir.path(), true); },
+                               {dir.File("metrics.csv") + ":2", "epoch number"});
+}
+
+TEST(Trainer, EmptyValidationSplitIsAClearError) {
+  testing::TempDir dir;
+  SpanExperimentConfig c = TinyConfig();
+  c.data.val_fraction = 0.0;
+  testing::ExpectErrorContains([&] { TrainSpan(c, dir.path(), false); },
+                               {"no validation windows", "data.val_fraction"});
+}
+
+TEST(Trainer, FreshStartRefusesARunDirectoryThatHoldsARun) {
+  testing::TempDir dir;
+  SpanExperimentConfig c = TinyConfig();
+  c.train.epochs = 1;
+  // An attempt that failed before training leaves config.yaml and log.txt: that is no run yet.
+  c.data.val_fraction = 0.0;
+  EXPECT_THROW(TrainSpan(c, dir.path(), false), Error);
+  c.data.val_fraction = 0.1;
+  TrainSpan(c, dir.path(), false);
+  testing::ExpectErrorContains([&] { TrainSpan(c, dir.path(), false); },
+                               {dir.path(), "already holds a run (checkpoints/)", "--resume", "--run-dir"});
+  for (const char* name : {"metrics.csv", "model.h5", "eval.json"}) {
+    testing::TempDir other;
+    testing::WriteText(other.File(name), "x");
+    testing::ExpectErrorContains([&] { TrainSpan(c, other.path(), false); },
+                                 {other.path(), std::string("(") + name + ")", "--resume"});
+  }
+}
+
+TEST(Trainer, InterruptedBeforeTheFirstCheckpointSuggestsNoResume) {
+  testing::TempDir dir;
+  const SpanExperimentConfig c = TinyConfig();
+  const std::atomic<bool> interrupted{true};
+  TrainHooks hooks;
+  hooks.interrupt = &interrupted;
+  ::testing::internal::CaptureStderr();
+  const auto s = TrainSpan(c, dir.path(), false, hooks);
+  const std::string err = ::testing::internal::GetCapturedStderr();
+  EXPECT_EQ(s.reason, TerminationReason::kInterrupted);
+  EXPECT_EQ(s.epochs_completed, 0);
+  EXPECT_NE(err.find("before the first checkpoint"), std::string::npos) << err;
+  EXPECT_EQ(err.find("--resume"), std::string::npos) << err;
+  // Nothing was saved, so starting again in the same directory is allowed.
+  EXPECT_FALSE(std::filesystem::exists(dir.File("metrics.csv")));
+  EXPECT_EQ(TrainSpan(c, dir.path(), false, StopAfter(1)).epochs_completed, 1);
+}
+
+TEST(Trainer, SummaryJsonHasNoInfinityOrNan) {
+  TrainingSummary s;
+  s.reason = TerminationReason::kNonFiniteLoss;
+  s.best_val_loss = INFINITY;  // no epoch completed
+  s.last_train_loss = NAN;
+  const std::string json = s.ToJson();
+  EXPECT_NE(json.find("\"best_val_loss\": null"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"last_train_loss\": null"), std::string::npos) << json;
+  EXPECT_EQ(json.find("inf"), std::string::npos) << json;
+  EXPECT_EQ(json.find("nan"), std::string::npos) << json;
+}
+
+void CountingHandler(int) {}
+
+TEST(Trainer, InterruptFlagRestoresThePreviousHandlers) {
+  for (auto previous : {&CountingHandler, static_cast<void (*)(int)>(SIG_DFL)}) {
+    std::signal(SIGINT, previous);
+    std::signal(SIGTERM, previous);
+    {
+      const ScopedInterruptFlag interrupt;
+      EXPECT_FALSE(interrupt.flag()->load());
+      std::raise(SIGINT);
+      EXPECT_TRUE(interrupt.flag()->load());
+    }
+    EXPECT_EQ(std::signal(SIGINT, SIG_DFL), previous);
+    EXPECT_EQ(std::signal(SIGTERM, SIG_DFL), previous);
+  }
 }
 
 TEST(Trainer, ResumeRefusesADifferentConfig) {
