@@ -59,6 +59,7 @@ BinaryMetrics EvaluateBinary(const std::vector<double>& scores, const std::vecto
 
 std::vector<std::pair<double, double>> RocCurve(const std::vector<double>& scores,
                                                 const std::vector<std::uint8_t>& labels, int max_points) {
+  FS_THROW_UNLESS(max_points >= 2, "ROC curve: max_points ", max_points, " must be at least 2 (both endpoints)");
   const std::vector<std::size_t> order = SortedByScoreDescending(scores, labels);
   std::int64_t pos = 0, neg = 0;
   for (const auto l : labels) (l ? pos : neg) += 1;

@@ -21,7 +21,7 @@ BinaryMetrics EvaluateBinary(const std::vector<double>& scores, const std::vecto
                              double threshold = 0.5);
 
 /// ROC curve as (false positive rate, true positive rate) points, at most `max_points` of them
-/// (evenly thinned), from (0, 0) to (1, 1).
+/// (evenly thinned; max_points >= 2, else Error), from (0, 0) to (1, 1).
 std::vector<std::pair<double, double>> RocCurve(const std::vector<double>& scores,
                                                 const std::vector<std::uint8_t>& labels,
                                                 int max_points = 200);

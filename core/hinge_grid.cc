@@ -18,9 +18,11 @@ HingeGrid::HingeGrid(const HingeGridConfig& config) : config_(config) {
                   "hinge grid: ", fx, " x ", fy, " inducing points is too many (max 2^26)");
   nx_ = std::max(1, static_cast<int>(std::lround(fx)));
   ny_ = std::max(1, static_cast<int>(std::lround(fy)));
-  window_ = 2 * static_cast<int>(std::floor(c.cutoff_radius / c.spacing)) + 2;
-  FS_THROW_UNLESS(window_ <= 64, "hinge grid: cutoff_radius ", c.cutoff_radius, " spans more than 31 "
+  // Checked before the cast: a huge cut-off would overflow the int.
+  const double half_window = std::floor(c.cutoff_radius / c.spacing);
+  FS_THROW_UNLESS(half_window <= 31, "hinge grid: cutoff_radius ", c.cutoff_radius, " spans more than 31 "
                                     , "inducing points of spacing ", c.spacing, " per side");
+  window_ = 2 * static_cast<int>(half_window) + 2;
   cutoff2_ = c.cutoff_radius * c.cutoff_radius;
 }
 

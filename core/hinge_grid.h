@@ -86,11 +86,12 @@ int HingeGrid::Visit(double x, double y, int* idx, double* phi, double* gx, doub
   if (!(std::abs(x) < 1e12 && std::abs(y) < 1e12)) return 0;
   const double s = config_.spacing, r = config_.cutoff_radius;
   const double fx = (x - config_.x_min) / s, fy = (y - config_.y_min) / s;
-  const int ix0 = std::max(0, static_cast<int>(std::ceil(fx - r / s)));
-  const int ix1 = std::min(nx_ - 1, static_cast<int>(std::floor(fx + r / s)));
-  const int iy0 = std::max(0, static_cast<int>(std::ceil(fy - r / s)));
-  const int iy1 = std::min(ny_ - 1, static_cast<int>(std::floor(fy + r / s)));
-  if (ix0 > ix1 || iy0 > iy1) return 0;
+  const double lo_x = std::ceil(fx - r / s), hi_x = std::floor(fx + r / s);
+  const double lo_y = std::ceil(fy - r / s), hi_y = std::floor(fy + r / s);
+  // Off the grid: return before casting, since far points (|x| / s > 2^31) overflow an int.
+  if (!(hi_x >= 0 && lo_x <= nx_ - 1 && hi_y >= 0 && lo_y <= ny_ - 1)) return 0;
+  const int ix0 = std::max(0, static_cast<int>(lo_x)), ix1 = std::min(nx_ - 1, static_cast<int>(hi_x));
+  const int iy0 = std::max(0, static_cast<int>(lo_y)), iy1 = std::min(ny_ - 1, static_cast<int>(hi_y));
   // Row and column factors (window_ is small: at most 2 r / s + 1 entries each).
   constexpr int kMaxWindow = 64;
   double ex[kMaxWindow], dx[kMaxWindow], ey[kMaxWindow], dy[kMaxWindow];

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # CLI checks: one-line errors with non-zero exit, train -> export -> eval on a tiny synthetic run,
-# resume, bench engine --json. Usage: cli_test.sh path/to/foresight
+# resume, bench engine --json; occupancy maps (train, map fuse, map info) in both builds.
+# Usage: cli_test.sh path/to/foresight
 set -euo pipefail
 BIN="$1"
 TMP="$(mktemp -d)"
@@ -32,6 +33,39 @@ expect_error "num_tracks" data generate -o "$TMP/x.h5" num_tracks=-3
 expect_error "not found" data info "$TMP/none.h5"
 printf '0\t1\t0.0\t0.0\n10\t1\tzz\t1.0\n' > "$TMP/bad.txt"
 expect_error "bad.txt:2" data convert "$TMP/bad.txt" -o "$TMP/bad.h5"
+
+# Occupancy maps: torch-free, so in both builds.
+json_number() {  # json_number FILE KEY: the number of "KEY": on its own line
+  sed -n "s/^ *\"$2\": \([-+0-9.eE]*\).*/\1/p" "$1" | head -1
+}
+OCC="$TMP/occ"
+"$BIN" train configs/occupancy/synthetic.yaml --run-dir "$OCC" >/dev/null 2>"$TMP/occ.log" || { cat "$TMP/occ.log"; fail "occupancy train"; }
+for f in config.yaml model.h5 eval.json roc.csv plots/map.png; do
+  [ -s "$OCC/$f" ] || fail "occupancy run dir lacks $f"
+done
+for k in auc precision recall artifact_bytes; do
+  grep -q "\"$k\"" "$OCC/eval.json" || fail "occupancy eval.json lacks $k"
+done
+check_json "$OCC/eval.json"
+AUC="$(json_number "$OCC/eval.json" auc)"
+awk -v a="$AUC" 'BEGIN { exit !(a > 0.9) }' || fail "occupancy test AUC '$AUC' is not above 0.9"
+expect_error "already holds model.h5" train configs/occupancy/synthetic.yaml --run-dir "$OCC"
+FUS="$TMP/fusion"
+"$BIN" train configs/occupancy/synthetic_fusion.yaml --run-dir "$FUS" >/dev/null 2>"$TMP/fus.log" || { cat "$TMP/fus.log"; fail "fusion train"; }
+for k in auc_single auc_fuse_once auc_repeated; do
+  grep -q "\"$k\"" "$FUS/eval.json" || fail "fusion eval.json lacks $k"
+done
+check_json "$FUS/eval.json"
+"$BIN" map fuse "$FUS/single.h5" "$FUS/fuse_once.h5" -o "$TMP/fused.h5" | grep -q "fused 2 maps" || fail "map fuse"
+"$BIN" map fuse "$OCC/model.h5" "$FUS/single.h5" --base "$FUS/model.h5" -o "$TMP/fused_base.h5" >/dev/null || fail "map fuse --base"
+"$BIN" map info "$TMP/fused.h5" | grep -q '"model_type": "occupancy.fast_bhm"' || fail "map info of a fused map"
+"$BIN" train configs/occupancy/synthetic.yaml features.spacing=0.6 --run-dir "$TMP/occ_coarse" >/dev/null 2>&1 || fail "coarse train"
+expect_error "feature grid" map fuse "$OCC/model.h5" "$TMP/occ_coarse/model.h5" -o "$TMP/refused.h5"
+grep -q "occ_coarse/model.h5" "$TMP/err" || fail "refused fusion does not name the map"
+[ ! -e "$TMP/refused.h5" ] || fail "a refused fusion wrote its output"
+"$BIN" train configs/occupancy/synthetic.yaml model=occupancy.grid --run-dir "$TMP/occ_grid" >/dev/null 2>&1 || fail "grid train"
+"$BIN" map info "$TMP/occ_grid/model.h5" | grep -q '"model_type": "occupancy.grid"' || fail "map info of a grid"
+expect_error "tracks.h5: not a foresight artifact" map info "$TMP/tracks.h5"
 
 if [ "${FORESIGHT_WITH_TORCH:-1}" = "1" ] || [ "${FORESIGHT_WITH_TORCH}" = "ON" ]; then
   printf 'model: span_predictor\ntrain: {epochs: 2, learning_rat: 0.1}\n' > "$TMP/typo.yaml"

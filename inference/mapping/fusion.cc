@@ -55,6 +55,7 @@ HingeMap Conflate(const HingeGrid& grid, const std::vector<WeightEstimate>& esti
   const Eigen::Index t_size = grid.size();
   Eigen::VectorXd precision = Eigen::VectorXd::Zero(t_size), info = Eigen::VectorXd::Zero(t_size);
   if (base != nullptr) {
+    RequireFastBhm(*base, "base map");  // a Hilbert map has no variances to conflate
     FS_THROW_UNLESS(base->grid().SameFeatures(grid), "conflation: base map grid differs");
     precision = base->weights().variance.cwiseInverse();
     info = base->weights().mean.cwiseProduct(precision);

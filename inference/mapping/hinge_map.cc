@@ -82,14 +82,14 @@ MapWorkspace HingeMap::MakeWorkspace() const {
   return ws;
 }
 
-void HingeMap::Latent(double x, double y, MapWorkspace* ws, double* mean, double* variance) const {
+bool HingeMap::Latent(double x, double y, MapWorkspace* ws, double* mean, double* variance) const {
   const int k = grid_.Features(x, y, ws->index.data(), ws->phi.data());
   const int* idx = ws->index.data();
   const double* phi = ws->phi.data();
   if (k == 0) {
     *mean = prior_mean_;
     *variance = kind_ == HingeMapKind::kHilbert ? 0.0 : prior_variance_;
-    return;
+    return false;
   }
   double m = 0, v = 0;
   const double* mu = weights_.mean.data();
@@ -106,11 +106,13 @@ void HingeMap::Latent(double x, double y, MapWorkspace* ws, double* mean, double
   }
   *mean = m;
   *variance = v;
+  return true;
 }
 
 double HingeMap::Probability(double x, double y, MapWorkspace* ws) const {
   double m, v;
-  Latent(x, y, ws, &m, &v);
+  // No features: the prior probability, as Query() answers (not the probit of the prior).
+  if (!Latent(x, y, ws, &m, &v)) return Sigmoid(prior_mean_);
   if (kind_ == HingeMapKind::kHilbert) return Sigmoid(m);
   return PredictiveProbability(m, v);
 }

@@ -57,8 +57,9 @@ class HingeMap final : public OccupancyMap {
   double Probability(double x, double y, MapWorkspace* ws) const override;
   Eigen::Vector4d Extent() const override;
 
-  /// Latent mean and variance of f(x) (no probit squashing).
-  void Latent(double x, double y, MapWorkspace* ws, double* mean, double* variance) const;
+  /// Latent mean and variance of f(x) (no probit squashing). Returns false where (x, y) has no
+  /// features (outside the grid, or not finite): mean and variance are then the prior's.
+  bool Latent(double x, double y, MapWorkspace* ws, double* mean, double* variance) const;
 
  private:
   HingeMapKind kind_;
