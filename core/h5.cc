@@ -47,6 +47,8 @@ template <>
 hid_t MemType<float>() { return H5T_NATIVE_FLOAT; }
 template <>
 hid_t MemType<std::int64_t>() { return H5T_NATIVE_INT64; }
+template <>
+hid_t MemType<std::uint8_t>() { return H5T_NATIVE_UINT8; }
 
 std::string ObjectName(const std::string& object) { return object.empty() ? "/" : object; }
 
@@ -315,6 +317,12 @@ void File::Write(const std::string& name, const std::int64_t* data,
   WriteRaw(id_, path_, name, data, shape);
 }
 
+void File::Write(const std::string& name, const std::uint8_t* data,
+                 const std::vector<std::size_t>& shape) {
+  EnsureParentGroups(name);
+  WriteRaw(id_, path_, name, data, shape);
+}
+
 void File::WriteString(const std::string& name, const std::string& text) {
   EnsureParentGroups(name);
   Handle type(H5Tcopy(H5T_C_S1), H5Tclose);
@@ -356,6 +364,10 @@ Array<double> File::ReadDouble(const std::string& name) const {
 Array<float> File::ReadFloat(const std::string& name) const {
   FS_THROW_UNLESS(Exists(name), path_, ": missing dataset '", name, "'");
   return ReadRaw<float>(id_, path_, name, H5T_FLOAT);
+}
+Array<std::uint8_t> File::ReadUint8(const std::string& name) const {
+  FS_THROW_UNLESS(Exists(name), path_, ": missing dataset '", name, "'");
+  return ReadRaw<std::uint8_t>(id_, path_, name, H5T_INTEGER);
 }
 Array<std::int64_t> File::ReadInt(const std::string& name) const {
   FS_THROW_UNLESS(Exists(name), path_, ": missing dataset '", name, "'");

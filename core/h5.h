@@ -50,11 +50,14 @@ class File {
   void Write(const std::string& name, const float* data, const std::vector<std::size_t>& shape);
   void Write(const std::string& name, const std::int64_t* data,
              const std::vector<std::size_t>& shape);
+  void Write(const std::string& name, const std::uint8_t* data, const std::vector<std::size_t>& shape);
   void WriteString(const std::string& name, const std::string& text);
 
   Array<double> ReadDouble(const std::string& name) const;
   Array<float> ReadFloat(const std::string& name) const;
   Array<std::int64_t> ReadInt(const std::string& name) const;
+  /// Integer dataset read as bytes (values outside 0..255 are converted by HDF5, clipped).
+  Array<std::uint8_t> ReadUint8(const std::string& name) const;
   std::string ReadString(const std::string& name) const;
 
   /// Writes a matrix row-major with shape (rows, cols).

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "training/occupancy_config.h"
 #include "training/span_config.h"
 
 namespace foresight {
@@ -20,12 +21,16 @@ TEST(Docs, ConfigReferenceIsCurrent) {
   ss << in.rdbuf();
   EXPECT_NE(ss.str().find(config::ReferenceTable<SpanExperimentConfig>()), std::string::npos)
       << "docs/config_reference.md is stale: run `build/bin/foresight docs config -o docs/config_reference.md`";
+  EXPECT_NE(ss.str().find(config::ReferenceTable<OccupancyExperimentConfig>()), std::string::npos)
+      << "docs/config_reference.md is stale: run `build/bin/foresight docs config -o docs/config_reference.md`";
 }
 
 TEST(Docs, ShippedConfigsLoad) {
   const std::string src = std::getenv("FORESIGHT_SOURCE_DIR");
   for (const char* name : {"quickstart", "span/eth_ucy_eth", "span/eth_ucy_hotel", "span/eth_ucy_univ", "span/eth_ucy_zara1"})
     EXPECT_NO_THROW(LoadSpanConfig(src + "/configs/" + name + ".yaml", {})) << name;
+  for (const char* name : {"intel", "intel_fusion", "synthetic", "synthetic_fusion"})
+    EXPECT_NO_THROW(LoadOccupancyConfig(src + "/configs/occupancy/" + name + ".yaml", {})) << name;
 }
 
 }  // namespace
