@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "core/error.h"
@@ -25,9 +26,9 @@ GridMap::GridMap(GridGeometry geometry, Eigen::MatrixXf probability, CellType ce
                   cells_.rows(), " x ", cells_.cols(), ", expected ", geometry_.ny, " x ", geometry_.nx);
   for (Eigen::Index i = 0; i < cells_.size(); ++i) {
     float& p = cells_.data()[i];
-    if (cell_type_ == CellType::kUint8) p = DecodeCell(EncodeCell(p));
-    if (!std::isfinite(p)) p = 0.5f;
+    if (std::isnan(p)) continue;  // unknown: kept as NaN (stored as NaN / 255), answered as 0.5
     FS_THROW_UNLESS(p >= 0.0f && p <= 1.0f, "grid map: cell probability ", p, " outside [0, 1]");
+    if (cell_type_ == CellType::kUint8) p = static_cast<float>(EncodeCell(p)) / 254.0f;
   }
 }
 
@@ -37,20 +38,21 @@ std::int64_t GridMap::PayloadBytes() const {
 
 double GridMap::CellOrHalf(int ix, int iy) const {
   if (ix < 0 || iy < 0 || ix >= geometry_.nx || iy >= geometry_.ny) return 0.5;
-  return cells_(iy, ix);
+  const float p = cells_(iy, ix);
+  return std::isnan(p) ? 0.5 : p;
 }
 
 double GridMap::Probability(double x, double y, MapWorkspace*) const {
   int ix, iy;
   if (!geometry_.Cell(x, y, &ix, &iy)) return 0.5;
-  return cells_(iy, ix);
+  return CellOrHalf(ix, iy);
 }
 
 OccupancyQuery GridMap::Query(double x, double y, MapWorkspace*) const {
   OccupancyQuery q;
   int ix, iy;
   if (!geometry_.Cell(x, y, &ix, &iy)) return q;
-  q.probability = cells_(iy, ix);
+  q.probability = CellOrHalf(ix, iy);
   const double h2 = 2.0 * geometry_.resolution;
   q.dp_dx = (CellOrHalf(ix + 1, iy) - CellOrHalf(ix - 1, iy)) / h2;
   q.dp_dy = (CellOrHalf(ix, iy + 1) - CellOrHalf(ix, iy - 1)) / h2;
@@ -106,7 +108,10 @@ GridMap GridMap::Load(const std::string& path) {
                       "/cells has the wrong shape");
       Eigen::MatrixXf p(ny, nx);
       for (int iy = 0; iy < g.ny; ++iy)
-        for (int ix = 0; ix < g.nx; ++ix) p(iy, ix) = DecodeCell(bytes.data[iy * g.nx + ix]);
+        for (int ix = 0; ix < g.nx; ++ix) {
+          const std::uint8_t q = bytes.data[iy * g.nx + ix];
+          p(iy, ix) = q == 255 ? std::numeric_limits<float>::quiet_NaN() : DecodeCell(q);
+        }
       return GridMap(g, std::move(p), CellType::kUint8);
     }
     FS_THROW_UNLESS(type == "float32", "cell_type '", type, "' is not float32 or uint8");

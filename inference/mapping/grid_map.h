@@ -43,7 +43,7 @@ class GridMap final : public OccupancyMap {
 
   const GridGeometry& geometry() const { return geometry_; }
   CellType cell_type() const { return cell_type_; }
-  /// Cell probabilities as stored (after one-byte quantisation for kUint8); unknown = 0.5.
+  /// Cell probabilities as stored (after one-byte quantisation for kUint8); unknown = NaN.
   const Eigen::MatrixXf& cells() const { return cells_; }
   /// Bytes of the cell payload (nx * ny * 4 or nx * ny).
   std::int64_t PayloadBytes() const;
