@@ -54,6 +54,16 @@ OccupancyExperimentConfig WithSpacing(OccupancyExperimentConfig c, double spacin
   return c;
 }
 
+/// A Fast-BHM trained on the listed scans of `points`, in order.
+HingeMap TrainOnScans(const OccupancyExperimentConfig& c, const LabelledPoints& points, const std::vector<int>& scans) {
+  FastBhmLearner l(HingeGrid(c.features), c.fast_bhm);
+  for (const int s : scans) {
+    const auto b = points.scan_begin[s], e = points.scan_begin[s + 1];
+    l.Update(points.xy.middleCols(b, e - b), points.occupied.data() + b);
+  }
+  return l.ToMap();
+}
+
 /// Log-odds fusion of discretised map outputs (the grid update rule the thesis compares against).
 GridMap FuseDiscretised(const std::vector<const OccupancyMap*>& maps, const GridMapConfig& g, CellType type) {
   GridGeometry geo;
@@ -199,19 +209,11 @@ int main(int argc, char** argv) try {
     const double spacing = std::sqrt((base.features.x_max - base.features.x_min) *
                                      (base.features.y_max - base.features.y_min) / 10000.0);
     const OccupancyExperimentConfig c = WithSpacing(base, spacing);
-    const HingeGrid grid(c.features);
     std::vector<int> all(data.train.num_scans());
     for (int i = 0; i < data.train.num_scans(); ++i) all[i] = i;
     const auto quadrants = QuadrantSplit(data.train, all, c.fusion.centre_x, c.fusion.centre_y);
     std::vector<HingeMap> locals;
-    for (const auto& scans : quadrants) {
-      FastBhmLearner l(grid, c.fast_bhm);
-      for (const int s : scans) {
-        const auto b = data.train.scan_begin[s], e = data.train.scan_begin[s + 1];
-        l.Update(data.train.xy.middleCols(b, e - b), data.train.occupied.data() + b);
-      }
-      locals.push_back(l.ToMap());
-    }
+    for (const auto& scans : quadrants) locals.push_back(TrainOnScans(c, data.train, scans));
     std::vector<const OccupancyMap*> ptrs;
     for (const auto& m : locals) ptrs.push_back(&m);
     for (const double r : {0.4, 0.3, 0.2, 0.15, 0.1}) {
@@ -223,24 +225,10 @@ int main(int argc, char** argv) try {
                         ArtifactBytes(fused, base), EvaluateMap(fused, data.test).auc});
       }
     }
-    std::vector<const HingeMap*> hp;
-    std::vector<std::string> names;
-    for (const auto& m : locals) {
-      hp.push_back(&m);
-      names.push_back("quadrant");
-    }
     for (const double s : {1.0, 0.5, 0.4, 0.3}) {
       const OccupancyExperimentConfig cs = WithSpacing(base, s);
-      const HingeGrid gs(cs.features);
       std::vector<HingeMap> qs;
-      for (const auto& scans : quadrants) {
-        FastBhmLearner l(gs, cs.fast_bhm);
-        for (const int sc : scans) {
-          const auto b = data.train.scan_begin[sc], e = data.train.scan_begin[sc + 1];
-          l.Update(data.train.xy.middleCols(b, e - b), data.train.occupied.data() + b);
-        }
-        qs.push_back(l.ToMap());
-      }
+      for (const auto& scans : quadrants) qs.push_back(TrainOnScans(cs, data.train, scans));
       std::vector<const HingeMap*> qp;
       for (const auto& m : qs) qp.push_back(&m);
       const HingeMap fused = FuseMaps(qp, std::vector<std::string>(qp.size(), "quadrant"), cs.fusion.options);

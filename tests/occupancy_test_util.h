@@ -14,6 +14,19 @@
 
 namespace foresight::testing {
 
+/// A small hinge grid from the origin to (x_max, y_max) every 0.5 m.
+inline HingeGridConfig SmallGrid(double x_max, double y_max, double gamma, double cutoff_radius) {
+  HingeGridConfig c;
+  c.x_min = 0;
+  c.x_max = x_max;
+  c.y_min = 0;
+  c.y_max = y_max;
+  c.spacing = 0.5;
+  c.gamma = gamma;
+  c.cutoff_radius = cutoff_radius;
+  return c;
+}
+
 /// Inducing points per axis as the config documents it: round((max - min) / spacing), at least 1.
 inline int InducingCount(double min, double max, double spacing) {
   return std::max(1, static_cast<int>(std::lround((max - min) / spacing)));

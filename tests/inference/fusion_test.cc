@@ -26,17 +26,7 @@ using testing::PointSet;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-HingeGridConfig FusionGrid() {
-  HingeGridConfig c;
-  c.x_min = 0;
-  c.x_max = 4;
-  c.y_min = 0;
-  c.y_max = 3;
-  c.spacing = 0.5;  // 8 x 6 = 48 features
-  c.gamma = 6.71;
-  c.cutoff_radius = 1.0;
-  return c;
-}
+HingeGridConfig FusionGrid() { return testing::SmallGrid(4, 3, 6.71, 1.0); }  // 8 x 6 = 48 features
 
 FastBhmConfig Linear() {
   FastBhmConfig cfg;  // bound_init one, one EM iteration: training is linear in information form

@@ -22,17 +22,7 @@ namespace {
 
 using testing::ExpectErrorContains;
 
-HingeGridConfig MapGrid() {
-  HingeGridConfig c;
-  c.x_min = 0;
-  c.x_max = 5;
-  c.y_min = 0;
-  c.y_max = 4;
-  c.spacing = 0.5;  // 10 x 8 = 80 features
-  c.gamma = 6.71;
-  c.cutoff_radius = 1.0;
-  return c;
-}
+HingeGridConfig MapGrid() { return testing::SmallGrid(5, 4, 6.71, 1.0); }  // 10 x 8 = 80 features
 
 constexpr HingeMapKind kKinds[] = {HingeMapKind::kHilbert, HingeMapKind::kFastBhm,
                                    HingeMapKind::kBhm};

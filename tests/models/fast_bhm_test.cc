@@ -17,17 +17,7 @@ namespace {
 using testing::PointSet;
 using testing::RandomPoints;
 
-HingeGridConfig TestGrid() {
-  HingeGridConfig c;
-  c.x_min = 0;
-  c.x_max = 4;
-  c.y_min = 0;
-  c.y_max = 3;
-  c.spacing = 0.5;  // 8 x 6 = 48 features
-  c.gamma = 2.5;
-  c.cutoff_radius = 1.1;
-  return c;
-}
+HingeGridConfig TestGrid() { return testing::SmallGrid(4, 3, 2.5, 1.1); }  // 8 x 6 = 48 features
 
 /// lambda straight from its definition (limit 1/8 at z = 0).
 double RefLambda(double z) {
