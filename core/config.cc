@@ -1,5 +1,6 @@
 #include "core/config.h"
 
+#include <cstdlib>
 #include <fstream>
 #include <iomanip>
 
@@ -71,7 +72,7 @@ std::string YamlWriter::FormatDouble(double v) {
   for (int p = 1; p <= 17; ++p) {
     std::ostringstream t;
     t << std::setprecision(p) << v;
-    if (std::stod(t.str()) == v) {
+    if (std::strtod(t.str().c_str(), nullptr) == v) {  // strtod: no throw on subnormals
       s = t.str();
       break;
     }

@@ -98,10 +98,12 @@ std::string ReadText(const std::string& path) {
 }
 
 /// The file of `run_dir` that shows it holds a run a fresh start would mix with, or "".
+/// A metrics.csv without checkpoints (a run killed in epoch 1) holds nothing to resume: a fresh
+/// start replaces it.
 std::string PreviousRunFile(const std::string& run_dir) {
   const std::string checkpoints = run_dir + "/checkpoints";
   if (fs::is_directory(checkpoints) && !fs::is_empty(checkpoints)) return "checkpoints/";
-  for (const char* name : {"model.h5", "eval.json", "metrics.csv"})
+  for (const char* name : {"model.h5", "eval.json"})
     if (fs::exists(run_dir + "/" + name)) return name;
   return "";
 }

@@ -143,12 +143,17 @@ TEST(Trainer, FreshStartRefusesARunDirectoryThatHoldsARun) {
   TrainSpan(c, dir.path(), false);
   testing::ExpectErrorContains([&] { TrainSpan(c, dir.path(), false); },
                                {dir.path(), "already holds a run (checkpoints/)", "--resume", "--run-dir"});
-  for (const char* name : {"metrics.csv", "model.h5", "eval.json"}) {
+  for (const char* name : {"model.h5", "eval.json"}) {
     testing::TempDir other;
     testing::WriteText(other.File(name), "x");
     testing::ExpectErrorContains([&] { TrainSpan(c, other.path(), false); },
                                  {other.path(), std::string("(") + name + ")", "--resume"});
   }
+  // A run killed in epoch 1 leaves metrics.csv but no checkpoint: nothing to resume, so a fresh
+  // start may replace it.
+  testing::TempDir killed;
+  testing::WriteText(killed.File("metrics.csv"), "epoch,train_loss\n1,0.5\n");
+  EXPECT_NO_THROW(TrainSpan(c, killed.path(), false));
 }
 
 TEST(Trainer, InterruptedBeforeTheFirstCheckpointSuggestsNoResume) {
