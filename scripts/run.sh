@@ -11,3 +11,6 @@ cd "$ROOT"
 [[ " $* " == *" --resume "* ]] || rm -rf runs/quickstart
 ./build/bin/foresight train default --run-dir runs/quickstart "$@"
 ./build/bin/foresight bench engine --artifact runs/quickstart/model.h5
+# Occupancy maps on the simulated two-robot floor plan: Fast-BHMs, fused once and repeatedly.
+rm -rf runs/occupancy_synthetic_fusion
+./build/bin/foresight train configs/occupancy/synthetic_fusion.yaml --run-dir runs/occupancy_synthetic_fusion
