@@ -40,7 +40,7 @@ void WriteMapPanels(const std::vector<MapPanel>& panels, double resolution, cons
     prob3.copyTo(canvas(cv::Rect(x0, kTitle, w, h)));
     var3.copyTo(canvas(cv::Rect(x0, 2 * kTitle + h, w, h)));
     cv::putText(canvas, panels[k].title + ": p(occupied)", {x0 + 4, 17}, cv::FONT_HERSHEY_SIMPLEX, 0.5, {0, 0, 0}, 1);
-    cv::putText(canvas, "log10 latent variance (1e-3..1e4)", {x0 + 4, h + kTitle + 17}, cv::FONT_HERSHEY_SIMPLEX,
+    cv::putText(canvas, "log10 var (1e-3..1e4)", {x0 + 4, h + kTitle + 17}, cv::FONT_HERSHEY_SIMPLEX,
                 0.5, {0, 0, 0}, 1);
   }
   FS_THROW_UNLESS(cv::imwrite(png_path, canvas), png_path, ": cannot write PNG");
