@@ -18,6 +18,7 @@
 #include "inference/mapping/hinge_map.h"
 #include "models/occupancy/bhm.h"
 #include "models/occupancy/fast_bhm.h"
+#include "models/occupancy/scan_training.h"
 #include "training/occupancy_pipeline.h"
 #include "training/octomap_baseline.h"
 
@@ -52,14 +53,6 @@ double TimeMedian(int repeats, F&& f) {
   return Median(t);
 }
 
-template <class Learner>
-void TrainOn(Learner* l, const LabelledPoints& p, int scans) {
-  for (int s = 0; s < scans; ++s) {
-    const auto b = p.scan_begin[s], e = p.scan_begin[s + 1];
-    l->Update(p.xy.middleCols(b, e - b), p.occupied.data() + b);
-  }
-}
-
 void RunMapBench(const BenchMapArgs& a) {
   FS_THROW_UNLESS(IsOccupancyConfig(a.config), a.config, ": not an occupancy config (model: occupancy.*)");
   OccupancyExperimentConfig c = LoadOccupancyConfig(a.config, a.overrides);
@@ -70,7 +63,7 @@ void RunMapBench(const BenchMapArgs& a) {
   std::unique_ptr<HingeMap> map;
   const double fast_s = TimeMedian(a.repeats, [&] {
     FastBhmLearner l(grid, c.fast_bhm);
-    TrainOn(&l, data.train, data.train.num_scans());
+    UpdateOnScans(&l, data.train, FirstScans(data.train));
     map = std::make_unique<HingeMap>(l.ToMap());
   });
   const double fast_auc = EvaluateMap(*map, data.test).auc;
@@ -89,11 +82,11 @@ void RunMapBench(const BenchMapArgs& a) {
   const int scans = std::min(a.bhm_scans, data.train.num_scans());
   const double bhm_s = TimeMedian(1, [&] {
     BhmLearner l(bhm_grid, c.fast_bhm);
-    TrainOn(&l, data.train, scans);
+    UpdateOnScans(&l, data.train, FirstScans(data.train, scans));
   });
   const double fast_same_s = TimeMedian(a.repeats, [&] {
     FastBhmLearner l(bhm_grid, c.fast_bhm);
-    TrainOn(&l, data.train, scans);
+    UpdateOnScans(&l, data.train, FirstScans(data.train, scans));
   });
 
   // Query throughput: probability + gradient + variance over the test points, one thread.

@@ -23,6 +23,7 @@
 #include "inference/mapping/grid_map.h"
 #include "inference/mapping/hinge_map.h"
 #include "models/occupancy/fast_bhm.h"
+#include "models/occupancy/scan_training.h"
 #include "training/occupancy_pipeline.h"
 #include "training/octomap_baseline.h"
 
@@ -57,10 +58,7 @@ OccupancyExperimentConfig WithSpacing(OccupancyExperimentConfig c, double spacin
 /// A Fast-BHM trained on the listed scans of `points`, in order.
 HingeMap TrainOnScans(const OccupancyExperimentConfig& c, const LabelledPoints& points, const std::vector<int>& scans) {
   FastBhmLearner l(HingeGrid(c.features), c.fast_bhm);
-  for (const int s : scans) {
-    const auto b = points.scan_begin[s], e = points.scan_begin[s + 1];
-    l.Update(points.xy.middleCols(b, e - b), points.occupied.data() + b);
-  }
+  UpdateOnScans(&l, points, scans);
   return l.ToMap();
 }
 
@@ -209,9 +207,7 @@ int main(int argc, char** argv) try {
     const double spacing = std::sqrt((base.features.x_max - base.features.x_min) *
                                      (base.features.y_max - base.features.y_min) / 10000.0);
     const OccupancyExperimentConfig c = WithSpacing(base, spacing);
-    std::vector<int> all(data.train.num_scans());
-    for (int i = 0; i < data.train.num_scans(); ++i) all[i] = i;
-    const auto quadrants = QuadrantSplit(data.train, all, c.fusion.centre_x, c.fusion.centre_y);
+    const auto quadrants = QuadrantSplit(data.train, FirstScans(data.train), c.fusion.centre_x, c.fusion.centre_y);
     std::vector<HingeMap> locals;
     for (const auto& scans : quadrants) locals.push_back(TrainOnScans(c, data.train, scans));
     std::vector<const OccupancyMap*> ptrs;

@@ -17,6 +17,7 @@
 #include "models/occupancy/fast_bhm.h"
 #include "models/occupancy/grid_builder.h"
 #include "models/occupancy/hilbert_map.h"
+#include "models/occupancy/scan_training.h"
 #include "training/occupancy_plots.h"
 
 namespace foresight {
@@ -26,20 +27,6 @@ namespace {
 
 double Seconds(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-/// Sequential Fast-BHM over the listed scans of `points`, continuing `learner`.
-void TrainScans(FastBhmLearner* learner, const LabelledPoints& points, const std::vector<int>& scans) {
-  for (const int s : scans) {
-    const auto b = points.scan_begin[s], e = points.scan_begin[s + 1];
-    learner->Update(points.xy.middleCols(b, e - b), points.occupied.data() + b);
-  }
-}
-
-std::vector<int> AllScans(const LabelledPoints& p) {
-  std::vector<int> s(p.num_scans());
-  for (int i = 0; i < p.num_scans(); ++i) s[i] = i;
-  return s;
 }
 
 std::string Json(double v) {
@@ -115,14 +102,11 @@ std::unique_ptr<OccupancyMap> TrainOccupancyMap(const std::string& model, const 
   std::unique_ptr<OccupancyMap> map;
   if (model == kFastBhmType) {
     FastBhmLearner learner(HingeGrid(c.features), c.fast_bhm);
-    TrainScans(&learner, data.train, AllScans(data.train));
+    UpdateOnScans(&learner, data.train, FirstScans(data.train));
     map = std::make_unique<HingeMap>(learner.ToMap());
   } else if (model == kBhmType) {
     BhmLearner learner(HingeGrid(c.features), c.fast_bhm);
-    for (int s = 0; s < data.train.num_scans(); ++s) {
-      const auto b = data.train.scan_begin[s], e = data.train.scan_begin[s + 1];
-      learner.Update(data.train.xy.middleCols(b, e - b), data.train.occupied.data() + b);
-    }
+    UpdateOnScans(&learner, data.train, FirstScans(data.train));
     map = std::make_unique<HingeMap>(learner.ToMap());
   } else if (model == kHilbertMapType) {
     map = std::make_unique<HingeMap>(TrainHilbertMap(HingeGrid(c.features), c.hilbert, data.train.xy,
@@ -162,7 +146,7 @@ FusionResult RunFusion(const OccupancyExperimentConfig& c, const OccupancyData& 
   // Robots: lists of indices into data.train's scans, in recording order.
   std::vector<std::vector<int>> robots;
   if (c.fusion.robots == FusionExperimentConfig::Robots::kQuadrants) {
-    const auto q = QuadrantSplit(data.train, AllScans(data.train), c.fusion.centre_x, c.fusion.centre_y);
+    const auto q = QuadrantSplit(data.train, FirstScans(data.train), c.fusion.centre_x, c.fusion.centre_y);
     for (const auto& list : q)
       if (!list.empty()) robots.push_back(list);
   } else {
@@ -178,14 +162,14 @@ FusionResult RunFusion(const OccupancyExperimentConfig& c, const OccupancyData& 
   for (const auto& l : robots) r.robot_scans.push_back(static_cast<int>(l.size()));
 
   FastBhmLearner single(grid, c.fast_bhm);
-  TrainScans(&single, data.train, AllScans(data.train));
+  UpdateOnScans(&single, data.train, FirstScans(data.train));
   r.single = std::make_unique<HingeMap>(single.ToMap());
 
   // Fuse once: independent local maps on all of each robot's data, one conflation.
   std::vector<HingeMap> locals;
   for (const auto& scans : robots) {
     FastBhmLearner l(grid, c.fast_bhm);
-    TrainScans(&l, data.train, scans);
+    UpdateOnScans(&l, data.train, scans);
     locals.push_back(l.ToMap());
   }
   std::vector<const HingeMap*> ptrs;
@@ -206,7 +190,7 @@ FusionResult RunFusion(const OccupancyExperimentConfig& c, const OccupancyData& 
       const std::size_t b = scans.size() * m / merges, e = scans.size() * (m + 1) / merges;
       const std::vector<int> chunk(scans.begin() + b, scans.begin() + e);
       FastBhmLearner l = global ? FastBhmLearner(*global, c.fast_bhm) : FastBhmLearner(grid, c.fast_bhm);
-      TrainScans(&l, data.train, chunk);
+      UpdateOnScans(&l, data.train, chunk);
       copies.push_back(l.ToMap());
     }
     std::vector<const HingeMap*> cp;
