@@ -18,6 +18,9 @@ void AddOccupancyOnlyTrainCommand(CLI::App* app);
 
 /// True when the YAML file's `model` is occupancy.* (so `train` runs the occupancy pipeline).
 bool IsOccupancyConfig(const std::string& path);
+/// Evaluates run_dir/model.h5 (any occupancy map) on the config's test scans; prints JSON.
+void EvalOccupancy(const std::string& config_path, const std::vector<std::string>& overrides,
+                   const std::string& run_dir);
 /// Trains, exports and evaluates an occupancy map into run_dir (refuses a used run_dir).
 void TrainOccupancy(const std::string& config_path, const std::vector<std::string>& overrides,
                     const std::string& run_dir, bool resume);

@@ -36,6 +36,19 @@ void TrainOccupancy(const std::string& config_path, const std::vector<std::strin
   std::cout << "wrote " << run_dir << "/model.h5, eval.json and plots/map.png\n";
 }
 
+void EvalOccupancy(const std::string& config_path, const std::vector<std::string>& overrides,
+                   const std::string& run_dir) {
+  const OccupancyExperimentConfig c = LoadOccupancyConfig(config_path, overrides);
+  const std::string artifact = run_dir + "/model.h5";
+  FS_THROW_UNLESS(fs::exists(artifact), artifact, ": not found (train the map first)");
+  const auto map = LoadOccupancyMap(artifact);
+  const OccupancyData data = LoadOccupancyData(c);
+  const BinaryMetrics m = EvaluateMap(*map, data.test);
+  std::cout << "{\"model_type\": \"" << map->model_type() << "\", \"test_points\": " << data.test.size()
+            << ", \"auc\": " << m.auc << ", \"precision\": " << m.precision << ", \"recall\": " << m.recall
+            << ", \"artifact_bytes\": " << fs::file_size(artifact) << "}\n";
+}
+
 namespace {
 struct FuseArgs {
   std::vector<std::string> inputs;

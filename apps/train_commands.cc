@@ -91,6 +91,10 @@ void AddTrainCommands(CLI::App* app) {
   eval->add_option("overrides", eargs->overrides, "key.path=value overrides of the config");
   eval->add_option("--run-dir", eargs->run_dir, "run directory holding model.h5")->required();
   eval->callback([eargs] {
+    if (IsOccupancyConfig(eargs->config)) {
+      EvalOccupancy(eargs->config, eargs->overrides, eargs->run_dir);
+      return;
+    }
     const SpanExperimentConfig c = LoadConfig(eargs->config, eargs->overrides);
     const std::string artifact = eargs->run_dir + "/model.h5";
     FS_THROW_UNLESS(fs::exists(artifact), artifact, ": not found (run `foresight export ", eargs->run_dir, "` first)");

@@ -73,6 +73,8 @@ if [ "${FORESIGHT_WITH_TORCH:-1}" = "1" ] || [ "${FORESIGHT_WITH_TORCH}" = "ON" 
   expect_error "'train.epochs'" train default train.epochs=zero --run-dir "$TMP/r0"
   expect_error "'train.epochs'" train default train.epochs=0 --run-dir "$TMP/r0"
   expect_error "cannot open config file" train "$TMP/missing.yaml"
+  # eval of an occupancy run recomputes the test AUC of its model.h5
+  "$BIN" eval configs/occupancy/synthetic.yaml --run-dir "$OCC" | grep -q "\"auc\": $AUC" || fail "occupancy eval"
   RUN="$TMP/run"
   TINY=(data.synthetic.num_tracks=120 network.hidden=[16,16] train.epochs=2 train.batch_size=64 train.progress=lines)
   "$BIN" train default "${TINY[@]}" --run-dir "$RUN" >/dev/null 2>"$TMP/train.log" || { cat "$TMP/train.log"; fail "train"; }
