@@ -3,7 +3,6 @@
 // coarser grid against Fast-BHM on that same grid and data, engine query throughput (probability,
 // gradient and variance), and OctoMap (insertion time, serialized size, memory, AUC).
 
-#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -67,10 +66,7 @@ void RunMapBench(const BenchMapArgs& a) {
     map = std::make_unique<HingeMap>(l.ToMap());
   });
   const double fast_auc = EvaluateMap(*map, data.test).auc;
-  const std::string tmp = (fs::temp_directory_path() / ("foresight_bench_map_" + std::to_string(::getpid()) + ".h5")).string();
-  map->Save(tmp, config::ToYaml(c), c.seed, c.precision);
-  const auto fast_bytes = static_cast<std::int64_t>(fs::file_size(tmp));
-  fs::remove(tmp);
+  const std::int64_t fast_bytes = ArtifactBytes(*map, c);
 
   // Full BHM against Fast-BHM on the same coarser grid and the first bhm_scans training scans.
   HingeGridConfig coarse = c.features;

@@ -39,14 +39,6 @@ struct Row {
   double auc;
 };
 
-std::int64_t ArtifactBytes(const OccupancyMap& map, const OccupancyExperimentConfig& c) {
-  const std::string tmp = (fs::temp_directory_path() / "foresight_occupancy_experiment.h5").string();
-  SaveOccupancyMap(map, tmp, c);
-  const auto bytes = static_cast<std::int64_t>(fs::file_size(tmp));
-  fs::remove(tmp);
-  return bytes;
-}
-
 OccupancyExperimentConfig WithSpacing(OccupancyExperimentConfig c, double spacing) {
   const double k = spacing / c.features.spacing;
   c.features.gamma /= k * k;  // keep the overlap of neighbouring features

@@ -132,6 +132,15 @@ void SaveOccupancyMap(const OccupancyMap& map, const std::string& path, const Oc
   }
 }
 
+std::int64_t ArtifactBytes(const OccupancyMap& map, const OccupancyExperimentConfig& c) {
+  const fs::path tmp = fs::temp_directory_path() /
+                       ("foresight_artifact_size_" + std::to_string(reinterpret_cast<std::uintptr_t>(&map)) + ".h5");
+  SaveOccupancyMap(map, tmp.string(), c);
+  const auto bytes = static_cast<std::int64_t>(fs::file_size(tmp));
+  fs::remove(tmp);
+  return bytes;
+}
+
 BinaryMetrics EvaluateMap(const OccupancyMap& map, const LabelledPoints& points) {
   MapWorkspace ws = map.MakeWorkspace();
   std::vector<double> scores(points.size());

@@ -3,6 +3,7 @@
 /// grid, or the multi-robot fusion experiment) -> one artifact -> evaluation on held-out scans.
 /// Torch-free; `foresight train` dispatches here when the config's model is occupancy.*.
 
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -34,6 +35,8 @@ std::unique_ptr<OccupancyMap> TrainOccupancyMap(const std::string& model, const 
                                                 const OccupancyData& data, double* seconds = nullptr);
 /// Writes the map's artifact (hinge maps with config.precision).
 void SaveOccupancyMap(const OccupancyMap& map, const std::string& path, const OccupancyExperimentConfig& config);
+/// Size in bytes of the artifact SaveOccupancyMap would write (measured via a temporary file).
+std::int64_t ArtifactBytes(const OccupancyMap& map, const OccupancyExperimentConfig& config);
 /// AUC, precision and recall (threshold 0.5) of the map's probabilities on labelled points.
 BinaryMetrics EvaluateMap(const OccupancyMap& map, const LabelledPoints& points);
 
