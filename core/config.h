@@ -65,6 +65,12 @@ template <typename T>
 struct IsStruct<T, std::void_t<decltype(std::declval<T&>().template Serialize<int>(nullptr))>>
     : std::true_type {};
 
+/// std::vector<S> where S is a config struct (a YAML sequence of mappings).
+template <typename T>
+struct IsStructVector : std::false_type {};
+template <typename S>
+struct IsStructVector<std::vector<S>> : IsStruct<S> {};
+
 template <typename T>
 const char* TypeName() {
   if constexpr (std::is_same_v<T, bool>) return "bool";
@@ -94,6 +100,20 @@ class YamlReader {
       YamlReader sub(child, source_, path);
       value->Serialize(&sub);
       sub.CheckNoUnknownKeys();
+    } else if constexpr (internal::IsStructVector<T>::value) {
+      if (!child.IsSequence()) FailAt(path, child, "a list of mappings");
+      T out;
+      for (std::size_t i = 0; i < child.size(); ++i) {
+        const std::string element = path + "[" + std::to_string(i) + "]";
+        const YAML::Node item = child[i];
+        if (!item.IsMap()) FailAt(element, item, "a mapping");
+        typename T::value_type v{};
+        YamlReader sub(item, source_, element);
+        v.Serialize(&sub);
+        sub.CheckNoUnknownKeys();
+        out.push_back(std::move(v));
+      }
+      *value = std::move(out);
     } else if constexpr (IsVector<T>::value) {
       if (!child.IsSequence()) FailAt(path, child, std::string("a list of ") +
                                                        internal::TypeName<typename T::value_type>());
@@ -195,6 +215,14 @@ class YamlWriter {
       *out_ << YAML::BeginMap;
       value->Serialize(this);
       *out_ << YAML::EndMap;
+    } else if constexpr (internal::IsStructVector<T>::value) {
+      *out_ << YAML::BeginSeq;
+      for (auto& element : *value) {
+        *out_ << YAML::BeginMap;
+        element.Serialize(this);
+        *out_ << YAML::EndMap;
+      }
+      *out_ << YAML::EndSeq;
     } else if constexpr (std::is_floating_point_v<T>) {
       *out_ << FormatDouble(*value);
     } else if constexpr (std::is_same_v<T, std::vector<double>>) {
@@ -242,6 +270,13 @@ class DocCollector {
       rows_->push_back({path, "mapping", "", "", doc});
       DocCollector sub(rows_, path);
       value->Serialize(&sub);
+    } else if constexpr (internal::IsStructVector<T>::value) {
+      // The list itself, then the fields of one element (defaults of a default element) as key[].field.
+      const std::string def = value->empty() ? "[]" : std::to_string(value->size()) + " entries";
+      rows_->push_back({path, "list of mapping", def, "", doc});
+      typename T::value_type element{};
+      DocCollector sub(rows_, path + "[]");
+      element.Serialize(&sub);
     } else {
       YAML::Emitter e;
       e << YAML::Flow;

@@ -105,5 +105,79 @@ TEST(Config, InvalidYamlNamesTheFile) {
   testing::ExpectErrorContains([] { config::LoadYamlFile("/nonexistent/x.yaml"); }, {"/nonexistent/x.yaml"});
 }
 
+// std::vector<S> of config structs: a YAML sequence of mappings.
+struct Segment {
+  double x0 = 0, x1 = 1;
+  std::vector<double> box = {0, 1};
+  template <class A>
+  void Serialize(A* a) {
+    a->Visit("x0", &x0, config::Range::Any(), "start");
+    a->Visit("x1", &x1, config::Range::NonNegative(), "end");
+    a->Visit("box", &box, config::Range::Any(), "a box");
+  }
+};
+struct Scene {
+  std::string name = "s";
+  std::vector<Segment> segments = {Segment{}, Segment{2, 3, {4}}};
+  Inner inner;
+  template <class A>
+  void Serialize(A* a) {
+    a->Visit("name", &name, config::Range::Any(), "a name");
+    a->Visit("segments", &segments, config::Range::Any(), "wall segments");
+    a->Visit("inner", &inner, config::Range::Any(), "nested");
+  }
+};
+
+Scene ParseScene(const std::string& text) {
+  return config::FromYaml<Scene>(config::ParseYaml(text, "scene.yaml"), "scene.yaml");
+}
+
+TEST(Config, VectorOfStructsReadsEachElementWithDefaults) {
+  const Scene d = ParseScene("{}");
+  ASSERT_EQ(d.segments.size(), 2u);
+  EXPECT_DOUBLE_EQ(d.segments[1].x1, 3);
+  const Scene s = ParseScene("segments:\n  - {x0: -1.5, x1: 2}\n  - x1: 4\n    box: [1, 2, 3]\n  - {}\n");
+  ASSERT_EQ(s.segments.size(), 3u);
+  EXPECT_DOUBLE_EQ(s.segments[0].x0, -1.5);
+  EXPECT_DOUBLE_EQ(s.segments[0].x1, 2);
+  EXPECT_EQ(s.segments[0].box, (std::vector<double>{0, 1}));  // element defaults, not the list's
+  EXPECT_DOUBLE_EQ(s.segments[1].x0, 0);
+  EXPECT_EQ(s.segments[1].box, (std::vector<double>{1, 2, 3}));
+  EXPECT_DOUBLE_EQ(s.segments[2].x1, 1);
+  EXPECT_TRUE(ParseScene("segments: []\n").segments.empty());
+}
+
+TEST(Config, VectorOfStructsErrorsNameTheElementPath) {
+  testing::ExpectErrorContains([] { ParseScene("segments:\n  - {x0: 1}\n  - {x0: 1, y0: 2}\n"); },
+                               {"scene.yaml:3", "unknown key 'segments[1].y0'", "x0"});
+  testing::ExpectErrorContains([] { ParseScene("segments:\n  - {x1: -1}\n"); },
+                               {"scene.yaml:2", "'segments[0].x1'", "'-1'", ">= 0"});
+  testing::ExpectErrorContains([] { ParseScene("segments:\n  - {}\n  - {box: [1, a]}\n"); },
+                               {"'segments[1].box[1]'", "'a'"});
+  testing::ExpectErrorContains([] { ParseScene("segments: {x0: 1}\n"); }, {"'segments'", "a list of mappings"});
+  testing::ExpectErrorContains([] { ParseScene("segments: [3]\n"); }, {"'segments[0]'", "'3'", "a mapping"});
+}
+
+TEST(Config, VectorOfStructsRoundTripsAndIsDocumented) {
+  const Scene s = ParseScene("name: t\nsegments:\n  - {x0: 0.25, x1: 7, box: [1]}\n  - {x0: -3}\n");
+  const std::string text = config::ToYaml(s);
+  const Scene back = config::FromYaml<Scene>(config::ParseYaml(text, "round"), "round");
+  EXPECT_EQ(config::ToYaml(back), text);
+  ASSERT_EQ(back.segments.size(), 2u);
+  EXPECT_DOUBLE_EQ(back.segments[0].x0, 0.25);
+  EXPECT_EQ(back.segments[0].box, (std::vector<double>{1}));
+  EXPECT_DOUBLE_EQ(back.segments[1].x0, -3);
+  Scene empty;
+  empty.segments.clear();
+  const std::string empty_text = config::ToYaml(empty);
+  EXPECT_TRUE(config::FromYaml<Scene>(config::ParseYaml(empty_text, "e"), "e").segments.empty()) << empty_text;
+
+  const std::string table = config::ReferenceTable<Scene>();
+  for (const char* key : {"`segments`", "`segments[].x0`", "`segments[].x1`", "`segments[].box`", "`inner.rate`"})
+    EXPECT_NE(table.find(key), std::string::npos) << key << "\n" << table;
+  EXPECT_NE(table.find("list of mapping"), std::string::npos);
+  EXPECT_NE(table.find("`2 entries`"), std::string::npos) << table;
+}
+
 }  // namespace
 }  // namespace foresight
