@@ -1,0 +1,245 @@
+#include "inference/navigation/span_controller.h"
+
+#include <nlopt.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <sstream>
+
+#include "core/error.h"
+
+namespace foresight::nav {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+double WrapToPi(double a) { return std::remainder(a, 2.0 * M_PI); }
+
+/// Starts of the per-cycle COBYLA runs: the previous solution, a goal-directed turn, then a fan.
+std::vector<Control> Starts(const SpanControllerOptions& o, const UnicycleState& robot, const Eigen::Vector2d& goal,
+                            const Control* previous) {
+  std::vector<Control> s;
+  if (previous) s.push_back(*previous);
+  const double bearing = std::atan2(goal.y() - robot.y, goal.x() - robot.x);
+  const double turn = std::clamp(WrapToPi(bearing - robot.heading) / std::max(o.horizon * 0.5, o.dt), -o.limits.omega_max,
+                                 o.limits.omega_max);
+  s.push_back({o.limits.v_max, turn});
+  for (double v : {o.limits.v_max, 0.5 * o.limits.v_max})
+    for (double w : {0.0, -0.5, 0.5, -1.0, 1.0}) s.push_back({v, w * o.limits.omega_max});
+  s.push_back({0.5 * o.limits.v_min, 0.0});
+  s.push_back({0.0, turn});
+  return s;
+}
+
+struct Problem {
+  std::function<double(const Control&)> cost;
+  int evaluations = 0;
+};
+
+double NloptCost(unsigned, const double* x, double*, void* data) {
+  auto* p = static_cast<Problem*>(data);
+  ++p->evaluations;
+  return p->cost({x[0], x[1]});
+}
+
+/// Runs COBYLA from each start; returns the best control and its cost. Never throws.
+std::pair<Control, double> MinimiseFromStarts(const SpanControllerOptions& o, const std::vector<Control>& starts,
+                                              int max_starts, double lower_bound, Problem* problem) {
+  Control best{0.0, 0.0};
+  double best_cost = kInf;
+  nlopt::opt opt(nlopt::LN_COBYLA, 2);
+  opt.set_lower_bounds({o.limits.v_min, -o.limits.omega_max});
+  opt.set_upper_bounds({o.limits.v_max, o.limits.omega_max});
+  opt.set_min_objective(NloptCost, problem);
+  opt.set_maxeval(o.max_evaluations);
+  opt.set_xtol_abs(o.xtol);
+  opt.set_initial_step(o.initial_step);
+  const int n = std::min<int>(max_starts, static_cast<int>(starts.size()));
+  for (int i = 0; i < n; ++i) {
+    const Control s = o.limits.Clamp(starts[static_cast<std::size_t>(i)]);
+    std::vector<double> x{s.v, s.omega};
+    double f = kInf;
+    try {
+      opt.optimize(x, f);
+    } catch (const std::exception&) {
+      // nlopt reports round-off limits and similar by exception; x holds the last iterate.
+      f = problem->cost({x[0], x[1]});
+    }
+    if (std::isfinite(f) && f < best_cost) {
+      best_cost = f;
+      best = o.limits.Clamp({x[0], x[1]});
+    }
+    if (best_cost <= lower_bound + 1e-3) break;  // cannot do better than the unobstructed optimum
+  }
+  return {best, best_cost};
+}
+
+}  // namespace
+
+std::string SpanControllerOptions::Problems() const {
+  std::ostringstream e;
+  if (!(kappa >= 0) || !std::isfinite(kappa)) e << "kappa = " << kappa << " must be >= 0; ";
+  if (!(epsilon > 0 && epsilon < 1)) e << "epsilon = " << epsilon << " must be in (0, 1); ";
+  if (!(dt > 0) || !std::isfinite(dt)) e << "dt = " << dt << " must be > 0; ";
+  if (!(horizon >= dt) || !std::isfinite(horizon)) e << "horizon = " << horizon << " must be >= dt; ";
+  if (!(robot_radius > 0) || !(pedestrian_radius >= 0)) e << "radii must be positive; ";
+  if (!(limits.v_min <= 0 && limits.v_max > 0 && limits.omega_max > 0))
+    e << "control limits need v_min <= 0 < v_max and omega_max > 0; ";
+  if (initialisations < 1) e << "initialisations = " << initialisations << " must be >= 1; ";
+  if (max_evaluations < 3) e << "max_evaluations = " << max_evaluations << " must be >= 3; ";
+  return e.str();
+}
+
+int CleanObservations(const Eigen::MatrixXd& past_rows, Eigen::MatrixXd* clean, Eigen::Matrix2Xd* current) {
+  const Eigen::Index p = past_rows.cols() / 2;
+  clean->resize(past_rows.rows(), past_rows.cols());
+  current->resize(2, past_rows.rows());
+  int kept = 0;
+  for (Eigen::Index n = 0; n < past_rows.rows(); ++n) {
+    Eigen::Index last = -1;
+    for (Eigen::Index i = p - 1; i >= 0 && last < 0; --i)
+      if (std::isfinite(past_rows(n, 2 * i)) && std::isfinite(past_rows(n, 2 * i + 1))) last = i;
+    if (last < 0) continue;
+    const bool all_finite = past_rows.row(n).allFinite();
+    for (Eigen::Index i = 0; i < p; ++i) {
+      clean->coeffRef(kept, 2 * i) = all_finite ? past_rows(n, 2 * i) : past_rows(n, 2 * last);
+      clean->coeffRef(kept, 2 * i + 1) = all_finite ? past_rows(n, 2 * i + 1) : past_rows(n, 2 * last + 1);
+    }
+    current->col(kept) = Eigen::Vector2d(past_rows(n, 2 * last), past_rows(n, 2 * last + 1));
+    ++kept;
+  }
+  return kept;
+}
+
+// ---- SPAN -------------------------------------------------------------------------------------
+
+SpanController::SpanController(const SpanPredictor* predictor, const StaticCollisionField* field,
+                               SpanControllerOptions options)
+    : predictor_(predictor), field_(field), options_(std::move(options)), threshold_(0.5) {
+  const std::string problems = options_.Problems();
+  FS_THROW_UNLESS(problems.empty(), "SPAN controller options: ", problems);
+  threshold_ = ChanceThreshold(options_.epsilon);
+  steps_ = static_cast<int>(std::lround(options_.horizon / options_.dt));
+  if (field_ && field_->empty()) field_ = nullptr;
+  if (field_) map_ws_ = field_->MakeWorkspace();
+  if (predictor_) {
+    predictor_ws_ = predictor_->MakeWorkspace();
+    forecast_.Reserve(64, steps_, predictor_->layout().components);
+  }
+}
+
+void SpanController::Forecast(const NavigationInput& input) {
+  const int n = input.past_rows ? CleanObservations(*input.past_rows, &clean_rows_, &current_) : 0;
+  if (predictor_ == nullptr || n == 0) {
+    forecast_.FromCurrentPositions(current_.leftCols(n), steps_);
+    return;
+  }
+  FS_THROW_UNLESS(clean_rows_.cols() == 2 * predictor_->observed(), "SPAN controller: observations hold ",
+                  clean_rows_.cols() / 2, " points per pedestrian, the predictor expects ", predictor_->observed());
+  while (predictions_.size() < static_cast<std::size_t>(n)) predictions_.push_back(predictor_->MakeDistribution());
+  predictor_->PredictBatch(clean_rows_.topRows(n), &predictor_ws_, &predictions_);
+  forecast_.FromPredictions(predictions_, n, steps_, options_.dt);
+}
+
+double SpanController::Cost(const UnicycleState& robot, const Eigen::Vector2d& goal, const Control& u,
+                            double* tau) const {
+  const double r = options_.robot_radius + options_.pedestrian_radius;
+  UnicycleState s = robot;
+  double t_collide = kInf;
+  for (int k = 1; k <= steps_; ++k) {
+    s = EulerStep(s, u, options_.dt);
+    if (t_collide < kInf) continue;
+    const Eigen::Vector2d p = s.position();
+    if ((field_ && field_->Collides(p.x(), p.y(), options_.epsilon, &map_ws_)) ||
+        forecast_.Collides(std::min(k, forecast_.steps()), p, r, threshold_))
+      t_collide = k * options_.dt;
+  }
+  if (tau) *tau = t_collide;
+  const double distance = (s.position() - goal).norm();
+  return std::isfinite(t_collide) ? distance + options_.kappa / t_collide : distance;
+}
+
+ControlOutcome SpanController::Compute(const NavigationInput& input) {
+  ControlOutcome out;
+  try {
+    Forecast(input);
+    Problem problem;
+    problem.cost = [&](const Control& u) { return Cost(input.robot, input.goal, u, nullptr); };
+    const double lower = std::max(0.0, (input.robot.position() - input.goal).norm() - options_.limits.v_max * options_.horizon);
+    const auto [best, cost] = MinimiseFromStarts(options_, Starts(options_, input.robot, input.goal,
+                                                                  has_previous_ ? &previous_ : nullptr),
+                                                 options_.initialisations, lower, &problem);
+    out.evaluations = problem.evaluations;
+    if (!std::isfinite(cost)) {
+      out.solved = false;
+      out.command = {0, 0};
+      has_previous_ = false;
+      return out;
+    }
+    out.command = best;
+    out.cost = Cost(input.robot, input.goal, best, &out.tau);
+    previous_ = best;
+    has_previous_ = true;
+  } catch (const std::exception&) {
+    out = ControlOutcome{};
+    out.solved = false;  // e.g. malformed observations: stop and let the harness count it
+    has_previous_ = false;
+  }
+  return out;
+}
+
+// ---- reactive ---------------------------------------------------------------------------------
+
+ReactiveController::ReactiveController(const StaticCollisionField* field, SpanControllerOptions options,
+                                       double heading_weight)
+    : field_(field), options_(std::move(options)), heading_weight_(heading_weight), threshold_(0.5) {
+  const std::string problems = options_.Problems();
+  FS_THROW_UNLESS(problems.empty(), "reactive controller options: ", problems);
+  threshold_ = ChanceThreshold(options_.epsilon);
+  if (field_ && field_->empty()) field_ = nullptr;
+  if (field_) map_ws_ = field_->MakeWorkspace();
+}
+
+double ReactiveController::Cost(const UnicycleState& robot, const Eigen::Vector2d& goal, const Control& u,
+                                bool* collides) const {
+  const UnicycleState s = EulerStep(robot, u, options_.dt);
+  const Eigen::Vector2d p = s.position();
+  const bool hit = (field_ && field_->Collides(p.x(), p.y(), options_.epsilon, &map_ws_)) ||
+                   forecast_.Collides(1, p, options_.robot_radius + options_.pedestrian_radius, threshold_);
+  if (collides) *collides = hit;
+  const double bearing = std::atan2(goal.y() - p.y(), goal.x() - p.x());
+  return (p - goal).norm() + heading_weight_ * std::abs(WrapToPi(bearing - s.heading)) + (hit ? options_.kappa : 0.0);
+}
+
+ControlOutcome ReactiveController::Compute(const NavigationInput& input) {
+  ControlOutcome out;
+  try {
+    Eigen::MatrixXd clean;
+    const int n = input.past_rows ? CleanObservations(*input.past_rows, &clean, &current_) : 0;
+    forecast_.FromCurrentPositions(current_.leftCols(n), 1);
+    Problem problem;
+    problem.cost = [&](const Control& u) { return Cost(input.robot, input.goal, u, nullptr); };
+    const auto [best, cost] = MinimiseFromStarts(options_, Starts(options_, input.robot, input.goal, nullptr),
+                                                 options_.initialisations, 0.0, &problem);
+    out.evaluations = problem.evaluations;
+    bool hit = true;
+    if (std::isfinite(cost)) Cost(input.robot, input.goal, best, &hit);
+    if (hit) {
+      out.solved = false;
+      out.command = {0, 0};
+      return out;
+    }
+    out.command = best;
+    out.cost = cost;
+    out.tau = kInf;
+  } catch (const std::exception&) {
+    out = ControlOutcome{};
+    out.solved = false;
+  }
+  return out;
+}
+
+}  // namespace foresight::nav

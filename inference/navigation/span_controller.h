@@ -1,0 +1,100 @@
+#pragma once
+/// SPAN: stochastic process anticipatory navigation (thesis ch 5, eqs. costOpt-costOptc, Algorithm 1).
+/// Each cycle: predict every observed pedestrian's future as a stochastic process with the SPAN
+/// engine, then minimise over constant controls u = (v, omega) on the horizon T
+///   J(u) = ||x(T) - g|| + kappa / tau(x_0, u, o, f_m)
+/// with COBYLA (NLopt) from several initialisations. tau is the first Euler step k dt at which the
+/// erf bound on the collision probability with any pedestrian exceeds epsilon (eq. dynamicCheck)
+/// or the swept occupancy of the static map exceeds epsilon (eq. staticCheck); without collision
+/// on the horizon tau = inf and the TTC term vanishes.
+///
+/// The same class with `anticipate = false` and a one-step horizon is the reactive baseline.
+
+#include <memory>
+#include <vector>
+
+#include "inference/navigation/controller.h"
+#include "inference/navigation/crowd_forecast.h"
+#include "inference/navigation/static_clearance.h"
+#include "inference/prediction/span_predictor.h"
+
+namespace foresight::nav {
+
+struct SpanControllerOptions {
+  double kappa = 100.0;            ///< weight of the inverse time-to-collision
+  double epsilon = 0.25;           ///< chance threshold
+  double horizon = 4.0;            ///< T (s)
+  double dt = 0.1;                 ///< Euler step of the rollout (s)
+  double robot_radius = 0.4;       ///< m
+  double pedestrian_radius = 0.4;  ///< m
+  ControlLimits limits;
+  int initialisations = 12;        ///< COBYLA starts per cycle (the previous solution first)
+  int max_evaluations = 40;        ///< per start
+  double xtol = 1e-3;              ///< COBYLA tolerance on u
+  double initial_step = 0.4;       ///< COBYLA initial trust radius on u
+  /// Describe problems (names the offending field) or return an empty string.
+  std::string Problems() const;
+};
+
+class SpanController final : public NavigationController {
+ public:
+  /// @param predictor SPAN engine (null: no pedestrian prediction; pedestrians stand still).
+  /// @param field swept static map (null or empty: no static obstacles). Both must outlive the controller.
+  SpanController(const SpanPredictor* predictor, const StaticCollisionField* field, SpanControllerOptions options);
+  std::string name() const override { return "span"; }
+  ControlOutcome Compute(const NavigationInput& input) override;
+
+  /// J(u) from `robot` towards `goal` against the current forecast; `tau` receives the TTC (inf: none).
+  double Cost(const UnicycleState& robot, const Eigen::Vector2d& goal, const Control& u, double* tau) const;
+  /// Fills the forecast from observations (done by Compute; exposed for tests and drawing).
+  void Forecast(const NavigationInput& input);
+  const CrowdForecast& forecast() const { return forecast_; }
+  /// Predictions of the last cycle (first forecast().pedestrians() entries are valid).
+  const std::vector<TrajectoryDistribution>& predictions() const { return predictions_; }
+  const SpanControllerOptions& options() const { return options_; }
+  int steps() const { return steps_; }
+
+ private:
+  const SpanPredictor* predictor_;
+  const StaticCollisionField* field_;
+  SpanControllerOptions options_;
+  ChanceThreshold threshold_;
+  int steps_;
+  CrowdForecast forecast_;
+  std::vector<TrajectoryDistribution> predictions_;
+  SpanPredictor::Workspace predictor_ws_;
+  mutable MapWorkspace map_ws_;
+  Eigen::MatrixXd clean_rows_;
+  Eigen::Matrix2Xd current_;
+  Control previous_;
+  bool has_previous_ = false;
+};
+
+/// The reactive baseline (thesis ch 5, "Experimental Evaluation"): optimises the next step only,
+/// without anticipation. Pedestrians are taken at their current positions; the cost is the distance
+/// to the goal after one step plus `heading_weight` times the heading error to the goal, with kappa
+/// added when the step collides (pedestrian discs or the swept static map). Stops when every
+/// candidate collides.
+class ReactiveController final : public NavigationController {
+ public:
+  ReactiveController(const StaticCollisionField* field, SpanControllerOptions options, double heading_weight = 0.5);
+  std::string name() const override { return "reactive"; }
+  ControlOutcome Compute(const NavigationInput& input) override;
+  double Cost(const UnicycleState& robot, const Eigen::Vector2d& goal, const Control& u, bool* collides) const;
+
+ private:
+  const StaticCollisionField* field_;
+  SpanControllerOptions options_;
+  double heading_weight_;
+  ChanceThreshold threshold_;
+  CrowdForecast forecast_;
+  Eigen::Matrix2Xd current_;
+  mutable MapWorkspace map_ws_;
+};
+
+/// Last finite position of each row of `past_rows` into `current` [2 x n]; rows without any finite
+/// point are dropped. @return number of pedestrians kept. Rows with some non-finite points are
+/// rewritten in `clean` as a pedestrian standing at its last finite point.
+int CleanObservations(const Eigen::MatrixXd& past_rows, Eigen::MatrixXd* clean, Eigen::Matrix2Xd* current);
+
+}  // namespace foresight::nav

@@ -1,0 +1,90 @@
+// The erf chance bound (thesis eq. upperbounds), its erf-free threshold form, and the forecast
+// tables, against Monte Carlo, brute force and closed forms.
+#include "inference/navigation/chance_bound.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "inference/navigation/crowd_forecast.h"
+#include "tests/test_util.h"
+
+namespace foresight::nav {
+namespace {
+
+TEST(ErfInv, InvertsErf) {
+  for (double x = -3.5; x <= 3.5; x += 0.05) EXPECT_NEAR(ErfInv(std::erf(x)), x, 1e-9) << x;
+  EXPECT_DOUBLE_EQ(ErfInv(0.0), 0.0);
+  testing::ExpectErrorContains([] { ErfInv(1.0); }, {"ErfInv", "outside (-1, 1)"});
+}
+
+TEST(ChanceBound, UpperBoundsTheMonteCarloProbability) {
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> n01;
+  for (int trial = 0; trial < 12; ++trial) {
+    const Eigen::Vector2d mean(std::uniform_real_distribution<double>(-1.5, 1.5)(rng), 0.3 * trial - 1.5);
+    Eigen::Matrix2d l;
+    l << 0.2 + 0.05 * trial, 0, 0.1, 0.3;
+    const Eigen::Matrix2d cov = l * l.transpose();
+    const Eigen::Vector2d x(0.2, -0.1);
+    const double radius = 0.8;
+    int inside = 0;
+    const int samples = 40000;
+    for (int i = 0; i < samples; ++i) {
+      const Eigen::Vector2d o = mean + l * Eigen::Vector2d(n01(rng), n01(rng));
+      inside += (x - o).norm() < radius;
+    }
+    const double p = static_cast<double>(inside) / samples;
+    EXPECT_GE(CollisionProbabilityBound(x, mean, cov, radius) + 3e-3, p) << "trial " << trial;
+  }
+}
+
+TEST(ChanceBound, MatchesTheOneDimensionalHalfPlaneProbability) {
+  // The bound is the probability of the half plane {o : a'(x - o) < r}: a'o ~ N(a'mean, a'Sigma a).
+  const Eigen::Vector2d x(2.0, 1.0), mean(0.5, 0.2);
+  Eigen::Matrix2d cov;
+  cov << 0.3, 0.1, 0.1, 0.2;
+  const Eigen::Vector2d d = x - mean, a = d.normalized();
+  const double s = std::sqrt(a.dot(cov * a));
+  const double r = 0.8;
+  const double half_plane = 0.5 * std::erfc((d.norm() - r) / (s * std::sqrt(2.0)));
+  EXPECT_NEAR(CollisionProbabilityBound(x, mean, cov, r), half_plane, 1e-12);
+  EXPECT_EQ(CollisionProbabilityBound(mean, mean, cov, r), 1.0);
+  EXPECT_EQ(CollisionProbabilityBound(x, mean, Eigen::Matrix2d::Zero(), r), 0.0);
+  EXPECT_EQ(CollisionProbabilityBound(x, mean, Eigen::Matrix2d::Zero(), 5.0), 1.0);
+}
+
+TEST(ChanceThreshold, IsTheSameTestAsTheBound) {
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(-2, 2);
+  for (double eps : {0.05, 0.25, 0.5, 0.8}) {
+    const ChanceThreshold t(eps);
+    int disagreements = 0;
+    for (int i = 0; i < 5000; ++i) {
+      const Eigen::Vector2d d(u(rng), u(rng));
+      Eigen::Matrix2d l;
+      l << std::abs(u(rng)) * 0.3, 0, u(rng) * 0.1, std::abs(u(rng)) * 0.3;
+      const Eigen::Matrix2d cov = l * l.transpose();
+      const double bound = CollisionProbabilityBound(d, Eigen::Vector2d::Zero(), cov, 0.8);
+      if (std::abs(bound - eps) < 1e-9) continue;  // on the boundary either answer is right
+      disagreements += (bound > eps) != t.Exceeds(d, cov, 0.8);
+    }
+    EXPECT_EQ(disagreements, 0) << "epsilon " << eps;
+  }
+  testing::ExpectErrorContains([] { ChanceThreshold(1.5); }, {"epsilon", "1.5"});
+}
+
+TEST(CrowdForecast, StandingPedestriansCollideWithinTheSumOfRadii) {
+  Eigen::Matrix2Xd pos(2, 2);
+  pos << 0.0, 5.0, 0.0, 0.0;
+  CrowdForecast f;
+  f.FromCurrentPositions(pos, 3);
+  const ChanceThreshold t(0.25);
+  EXPECT_TRUE(f.Collides(1, Eigen::Vector2d(0.79, 0), 0.8, t));
+  EXPECT_FALSE(f.Collides(3, Eigen::Vector2d(0.81, 0), 0.8, t));
+  EXPECT_TRUE(f.Collides(2, Eigen::Vector2d(5.5, 0.5), 0.8, t));
+  EXPECT_EQ(f.MaxBound(1, Eigen::Vector2d(2.5, 0), 0.8), 0.0);
+}
+
+}  // namespace
+}  // namespace foresight::nav

@@ -1,0 +1,249 @@
+// SPAN controller, reactive baseline and CL-RRT*: costs against brute force, closed-loop behaviour
+// in small scenes, and bad input.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "inference/mapping/grid_map.h"
+#include "inference/navigation/cl_rrt_star.h"
+#include "inference/navigation/span_controller.h"
+#include "inference/navigation/static_clearance.h"
+#include "tests/test_util.h"
+
+namespace foresight::nav {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+/// 12 m x 8 m free room with 0.1 m cells; `wall` adds a vertical wall at x = 5 with a gap at y in [5, 6.5].
+GridMap Room(bool wall) {
+  GridGeometry g;
+  g.x_min = -1;
+  g.y_min = -1;
+  g.resolution = 0.1;
+  g.nx = 140;
+  g.ny = 100;
+  Eigen::MatrixXf p = Eigen::MatrixXf::Constant(g.ny, g.nx, 0.05f);
+  for (int iy = 0; iy < g.ny; ++iy)
+    for (int ix = 0; ix < g.nx; ++ix) {
+      const double x = g.x_min + (ix + 0.5) * g.resolution, y = g.y_min + (iy + 0.5) * g.resolution;
+      const bool border = x < -0.5 || x > 12.5 || y < -0.5 || y > 8.5;
+      const bool w = wall && std::abs(x - 5.0) < 0.15 && !(y > 5.0 && y < 6.5);
+      if (border || w) p(iy, ix) = 0.95f;
+    }
+  return GridMap(g, p, CellType::kFloat32);
+}
+
+/// Rows of standing pedestrians observed for `p` steps.
+Eigen::MatrixXd Standing(const std::vector<Eigen::Vector2d>& at, int p) {
+  Eigen::MatrixXd rows(static_cast<Eigen::Index>(at.size()), 2 * p);
+  for (std::size_t n = 0; n < at.size(); ++n)
+    for (int i = 0; i < p; ++i) rows.row(static_cast<Eigen::Index>(n)).segment(2 * i, 2) = at[n].transpose();
+  return rows;
+}
+
+TEST(StaticCollisionField, TabulatesTheSweptOccupancy) {
+  const GridMap map = Room(true);
+  const StaticCollisionField field(map, 0.4, 0.05);
+  MapWorkspace ws = field.MakeWorkspace();
+  int disagree = 0, checked = 0;
+  for (double x = 0.0; x < 12.0; x += 0.173)
+    for (double y = 0.0; y < 8.0; y += 0.191) {
+      const double exact = SweptOccupancy(map, &ws, x, y, 0.4, 64);
+      const double tab = field.Value(x, y, &ws);
+      // Conservative up to the raster step: near the boundary the tabulated value may be larger.
+      if ((exact > 0.25) != (tab > 0.25)) {
+        ++disagree;
+        EXPECT_GT(tab, 0.25) << "the table missed an obstacle at " << x << ", " << y;
+      }
+      ++checked;
+    }
+  EXPECT_LT(disagree, checked / 20);
+  EXPECT_TRUE(field.Collides(5.0, 2.0, 0.25, &ws));   // on the wall
+  EXPECT_TRUE(field.Collides(4.7, 2.0, 0.25, &ws));   // robot disc touches the wall
+  EXPECT_FALSE(field.Collides(4.2, 2.0, 0.25, &ws));  // clear of it
+  EXPECT_FALSE(field.Collides(5.0, 5.75, 0.25, &ws));  // in the gap
+  EXPECT_TRUE(field.Collides(-3.0, 2.0, 0.25, &ws));  // outside the map: prior 0.5
+}
+
+SpanControllerOptions Options() {
+  SpanControllerOptions o;
+  o.initialisations = 12;
+  return o;
+}
+
+TEST(SpanController, FreeSpaceDrivesStraightAtTheGoal) {
+  SpanController c(nullptr, nullptr, Options());
+  NavigationInput in;
+  in.robot = {0, 0, 0};
+  in.goal = {10, 0};
+  const ControlOutcome out = c.Compute(in);
+  EXPECT_TRUE(out.solved);
+  EXPECT_NEAR(out.command.v, 1.0, 1e-3);
+  EXPECT_NEAR(out.command.omega, 0.0, 2e-2);
+  EXPECT_EQ(out.tau, kInf);
+  EXPECT_NEAR(out.cost, 6.0, 1e-2);
+}
+
+TEST(SpanController, CostIsDistancePlusKappaOverTheFirstCollisionTime) {
+  SpanController c(nullptr, nullptr, Options());
+  const Eigen::MatrixXd rows = Standing({{2.0, 0.0}}, 5);
+  NavigationInput in;
+  in.robot = {0, 0, 0};
+  in.goal = {10, 0};
+  in.past_rows = &rows;
+  c.Forecast(in);
+  double tau = 0;
+  const double cost = c.Cost(in.robot, in.goal, {1.0, 0.0}, &tau);
+  // Straight at 1 m/s: first step with ||x - o|| < 0.8 is x = 1.3 m (step 13; x = 1.2 is exactly 0.8 away).
+  EXPECT_NEAR(tau, 1.3, 1e-9);
+  EXPECT_NEAR(cost, 6.0 + 100.0 / 1.3, 1e-9);
+  EXPECT_NEAR(c.Cost(in.robot, in.goal, {0.0, 0.0}, &tau), 10.0, 1e-12);
+  EXPECT_EQ(tau, kInf);
+}
+
+TEST(SpanController, CobylaFindsAsGoodAControlAsAGridSearch) {
+  const GridMap map = Room(false);
+  const StaticCollisionField field(map, 0.4, 0.05);
+  SpanController c(nullptr, &field, Options());
+  const Eigen::MatrixXd rows = Standing({{2.5, 0.3}, {3.0, -1.2}, {4.0, 2.0}}, 5);
+  NavigationInput in;
+  in.robot = {0.5, 1.0, 0.2};
+  in.goal = {10, 1};
+  in.past_rows = &rows;
+  const ControlOutcome out = c.Compute(in);
+  double grid_best = kInf;
+  for (int i = 0; i <= 40; ++i)
+    for (int j = 0; j <= 40; ++j)
+      grid_best = std::min(grid_best, c.Cost(in.robot, in.goal, {-1.0 + 0.05 * i, -1.0 + 0.05 * j}, nullptr));
+  EXPECT_TRUE(out.solved);
+  EXPECT_LE(out.cost, grid_best + 0.05) << "COBYLA " << out.cost << " vs grid " << grid_best;
+}
+
+TEST(SpanController, ClosedLoopPassesAStandingPedestrianWithoutCollision) {
+  SpanController c(nullptr, nullptr, Options());
+  const Eigen::MatrixXd rows = Standing({{4.0, 0.0}}, 5);
+  UnicycleState s{0, 0, 0};
+  const Eigen::Vector2d goal(8, 0);
+  double min_gap = kInf;
+  int steps = 0;
+  for (; steps < 300 && (s.position() - goal).norm() > 0.3; ++steps) {
+    NavigationInput in;
+    in.robot = s;
+    in.goal = goal;
+    in.past_rows = &rows;
+    s = EulerStep(s, c.Compute(in).command, 0.1);
+    min_gap = std::min(min_gap, (s.position() - Eigen::Vector2d(4, 0)).norm() - 0.8);
+  }
+  EXPECT_LT(steps, 300) << "goal not reached";
+  EXPECT_GT(min_gap, 0.0);
+}
+
+TEST(SpanController, WithTheMapGoesThroughTheGap) {
+  const GridMap map = Room(true);
+  const StaticCollisionField field(map, 0.4, 0.05);
+  SpanController c(nullptr, &field, Options());
+  MapWorkspace ws = field.MakeWorkspace();
+  UnicycleState s{2, 5.75, 0};
+  const Eigen::Vector2d goal(9, 5.75);
+  int steps = 0;
+  bool hit = false;
+  for (; steps < 300 && (s.position() - goal).norm() > 0.3; ++steps) {
+    NavigationInput in;
+    in.robot = s;
+    in.goal = goal;
+    s = EulerStep(s, c.Compute(in).command, 0.1);
+    hit = hit || SweptOccupancy(map, &ws, s.x, s.y, 0.4, 64) > 0.5;
+  }
+  EXPECT_LT(steps, 300);
+  EXPECT_FALSE(hit);
+}
+
+TEST(SpanController, NonFiniteObservationsNeverThrow) {
+  SpanController c(nullptr, nullptr, Options());
+  Eigen::MatrixXd rows = Standing({{2.0, 0.0}, {5.0, 5.0}}, 5);
+  rows(0, 9) = std::nan("");
+  rows.row(1).setConstant(std::nan(""));
+  NavigationInput in;
+  in.robot = {0, 0, 0};
+  in.goal = {10, 0};
+  in.past_rows = &rows;
+  const ControlOutcome out = c.Compute(in);
+  EXPECT_TRUE(out.solved);
+  EXPECT_EQ(c.forecast().pedestrians(), 1);  // the all-NaN row is dropped, the other stands at its last finite point
+  EXPECT_EQ(c.forecast().Mean(0, 1, 0), Eigen::Vector2d(2.0, 0.0));
+}
+
+TEST(SpanController, BadOptionsAreClearErrors) {
+  SpanControllerOptions o;
+  o.epsilon = 1.2;
+  testing::ExpectErrorContains([&] { SpanController(nullptr, nullptr, o); }, {"epsilon", "1.2"});
+  o = SpanControllerOptions();
+  o.horizon = 0.0;
+  testing::ExpectErrorContains([&] { SpanController(nullptr, nullptr, o); }, {"horizon"});
+}
+
+TEST(ReactiveController, StopsWhenBoxedInAndMovesWhenFree) {
+  ReactiveController c(nullptr, Options());
+  const Eigen::MatrixXd boxed = Standing({{0.75, 0}, {-0.75, 0}, {0, 0.75}, {0, -0.75}}, 5);
+  NavigationInput in;
+  in.robot = {0, 0, 0};
+  in.goal = {10, 0};
+  in.past_rows = &boxed;
+  ControlOutcome out = c.Compute(in);
+  EXPECT_FALSE(out.solved);
+  EXPECT_EQ(out.command.v, 0.0);
+  in.past_rows = nullptr;
+  out = c.Compute(in);
+  EXPECT_TRUE(out.solved);
+  EXPECT_GT(out.command.v, 0.9);
+}
+
+TEST(PurePursuit, SteersTowardsTheLookaheadPoint) {
+  Eigen::Matrix2Xd path(2, 3);
+  path << 0, 5, 10, 0, 0, 0;
+  const ControlLimits lim;
+  Control u = PurePursuit({0, 0, 0}, path, 0.8, lim);
+  EXPECT_NEAR(u.v, 1.0, 1e-9);
+  EXPECT_NEAR(u.omega, 0.0, 1e-9);
+  u = PurePursuit({0, 0.5, 0}, path, 0.8, lim);
+  EXPECT_LT(u.omega, 0.0);  // path to the right: turn clockwise
+  u = PurePursuit({0, 0, M_PI}, path, 0.8, lim);
+  EXPECT_EQ(u.v, 0.0);  // target behind: turn in place
+  EXPECT_NE(u.omega, 0.0);
+}
+
+TEST(ClRrtStar, PlansThroughTheGapAndStaysPutWhenBlocked) {
+  const GridMap map = Room(true);
+  const StaticCollisionField field(map, 0.4, 0.05);
+  ClRrtStarOptions o;
+  o.budget_s = 1.0;
+  o.max_iterations = 400;
+  ClRrtStarController c(&field, Eigen::Vector4d(-0.5, 12.5, -0.5, 8.5), o, 1);
+  MapWorkspace ws = field.MakeWorkspace();
+  UnicycleState s{2, 2, 0};
+  const Eigen::Vector2d goal(9, 2);
+  int steps = 0;
+  bool hit = false;
+  for (; steps < 400 && (s.position() - goal).norm() > 0.3; ++steps) {
+    NavigationInput in;
+    in.robot = s;
+    in.goal = goal;
+    s = EulerStep(s, c.Compute(in).command, 0.1);
+    hit = hit || SweptOccupancy(map, &ws, s.x, s.y, 0.35, 64) > 0.5;
+  }
+  EXPECT_LT(steps, 400) << "goal not reached; at " << s.x << ", " << s.y;
+  EXPECT_FALSE(hit);
+  // A goal inside the wall cannot be reached: no plan, stop.
+  NavigationInput in;
+  in.robot = {2, 2, 0};
+  in.goal = {5.0, 2.0};
+  const ControlOutcome out = c.Compute(in);
+  EXPECT_FALSE(out.solved);
+  EXPECT_EQ(out.command.v, 0.0);
+  EXPECT_EQ(out.command.omega, 0.0);
+}
+
+}  // namespace
+}  // namespace foresight::nav
