@@ -152,6 +152,20 @@ CrowdScenarioConfig Sim2Scenario() {
   return s;
 }
 
+CrowdScenarioConfig DatasetScenario() {
+  CrowdScenarioConfig s;
+  s.name = "dataset";
+  s.source = CrowdSource::kReplay;
+  s.extent = {-11, 12, -10, 13.5};
+  s.walls.clear();
+  s.groups.clear();
+  s.robot_start = {-3.5, -3, std::atan2(8.5, 7.0)};
+  s.robot_goal = {3.5, 5.5};
+  s.start_jitter = 0.3;
+  s.replay = ReplayConfig{};  // thor1, 0.1 s, 3 windows of 60 s, 60 s apart
+  return s;
+}
+
 std::unique_ptr<Crowd> MakeCrowd(const CrowdScenarioConfig& scenario, std::uint64_t episode_seed) {
   scenario.Validate("crowd scenario '" + scenario.name + "'");
   if (scenario.source == CrowdSource::kReplay) return std::make_unique<ReplayCrowd>(scenario, episode_seed);

@@ -179,6 +179,10 @@ struct CrowdScenarioConfig {
 CrowdScenarioConfig Sim1Scenario();
 /// The `sim2` default: an open 20 m x 20 m area with 24 pedestrians in four loosely crossing flows.
 CrowdScenarioConfig Sim2Scenario();
+/// The `dataset` default: THOR run thor1 (../shared/data/thor) replayed with 3 overlaid 60 s windows
+/// 60 s apart on the room's map (extent x in [-11, 12], y in [-10, 13.5]); the robot crosses the room
+/// diagonally from (-3.5, -3) to (3.5, 5.5), past the central obstacle.
+CrowdScenarioConfig DatasetScenario();
 
 /// One pedestrian at the crowd's current time.
 struct CrowdAgent {

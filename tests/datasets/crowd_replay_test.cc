@@ -207,15 +207,19 @@ TEST(CrowdReplay, RealThorRunReplaysOnFreeSpaceAtWalkingSpeed) {
   if (root.empty()) GTEST_SKIP() << "thor/thor1_exp-1-run-2.csv not found under $FORESIGHT_DATA or ../shared/data";
   const TrackSet raw = ReadThorTracks(root + "/thor/thor1_exp-1-run-2.csv");
   EXPECT_EQ(raw.tracks.size(), 87u);  // README
-  CrowdScenarioConfig s;
-  s.name = "dataset";
-  s.source = CrowdSource::kReplay;
-  s.extent = {-11, 12, -10, 13.5};
-  s.robot_start = {-4, -4, 0};
-  s.robot_goal = {4, 4};
+  CrowdScenarioConfig s = DatasetScenario();
   s.replay.root = root;
-  ReplayCrowd crowd(s, 1);
-  const OccupancyRaster map = ReplayOccupancy(s, 0.1);
+  const std::unique_ptr<Crowd> crowd_ptr = MakeCrowd(s, 1);
+  Crowd& crowd = *crowd_ptr;
+  const OccupancyRaster map = ScenarioOccupancy(s, 0.1);
+  // The default robot start and goal are free (robot disc with the start jitter).
+  const OccupancyRaster fine = ScenarioOccupancy(s, 0.05);
+  for (const auto& pt : {s.robot_start, s.robot_goal})
+    for (double dx = -0.7; dx <= 0.7; dx += 0.05)
+      for (double dy = -0.7; dy <= 0.7; dy += 0.05)
+        if (std::hypot(dx, dy) <= s.robot_radius + std::sqrt(2.0) * s.start_jitter) {
+          EXPECT_FALSE(fine.Occupied(pt[0] + dx, pt[1] + dy)) << pt[0] + dx << ", " << pt[1] + dy;
+        }
   int samples = 0, on_free = 0, max_active = 0;
   std::vector<double> speeds;
   for (int k = 0; k < 600; ++k) {
