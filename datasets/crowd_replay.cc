@@ -25,29 +25,35 @@ struct Sample {
 
 double Field(const std::string& text, const std::string& path, int line, const char* what) {
   std::string trimmed = text;
-  while (!trimmed.empty() && std::isspace(static_cast<unsigned char>(trimmed.back()))) trimmed.pop_back();
+  while (!trimmed.empty() && std::isspace(static_cast<unsigned char>(trimmed.back())))
+    trimmed.pop_back();
   std::size_t start = 0;
-  while (start < trimmed.size() && std::isspace(static_cast<unsigned char>(trimmed[start]))) ++start;
+  while (start < trimmed.size() && std::isspace(static_cast<unsigned char>(trimmed[start])))
+    ++start;
   trimmed = trimmed.substr(start);
   const std::optional<double> v = ParseDouble(trimmed);
-  FS_THROW_UNLESS(v && std::isfinite(*v), path, ":", line, ": ", what, " '", trimmed, "' is not a finite number");
+  FS_THROW_UNLESS(v && std::isfinite(*v), path, ":", line, ": ", what, " '", trimmed,
+                  "' is not a finite number");
   return *v;
 }
 
 /// Sorted samples per id -> raw tracks; a time given twice for one id is an error.
-TrackSet ToTracks(std::map<std::int64_t, std::vector<Sample>> by_id, const std::string& path, double nominal_step) {
+TrackSet ToTracks(std::map<std::int64_t, std::vector<Sample>> by_id, const std::string& path,
+                  double nominal_step) {
   TrackSet set;
   set.source = path;
   set.seconds_per_step = nominal_step;
   for (auto& [id, samples] : by_id) {
-    std::stable_sort(samples.begin(), samples.end(), [](const Sample& a, const Sample& b) { return a.t < b.t; });
+    std::stable_sort(samples.begin(), samples.end(),
+                     [](const Sample& a, const Sample& b) { return a.t < b.t; });
     Track tr;
     tr.agent_id = id;
     tr.positions.resize(static_cast<Eigen::Index>(samples.size()), 2);
     for (std::size_t i = 0; i < samples.size(); ++i) {
       if (i > 0)
         FS_THROW_UNLESS(samples[i].t > samples[i - 1].t, path, ":", samples[i].line, ": agent ", id,
-                        " has two samples at time ", samples[i].t, " (also line ", samples[i - 1].line, ")");
+                        " has two samples at time ", samples[i].t, " (also line ",
+                        samples[i - 1].line, ")");
       tr.time.push_back(samples[i].t);
       tr.positions(static_cast<Eigen::Index>(i), 0) = samples[i].x;
       tr.positions(static_cast<Eigen::Index>(i), 1) = samples[i].y;
@@ -59,15 +65,18 @@ TrackSet ToTracks(std::map<std::int64_t, std::vector<Sample>> by_id, const std::
 }
 
 OccupancyRaster EmptyRaster(const Eigen::Vector4d& extent, double resolution) {
-  FS_THROW_UNLESS(std::isfinite(resolution) && resolution > 0, "occupancy raster: resolution must be positive, got ",
-                  resolution);
-  FS_THROW_UNLESS(extent[1] > extent[0] && extent[3] > extent[2], "occupancy raster: empty extent [", extent[0], ", ",
-                  extent[1], ", ", extent[2], ", ", extent[3], "]");
+  FS_THROW_UNLESS(std::isfinite(resolution) && resolution > 0,
+                  "occupancy raster: resolution must be positive, got ", resolution);
+  FS_THROW_UNLESS(extent[1] > extent[0] && extent[3] > extent[2],
+                  "occupancy raster: empty extent [", extent[0], ", ", extent[1], ", ", extent[2],
+                  ", ", extent[3], "]");
   OccupancyRaster r;
   r.extent = extent;
   r.resolution = resolution;
-  const auto cols = static_cast<Eigen::Index>(std::ceil((extent[1] - extent[0]) / resolution - 1e-9));
-  const auto rows = static_cast<Eigen::Index>(std::ceil((extent[3] - extent[2]) / resolution - 1e-9));
+  const auto cols =
+      static_cast<Eigen::Index>(std::ceil((extent[1] - extent[0]) / resolution - 1e-9));
+  const auto rows =
+      static_cast<Eigen::Index>(std::ceil((extent[3] - extent[2]) / resolution - 1e-9));
   r.cells.setZero(rows, cols);
   return r;
 }
@@ -99,12 +108,14 @@ TrackSet ReadThorTracks(const std::string& path) {
     std::vector<std::string> f;
     std::stringstream ss(line);
     for (std::string cell; std::getline(ss, cell, ',');) f.push_back(cell);
-    FS_THROW_UNLESS(f.size() == 6, path, ":", number,
-                    ": expected 6 comma-separated fields (time, person_id, x, y, velocity, motion_angle), got ",
-                    f.size());
+    FS_THROW_UNLESS(
+        f.size() == 6, path, ":", number,
+        ": expected 6 comma-separated fields (time, person_id, x, y, velocity, motion_angle), got ",
+        f.size());
     const double t = Field(f[0], path, number, "time");
     const double id = Field(f[1], path, number, "person_id");
-    FS_THROW_UNLESS(id == std::floor(id), path, ":", number, ": person_id '", f[1], "' is not an integer");
+    FS_THROW_UNLESS(id == std::floor(id), path, ":", number, ": person_id '", f[1],
+                    "' is not an integer");
     by_id[static_cast<std::int64_t>(id)].push_back(
         {t, Field(f[2], path, number, "x"), Field(f[3], path, number, "y"), number});
   }
@@ -129,7 +140,8 @@ TrackSet ReadEthObsmat(const std::string& path, double annotation_step) {
     for (std::string t; is >> t;) f.push_back(t);
     if (f.empty()) continue;
     FS_THROW_UNLESS(f.size() == 8, path, ":", number,
-                    ": expected 8 fields (frame ped_id pos_x pos_z pos_y v_x v_z v_y), got ", f.size());
+                    ": expected 8 fields (frame ped_id pos_x pos_z pos_y v_x v_z v_y), got ",
+                    f.size());
     const double frame = Field(f[0], path, number, "frame");
     const double id = Field(f[1], path, number, "ped_id");
     FS_THROW_UNLESS(id == std::floor(id) && frame == std::floor(frame), path, ":", number,
@@ -158,7 +170,8 @@ TrackSet ReadEthObsmat(const std::string& path, double annotation_step) {
 }
 
 TrackSet ResampleTracks(const TrackSet& raw, double step, double max_gap) {
-  FS_THROW_UNLESS(std::isfinite(step) && step > 0, "ResampleTracks: step must be positive, got ", step);
+  FS_THROW_UNLESS(std::isfinite(step) && step > 0, "ResampleTracks: step must be positive, got ",
+                  step);
   TrackSet out;
   out.source = raw.source;
   out.seconds_per_step = step;
@@ -214,9 +227,11 @@ Eigen::Matrix3d ReadHomography(const std::string& path) {
   return H;
 }
 
-OccupancyRaster ThorMapRaster(const std::string& image_path, const Eigen::Vector4d& extent, double resolution) {
+OccupancyRaster ThorMapRaster(const std::string& image_path, const Eigen::Vector4d& extent,
+                              double resolution) {
   const cv::Mat img = ReadGrey(image_path);
-  constexpr double kPixel = 0.01, kXMin = -11.0, kYMax = 13.5;  // README: 0.01 m/px, x in [-11, 12], y <= 13.5
+  constexpr double kPixel = 0.01, kXMin = -11.0,
+                   kYMax = 13.5;  // README: 0.01 m/px, x in [-11, 12], y <= 13.5
   OccupancyRaster r = EmptyRaster(extent, resolution);
   for (Eigen::Index row = 0; row < r.cells.rows(); ++row)
     for (Eigen::Index c = 0; c < r.cells.cols(); ++c) {
@@ -233,8 +248,8 @@ OccupancyRaster ThorMapRaster(const std::string& image_path, const Eigen::Vector
   return r;
 }
 
-OccupancyRaster EthMapRaster(const std::string& image_path, const Eigen::Matrix3d& H, const Eigen::Vector4d& extent,
-                             double resolution) {
+OccupancyRaster EthMapRaster(const std::string& image_path, const Eigen::Matrix3d& H,
+                             const Eigen::Vector4d& extent, double resolution) {
   const cv::Mat img = ReadGrey(image_path);
   const Eigen::Matrix3d H_inv = H.inverse();
   OccupancyRaster r = EmptyRaster(extent, resolution);
@@ -265,9 +280,12 @@ OccupancyRaster EthMapRaster(const std::string& image_path, const Eigen::Matrix3
 TrackSet ReadReplayTracks(const ReplayConfig& replay) {
   const std::string file = ResolveDataFile(replay.root, replay.file);
   TrackSet raw;
-  if (replay.format == "thor") raw = ReadThorTracks(file);
-  else if (replay.format == "eth_obsmat") raw = ReadEthObsmat(file);
-  else Fail("replay.format: unknown track format '", replay.format, "' (expected thor or eth_obsmat)");
+  if (replay.format == "thor")
+    raw = ReadThorTracks(file);
+  else if (replay.format == "eth_obsmat")
+    raw = ReadEthObsmat(file);
+  else
+    Fail("replay.format: unknown track format '", replay.format, "' (expected thor or eth_obsmat)");
   return ResampleTracks(raw, replay.step, 1.0);
 }
 
@@ -277,9 +295,11 @@ OccupancyRaster ReplayOccupancy(const CrowdScenarioConfig& s, double resolution)
   const std::string image = ResolveDataFile(rc.root, rc.map_image);
   if (rc.format == "thor") return ThorMapRaster(image, extent, resolution);
   if (rc.format == "eth_obsmat") {
-    const std::string h = rc.homography.empty()
-                              ? (std::filesystem::path(ResolveDataFile(rc.root, rc.file)).parent_path() / "H.txt").string()
-                              : ResolveDataFile(rc.root, rc.homography);
+    const std::string h =
+        rc.homography.empty()
+            ? (std::filesystem::path(ResolveDataFile(rc.root, rc.file)).parent_path() / "H.txt")
+                  .string()
+            : ResolveDataFile(rc.root, rc.homography);
     return EthMapRaster(image, ReadHomography(h), extent, resolution);
   }
   Fail("replay.format: unknown track format '", rc.format, "' (expected thor or eth_obsmat)");
@@ -290,14 +310,17 @@ ReplayCrowd::ReplayCrowd(const CrowdScenarioConfig& scenario, std::uint64_t seed
   Init(ReadReplayTracks(scenario.replay), scenario.replay, scenario.pedestrian_radius, seed);
 }
 
-ReplayCrowd::ReplayCrowd(const TrackSet& resampled, const ReplayConfig& replay, double radius, std::uint64_t seed) {
+ReplayCrowd::ReplayCrowd(const TrackSet& resampled, const ReplayConfig& replay, double radius,
+                         std::uint64_t seed) {
   Init(resampled, replay, radius, seed);
 }
 
-void ReplayCrowd::Init(const TrackSet& tracks, const ReplayConfig& rc, double radius, std::uint64_t seed) {
+void ReplayCrowd::Init(const TrackSet& tracks, const ReplayConfig& rc, double radius,
+                       std::uint64_t seed) {
   step_ = rc.step;
   duration_ = rc.duration;
-  FS_THROW_UNLESS(!tracks.tracks.empty(), "replay: ", tracks.source, " has no track of two or more samples");
+  FS_THROW_UNLESS(!tracks.tracks.empty(), "replay: ", tracks.source,
+                  " has no track of two or more samples");
   double t_first = tracks.tracks.front().time.front(), t_last = t_first;
   for (const Track& tr : tracks.tracks) {
     t_first = std::min(t_first, tr.time.front());
@@ -341,7 +364,8 @@ void ReplayCrowd::Update() {
     const Eigen::Index n = p.positions.rows();
     const double u = (time_ - p.t0) / step_;
     a.active = u >= -1e-9 && u <= static_cast<double>(n - 1) + 1e-9;
-    const Eigen::Index k = std::clamp<Eigen::Index>(static_cast<Eigen::Index>(std::floor(u)), 0, n - 2);
+    const Eigen::Index k =
+        std::clamp<Eigen::Index>(static_cast<Eigen::Index>(std::floor(u)), 0, n - 2);
     const double w = std::clamp(u - static_cast<double>(k), 0.0, 1.0);
     a.position = ((1 - w) * p.positions.row(k) + w * p.positions.row(k + 1)).transpose();
     a.velocity = ((p.positions.row(k + 1) - p.positions.row(k)) / step_).transpose();
@@ -350,7 +374,8 @@ void ReplayCrowd::Update() {
 }
 
 void ReplayCrowd::Step(double dt, const RobotAgent&) {
-  FS_THROW_UNLESS(std::isfinite(dt) && dt > 0, "Crowd::Step: dt must be a positive finite number, got ", dt);
+  FS_THROW_UNLESS(std::isfinite(dt) && dt > 0,
+                  "Crowd::Step: dt must be a positive finite number, got ", dt);
   time_ += dt;
   Update();
 }

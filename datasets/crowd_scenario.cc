@@ -22,14 +22,15 @@ std::string Join(const std::vector<double>& v) {
 }
 
 /// A box [x_min, x_max, y_min, y_max] (degenerate allowed) inside `extent`.
-void CheckBox(const std::vector<double>& box, const std::vector<double>& extent, const std::string& where,
-              const std::string& key) {
+void CheckBox(const std::vector<double>& box, const std::vector<double>& extent,
+              const std::string& where, const std::string& key) {
   FS_THROW_UNLESS(box.size() == 4 && Finite(box), where, ": '", key,
                   "' must be 4 finite numbers [x_min, x_max, y_min, y_max], got ", Join(box));
   FS_THROW_UNLESS(box[0] <= box[1] && box[2] <= box[3], where, ": '", key, "' = ", Join(box),
                   " is malformed (x_min > x_max or y_min > y_max)");
-  FS_THROW_UNLESS(box[0] >= extent[0] && box[1] <= extent[1] && box[2] >= extent[2] && box[3] <= extent[3], where,
-                  ": '", key, "' = ", Join(box), " is not inside the extent ", Join(extent));
+  FS_THROW_UNLESS(
+      box[0] >= extent[0] && box[1] <= extent[1] && box[2] >= extent[2] && box[3] <= extent[3],
+      where, ": '", key, "' = ", Join(box), " is not inside the extent ", Join(extent));
 }
 
 }  // namespace
@@ -46,17 +47,19 @@ PowerLawParams PowerLawParams::Aggressive() {
 }
 
 void CrowdScenarioConfig::Validate(const std::string& where) const {
-  FS_THROW_UNLESS(extent.size() == 4 && Finite(extent), where, ": 'extent' must be 4 finite numbers ",
-                  "[x_min, x_max, y_min, y_max], got ", Join(extent));
-  FS_THROW_UNLESS(extent[0] < extent[1] && extent[2] < extent[3], where, ": 'extent' = ", Join(extent),
-                  " is empty (x_min >= x_max or y_min >= y_max)");
+  FS_THROW_UNLESS(extent.size() == 4 && Finite(extent), where,
+                  ": 'extent' must be 4 finite numbers ", "[x_min, x_max, y_min, y_max], got ",
+                  Join(extent));
+  FS_THROW_UNLESS(extent[0] < extent[1] && extent[2] < extent[3], where,
+                  ": 'extent' = ", Join(extent), " is empty (x_min >= x_max or y_min >= y_max)");
   FS_THROW_UNLESS(robot_start.size() == 3 && Finite(robot_start), where,
                   ": 'robot_start' must be [x, y, heading], got ", Join(robot_start));
-  FS_THROW_UNLESS(robot_goal.size() == 2 && Finite(robot_goal), where, ": 'robot_goal' must be [x, y], got ",
-                  Join(robot_goal));
+  FS_THROW_UNLESS(robot_goal.size() == 2 && Finite(robot_goal), where,
+                  ": 'robot_goal' must be [x, y], got ", Join(robot_goal));
   const double margin = robot_radius + start_jitter;
-  for (const auto& [key, pt] : {std::pair<const char*, const std::vector<double>*>{"robot_start", &robot_start},
-                                {"robot_goal", &robot_goal}}) {
+  for (const auto& [key, pt] :
+       {std::pair<const char*, const std::vector<double>*>{"robot_start", &robot_start},
+        {"robot_goal", &robot_goal}}) {
     const double x = (*pt)[0], y = (*pt)[1];
     FS_THROW_UNLESS(x - margin >= extent[0] && x + margin <= extent[1] && y - margin >= extent[2] &&
                         y + margin <= extent[3],
@@ -68,7 +71,8 @@ void CrowdScenarioConfig::Validate(const std::string& where) const {
                     "' has no pedestrian groups (empty crowd); add 'groups'");
     for (std::size_t g = 0; g < groups.size(); ++g) {
       const std::string key = "groups[" + std::to_string(g) + "]";
-      FS_THROW_UNLESS(groups[g].count >= 1, where, ": '", key, ".count' must be >= 1, got ", groups[g].count);
+      FS_THROW_UNLESS(groups[g].count >= 1, where, ": '", key, ".count' must be >= 1, got ",
+                      groups[g].count);
       CheckBox(groups[g].spawn, extent, where, key + ".spawn");
       CheckBox(groups[g].goal, extent, where, key + ".goal");
     }
@@ -76,21 +80,27 @@ void CrowdScenarioConfig::Validate(const std::string& where) const {
     for (std::size_t i = 0; i < walls.size(); ++i) {
       const WallSegment& w = walls[i];
       const std::string key = "walls[" + std::to_string(i) + "]";
-      FS_THROW_UNLESS(Finite({w.x0, w.y0, w.x1, w.y1}), where, ": '", key, "' has a non-finite coordinate");
+      FS_THROW_UNLESS(Finite({w.x0, w.y0, w.x1, w.y1}), where, ": '", key,
+                      "' has a non-finite coordinate");
       for (const auto& [x, y] : {std::pair<double, double>{w.x0, w.y0}, {w.x1, w.y1}})
-        FS_THROW_UNLESS(x >= extent[0] - tol && x <= extent[1] + tol && y >= extent[2] - tol && y <= extent[3] + tol,
-                        where, ": '", key, "' end (", x, ", ", y, ") is outside the extent ", Join(extent));
-      for (const auto& [key2, pt] : {std::pair<const char*, const std::vector<double>*>{"robot_start", &robot_start},
-                                     {"robot_goal", &robot_goal}}) {
+        FS_THROW_UNLESS(x >= extent[0] - tol && x <= extent[1] + tol && y >= extent[2] - tol &&
+                            y <= extent[3] + tol,
+                        where, ": '", key, "' end (", x, ", ", y, ") is outside the extent ",
+                        Join(extent));
+      for (const auto& [key2, pt] :
+           {std::pair<const char*, const std::vector<double>*>{"robot_start", &robot_start},
+            {"robot_goal", &robot_goal}}) {
         const double d = DistanceToSegment({(*pt)[0], (*pt)[1]}, {w.x0, w.y0}, {w.x1, w.y1});
-        FS_THROW_UNLESS(d >= robot_radius + 0.5 * wall_thickness, where, ": '", key2, "' = (", (*pt)[0], ", ",
-                        (*pt)[1], ") is in collision with '", key, "' (distance ", d, " m < robot radius ",
-                        robot_radius, " + half wall thickness ", 0.5 * wall_thickness, ")");
+        FS_THROW_UNLESS(d >= robot_radius + 0.5 * wall_thickness, where, ": '", key2, "' = (",
+                        (*pt)[0], ", ", (*pt)[1], ") is in collision with '", key, "' (distance ",
+                        d, " m < robot radius ", robot_radius, " + half wall thickness ",
+                        0.5 * wall_thickness, ")");
       }
     }
   } else {
-    FS_THROW_UNLESS(replay.format == "thor" || replay.format == "eth_obsmat", where, ": 'replay.format' = '",
-                    replay.format, "' is unknown (expected thor or eth_obsmat)");
+    FS_THROW_UNLESS(replay.format == "thor" || replay.format == "eth_obsmat", where,
+                    ": 'replay.format' = '", replay.format,
+                    "' is unknown (expected thor or eth_obsmat)");
     FS_THROW_UNLESS(!replay.file.empty(), where, ": 'replay.file' is empty");
     FS_THROW_UNLESS(!replay.map_image.empty(), where, ": 'replay.map_image' is empty");
     FS_THROW_UNLESS(replay.step > 0 && replay.duration > replay.step, where,
@@ -137,9 +147,10 @@ CrowdScenarioConfig Sim2Scenario() {
   g.preferred_speed = 0.9;
   g.speed_jitter = 0.1;
   g.round_trip = true;
-  const std::vector<double> west{-9.5, -6.5, -5, 5}, east{6.5, 9.5, -5, 5}, south{-5, 5, -9.5, -6.5},
-      north{-5, 5, 6.5, 9.5};
-  for (const auto& [from, to] : {std::pair{west, east}, {east, west}, {south, north}, {north, south}}) {
+  const std::vector<double> west{-9.5, -6.5, -5, 5}, east{6.5, 9.5, -5, 5},
+      south{-5, 5, -9.5, -6.5}, north{-5, 5, 6.5, 9.5};
+  for (const auto& [from, to] :
+       {std::pair{west, east}, {east, west}, {south, north}, {north, south}}) {
     g.spawn = from;
     g.goal = to;
     s.groups.push_back(g);
@@ -168,7 +179,8 @@ CrowdScenarioConfig DatasetScenario() {
 
 std::unique_ptr<Crowd> MakeCrowd(const CrowdScenarioConfig& scenario, std::uint64_t episode_seed) {
   scenario.Validate("crowd scenario '" + scenario.name + "'");
-  if (scenario.source == CrowdSource::kReplay) return std::make_unique<ReplayCrowd>(scenario, episode_seed);
+  if (scenario.source == CrowdSource::kReplay)
+    return std::make_unique<ReplayCrowd>(scenario, episode_seed);
   return std::make_unique<PowerLawCrowd>(scenario, episode_seed);
 }
 
@@ -197,13 +209,15 @@ bool OccupancyRaster::Occupied(double x, double y) const {
 OccupancyRaster ScenarioOccupancy(const CrowdScenarioConfig& s, double resolution) {
   s.Validate("crowd scenario '" + s.name + "'");
   if (s.source == CrowdSource::kReplay) return ReplayOccupancy(s, resolution);
-  FS_THROW_UNLESS(std::isfinite(resolution) && resolution > 0, "ScenarioOccupancy: resolution must be positive, got ",
-                  resolution);
+  FS_THROW_UNLESS(std::isfinite(resolution) && resolution > 0,
+                  "ScenarioOccupancy: resolution must be positive, got ", resolution);
   OccupancyRaster r;
   r.extent = Eigen::Vector4d(s.extent[0], s.extent[1], s.extent[2], s.extent[3]);
   r.resolution = resolution;
-  const auto cols = static_cast<Eigen::Index>(std::ceil((s.extent[1] - s.extent[0]) / resolution - 1e-9));
-  const auto rows = static_cast<Eigen::Index>(std::ceil((s.extent[3] - s.extent[2]) / resolution - 1e-9));
+  const auto cols =
+      static_cast<Eigen::Index>(std::ceil((s.extent[1] - s.extent[0]) / resolution - 1e-9));
+  const auto rows =
+      static_cast<Eigen::Index>(std::ceil((s.extent[3] - s.extent[2]) / resolution - 1e-9));
   r.cells.setZero(rows, cols);
   // A cell is a wall when its centre is within half the thickness (plus half a cell) of a segment.
   const double reach = 0.5 * s.wall_thickness + 0.5 * resolution;
@@ -220,11 +234,12 @@ OccupancyRaster ScenarioOccupancy(const CrowdScenarioConfig& s, double resolutio
   return r;
 }
 
-TrackSet RecordCrowdTracks(const CrowdScenarioConfig& scenario, int episodes, double duration, double step,
-                           std::uint64_t seed) {
+TrackSet RecordCrowdTracks(const CrowdScenarioConfig& scenario, int episodes, double duration,
+                           double step, std::uint64_t seed) {
   FS_THROW_UNLESS(episodes >= 1, "RecordCrowdTracks: episodes must be >= 1, got ", episodes);
   FS_THROW_UNLESS(std::isfinite(step) && step > 0 && std::isfinite(duration) && duration >= step,
-                  "RecordCrowdTracks: need 0 < step <= duration, got step ", step, ", duration ", duration);
+                  "RecordCrowdTracks: need 0 < step <= duration, got step ", step, ", duration ",
+                  duration);
   TrackSet set;
   set.source = "crowd:" + scenario.name;
   set.seconds_per_step = step;
@@ -233,7 +248,8 @@ TrackSet RecordCrowdTracks(const CrowdScenarioConfig& scenario, int episodes, do
   const int samples = static_cast<int>(std::floor(duration / step + 1e-9)) + 1;
   std::int64_t next_id = 0;
   for (int e = 0; e < episodes; ++e) {
-    const std::unique_ptr<Crowd> crowd = MakeCrowd(scenario, seed * 1000003ULL + static_cast<std::uint64_t>(e));
+    const std::unique_ptr<Crowd> crowd =
+        MakeCrowd(scenario, seed * 1000003ULL + static_cast<std::uint64_t>(e));
     const std::size_t n = crowd->agents().size();
     // Per agent: the track piece being recorded (consecutive active samples).
     std::vector<Track> open(n);
@@ -253,7 +269,8 @@ TrackSet RecordCrowdTracks(const CrowdScenarioConfig& scenario, int episodes, do
         if (!a.active) {
           if (!points[i].empty()) {
             open[i].positions.resize(static_cast<Eigen::Index>(points[i].size()), 2);
-            for (std::size_t j = 0; j < points[i].size(); ++j) open[i].positions.row(j) = points[i][j].transpose();
+            for (std::size_t j = 0; j < points[i].size(); ++j)
+              open[i].positions.row(j) = points[i][j].transpose();
             points[i].clear();
           }
           close(i);
@@ -265,7 +282,8 @@ TrackSet RecordCrowdTracks(const CrowdScenarioConfig& scenario, int episodes, do
     }
     for (std::size_t i = 0; i < n; ++i) {
       open[i].positions.resize(static_cast<Eigen::Index>(points[i].size()), 2);
-      for (std::size_t j = 0; j < points[i].size(); ++j) open[i].positions.row(j) = points[i][j].transpose();
+      for (std::size_t j = 0; j < points[i].size(); ++j)
+        open[i].positions.row(j) = points[i][j].transpose();
       close(i);
     }
   }

@@ -1,8 +1,8 @@
 #pragma once
-/// Crowd scenarios for anticipatory navigation (SPAN, thesis ch. 5): a YAML-configured scene (extent,
-/// walls, pedestrian groups, robot start and goal) whose crowd is either simulated with the power-law
-/// model (Karamouzas, Skinner, Guy, PRL 2014; pedestrians react to the robot) or replayed from
-/// recorded tracks (THOR, ETH obsmat; replayed pedestrians do not react).
+/// Crowd scenarios for anticipatory navigation (SPAN, thesis ch. 5): a YAML-configured scene
+/// (extent, walls, pedestrian groups, robot start and goal) whose crowd is either simulated with
+/// the power-law model (Karamouzas, Skinner, Guy, PRL 2014; pedestrians react to the robot) or
+/// replayed from recorded tracks (THOR, ETH obsmat; replayed pedestrians do not react).
 ///
 /// Frames: every position is in the scenario's world frame (metres), velocities in m/s.
 
@@ -31,20 +31,20 @@ struct WallSegment {
 
 /// Parameters of the force-based power-law model (Karamouzas, Skinner, Guy, "Universal power law
 /// governing pedestrian interactions", PRL 113, 238701, 2014). Defaults are the paper's / reference
-/// code's values (k 1.5, exponent 2, tau0 3 s, relaxation 0.54 s, max accel 20 m/s^2, neighbour 10 m)
-/// with the issue's maximum speed of 1 m/s.
+/// code's values (k 1.5, exponent 2, tau0 3 s, relaxation 0.54 s, max accel 20 m/s^2, neighbour 10
+/// m) with the issue's maximum speed of 1 m/s.
 struct PowerLawParams {
-  double k = 1.5;              ///< energy scale k (m^2/s^2 per unit mass)
-  double exponent = 2.0;       ///< power-law exponent of tau in E(tau) = k tau^-exponent exp(-tau/tau0)
-  double tau0 = 3.0;           ///< s, exponential cut-off of the interaction horizon
-  double relaxation = 0.54;    ///< s, goal-velocity relaxation time (xi of the PRL code)
-  double max_accel = 20.0;     ///< m/s^2, cap on |dv/dt|
-  double max_speed = 1.0;      ///< m/s, cap on |v|
-  double neighbor_dist = 10.0; ///< m, only neighbours (and walls) within this distance interact
-  double wall_k = 1.5;         ///< energy scale of the time-to-collision energy with walls
+  double k = 1.5;         ///< energy scale k (m^2/s^2 per unit mass)
+  double exponent = 2.0;  ///< power-law exponent of tau in E(tau) = k tau^-exponent exp(-tau/tau0)
+  double tau0 = 3.0;      ///< s, exponential cut-off of the interaction horizon
+  double relaxation = 0.54;     ///< s, goal-velocity relaxation time (xi of the PRL code)
+  double max_accel = 20.0;      ///< m/s^2, cap on |dv/dt|
+  double max_speed = 1.0;       ///< m/s, cap on |v|
+  double neighbor_dist = 10.0;  ///< m, only neighbours (and walls) within this distance interact
+  double wall_k = 1.5;          ///< energy scale of the time-to-collision energy with walls
   double wall_contact_stiffness = 50.0;  ///< 1/s^2, short-range push-out once a disc touches a wall
-  double tau_min = 0.05;       ///< s, tau is clamped below at this value (bounded forces)
-  double substep = 0.02;       ///< s, integration step inside Crowd::Step
+  double tau_min = 0.05;                 ///< s, tau is clamped below at this value (bounded forces)
+  double substep = 0.02;                 ///< s, integration step inside Crowd::Step
 
   template <class A>
   void Serialize(A* a) {
@@ -75,11 +75,12 @@ struct PowerLawParams {
 /// A group of pedestrians spawned in one box and walking to random points of another.
 struct PedestrianGroupConfig {
   int count = 1;
-  std::vector<double> spawn{-1, 1, -1, 1};  ///< x_min, x_max, y_min, y_max (m); degenerate = a point
-  std::vector<double> goal{-1, 1, -1, 1};   ///< x_min, x_max, y_min, y_max (m)
-  double preferred_speed = 1.0;             ///< m/s (capped by PowerLawParams::max_speed)
-  double speed_jitter = 0.1;                ///< m/s, uniform +- jitter of each pedestrian's speed
-  double radius = 0.0;                      ///< m, 0 = CrowdScenarioConfig::pedestrian_radius
+  std::vector<double> spawn{-1, 1, -1,
+                            1};            ///< x_min, x_max, y_min, y_max (m); degenerate = a point
+  std::vector<double> goal{-1, 1, -1, 1};  ///< x_min, x_max, y_min, y_max (m)
+  double preferred_speed = 1.0;            ///< m/s (capped by PowerLawParams::max_speed)
+  double speed_jitter = 0.1;               ///< m/s, uniform +- jitter of each pedestrian's speed
+  double radius = 0.0;                     ///< m, 0 = CrowdScenarioConfig::pedestrian_radius
   /// On reaching the goal, walk back to a new point of the spawn box (and so on), so the density
   /// persists; otherwise stop at the goal (the pedestrian stays, as an obstacle).
   bool round_trip = true;
@@ -89,7 +90,8 @@ struct PedestrianGroupConfig {
     a->Visit("count", &count, config::Range::AtLeast(1), "number of pedestrians");
     a->Visit("spawn", &spawn, config::Range::Any(), "spawn box [x_min, x_max, y_min, y_max] (m)");
     a->Visit("goal", &goal, config::Range::Any(), "goal box [x_min, x_max, y_min, y_max] (m)");
-    a->Visit("preferred_speed", &preferred_speed, config::Range::Positive(), "preferred speed (m/s)");
+    a->Visit("preferred_speed", &preferred_speed, config::Range::Positive(),
+             "preferred speed (m/s)");
     a->Visit("speed_jitter", &speed_jitter, config::Range::NonNegative(),
              "uniform +- jitter of the preferred speed per pedestrian (m/s)");
     a->Visit("radius", &radius, config::Range::NonNegative(),
@@ -106,10 +108,10 @@ struct ReplayConfig {
   std::string format = "thor";  ///< thor | eth_obsmat
   std::string file = "thor/thor1_exp-1-run-2.csv";
   std::string map_image = "thor/maps/thor1.png";
-  std::string homography;       ///< eth_obsmat: H.txt (image -> world); empty = H.txt beside `file`
-  std::string root;             ///< data root for relative names; empty = datasets/data_root.h default
-  double step = 0.1;            ///< s, tracks are interpolated to this step
-  int overlays = 3;             ///< number of time windows overlaid
+  std::string homography;  ///< eth_obsmat: H.txt (image -> world); empty = H.txt beside `file`
+  std::string root;        ///< data root for relative names; empty = datasets/data_root.h default
+  double step = 0.1;       ///< s, tracks are interpolated to this step
+  int overlays = 3;        ///< number of time windows overlaid
   double overlay_spacing = 60;  ///< s between the starts of overlaid windows
   double duration = 60;         ///< s, length of each window
 
@@ -157,9 +159,11 @@ struct CrowdScenarioConfig {
     a->Visit("walls", &walls, config::Range::Any(), "wall segments (simulated scenes)");
     a->Visit("wall_thickness", &wall_thickness, config::Range::Positive(), "wall thickness (m)");
     a->Visit("groups", &groups, config::Range::Any(), "pedestrian groups (simulated scenes)");
-    a->Visit("pedestrian_radius", &pedestrian_radius, config::Range::Positive(), "pedestrian radius (m)");
+    a->Visit("pedestrian_radius", &pedestrian_radius, config::Range::Positive(),
+             "pedestrian radius (m)");
     a->Visit("power_law", &power_law, config::Range::Any(), "power-law model parameters");
-    a->Visit("robot_start", &robot_start, config::Range::Any(), "robot start [x, y, heading] (m, rad)");
+    a->Visit("robot_start", &robot_start, config::Range::Any(),
+             "robot start [x, y, heading] (m, rad)");
     a->Visit("robot_goal", &robot_goal, config::Range::Any(), "robot goal [x, y] (m)");
     a->Visit("robot_radius", &robot_radius, config::Range::Positive(), "robot radius (m)");
     a->Visit("start_jitter", &start_jitter, config::Range::NonNegative(),
@@ -167,9 +171,9 @@ struct CrowdScenarioConfig {
     a->Visit("replay", &replay, config::Range::Any(), "replayed tracks (source: replay)");
   }
 
-  /// Throws foresight::Error naming `where` (a file or config path) for inconsistent scenes: malformed
-  /// extent or boxes, start/goal outside the extent or inside a wall, walls outside the extent, a
-  /// simulated scene without pedestrians, an unknown replay format.
+  /// Throws foresight::Error naming `where` (a file or config path) for inconsistent scenes:
+  /// malformed extent or boxes, start/goal outside the extent or inside a wall, walls outside the
+  /// extent, a simulated scene without pedestrians, an unknown replay format.
   void Validate(const std::string& where) const;
 };
 
@@ -179,9 +183,9 @@ struct CrowdScenarioConfig {
 CrowdScenarioConfig Sim1Scenario();
 /// The `sim2` default: an open 20 m x 20 m area with 24 pedestrians in four loosely crossing flows.
 CrowdScenarioConfig Sim2Scenario();
-/// The `dataset` default: THOR run thor1 (../shared/data/thor) replayed with 3 overlaid 60 s windows
-/// 60 s apart on the room's map (extent x in [-11, 12], y in [-10, 13.5]); the robot crosses the room
-/// diagonally from (-3.5, -3) to (3.5, 5.5), past the central obstacle.
+/// The `dataset` default: THOR run thor1 (../shared/data/thor) replayed with 3 overlaid 60 s
+/// windows 60 s apart on the room's map (extent x in [-11, 12], y in [-10, 13.5]); the robot
+/// crosses the room diagonally from (-3.5, -3) to (3.5, 5.5), past the central obstacle.
 CrowdScenarioConfig DatasetScenario();
 
 /// One pedestrian at the crowd's current time.
@@ -189,7 +193,7 @@ struct CrowdAgent {
   std::int64_t id = 0;
   Eigen::Vector2d position = Eigen::Vector2d::Zero();  ///< m, world
   Eigen::Vector2d velocity = Eigen::Vector2d::Zero();  ///< m/s, world
-  double radius = 0.4;                                  ///< m
+  double radius = 0.4;                                 ///< m
   bool active = true;  ///< replay: the track covers the current time; simulated: always true
 };
 
@@ -220,7 +224,8 @@ struct EpisodeEndpoints {
   Eigen::Vector3d start;
   Eigen::Vector2d goal;
 };
-EpisodeEndpoints MakeEpisodeEndpoints(const CrowdScenarioConfig& scenario, std::uint64_t episode_seed);
+EpisodeEndpoints MakeEpisodeEndpoints(const CrowdScenarioConfig& scenario,
+                                      std::uint64_t episode_seed);
 
 /// Static occupancy of the scenario as a raster (row 0 = y_max, col 0 = x_min, 1 = occupied).
 struct OccupancyRaster {
@@ -237,7 +242,7 @@ OccupancyRaster ScenarioOccupancy(const CrowdScenarioConfig& scenario, double re
 
 /// Tracks of simulated pedestrians (no robot) for training the SPAN predictor: `episodes` seeded
 /// runs of `duration` s sampled every `step` s. One track per pedestrian and episode (ids unique).
-TrackSet RecordCrowdTracks(const CrowdScenarioConfig& scenario, int episodes, double duration, double step,
-                           std::uint64_t seed);
+TrackSet RecordCrowdTracks(const CrowdScenarioConfig& scenario, int episodes, double duration,
+                           double step, std::uint64_t seed);
 
 }  // namespace foresight

@@ -52,8 +52,8 @@ BodyContact Body(const Eigen::Vector2d& x, const SimWall& w) {
 }
 
 /// Time to collision with the body of the segment (not its end caps), or inf.
-double BodyTimeToCollision(const Eigen::Vector2d& x, const Eigen::Vector2d& v, double r, const SimWall& w,
-                           BodyContact* contact) {
+double BodyTimeToCollision(const Eigen::Vector2d& x, const Eigen::Vector2d& v, double r,
+                           const SimWall& w, BodyContact* contact) {
   const BodyContact b = Body(x, w);
   if (!b.valid) return kInf;
   const double approach = -v.dot(b.n);
@@ -98,8 +98,8 @@ double PowerLawEnergy(double tau, double k, double exponent, double tau0) {
   return k * std::pow(tau, -exponent) * std::exp(-tau / tau0);
 }
 
-Eigen::Vector2d PowerLawInteractionForce(const Eigen::Vector2d& x, const Eigen::Vector2d& v, double r, double k,
-                                         const PowerLawParams& p) {
+Eigen::Vector2d PowerLawInteractionForce(const Eigen::Vector2d& x, const Eigen::Vector2d& v,
+                                         double r, double k, const PowerLawParams& p) {
   const double dist2 = x.squaredNorm();
   if (dist2 < 1e-18) return Eigen::Vector2d::Zero();
   if (dist2 < r * r) r = 0.99 * std::sqrt(dist2);  // overlap: the reference code's effective radius
@@ -115,8 +115,8 @@ Eigen::Vector2d PowerLawInteractionForce(const Eigen::Vector2d& x, const Eigen::
   return -ForceFactor(tau, k, p) * (v + (b * v - a * x) / sd) / a;
 }
 
-double DistanceToSegment(const Eigen::Vector2d& x, const Eigen::Vector2d& p, const Eigen::Vector2d& q,
-                         Eigen::Vector2d* closest) {
+double DistanceToSegment(const Eigen::Vector2d& x, const Eigen::Vector2d& p,
+                         const Eigen::Vector2d& q, Eigen::Vector2d* closest) {
   const Eigen::Vector2d d = q - p;
   const double l2 = d.squaredNorm();
   const double t = l2 > 0 ? std::clamp((x - p).dot(d) / l2, 0.0, 1.0) : 0.0;
@@ -125,14 +125,15 @@ double DistanceToSegment(const Eigen::Vector2d& x, const Eigen::Vector2d& p, con
   return (x - c).norm();
 }
 
-double WallTimeToCollision(const Eigen::Vector2d& x, const Eigen::Vector2d& v, double r, const SimWall& w) {
+double WallTimeToCollision(const Eigen::Vector2d& x, const Eigen::Vector2d& v, double r,
+                           const SimWall& w) {
   const double radius = r + w.half_thickness;
   double t = std::min(TimeToCollision(x - w.p, v, radius), TimeToCollision(x - w.q, v, radius));
   return std::min(t, BodyTimeToCollision(x, v, r, w, nullptr));
 }
 
-Eigen::Vector2d WallInteractionForce(const Eigen::Vector2d& x, const Eigen::Vector2d& v, double r, const SimWall& w,
-                                     const PowerLawParams& p) {
+Eigen::Vector2d WallInteractionForce(const Eigen::Vector2d& x, const Eigen::Vector2d& v, double r,
+                                     const SimWall& w, const PowerLawParams& p) {
   const double radius = r + w.half_thickness;
   BodyContact contact;
   const double t_body = BodyTimeToCollision(x, v, r, w, &contact);
@@ -150,7 +151,8 @@ Eigen::Vector2d WallInteractionForce(const Eigen::Vector2d& x, const Eigen::Vect
 
 std::vector<SimWall> ScenarioWalls(const CrowdScenarioConfig& s) {
   std::vector<SimWall> walls;
-  for (const auto& w : s.walls) walls.push_back({{w.x0, w.y0}, {w.x1, w.y1}, 0.5 * s.wall_thickness});
+  for (const auto& w : s.walls)
+    walls.push_back({{w.x0, w.y0}, {w.x1, w.y1}, 0.5 * s.wall_thickness});
   if (s.extent.size() == 4) {
     const double x0 = s.extent[0], x1 = s.extent[1], y0 = s.extent[2], y1 = s.extent[3];
     walls.push_back({{x0, y0}, {x1, y0}, 0});
@@ -166,7 +168,8 @@ PowerLawCrowd::PowerLawCrowd(const CrowdScenarioConfig& scenario, std::uint64_t 
     : scenario_(scenario), walls_(ScenarioWalls(scenario)), rng_(seed) {
   const PowerLawParams& p = scenario_.power_law;
   const Eigen::Vector2d robot_start(scenario_.robot_start[0], scenario_.robot_start[1]);
-  const double robot_clearance = scenario_.robot_radius + 0.2 + std::sqrt(2.0) * scenario_.start_jitter;
+  const double robot_clearance =
+      scenario_.robot_radius + 0.2 + std::sqrt(2.0) * scenario_.start_jitter;
   std::uniform_real_distribution<double> u01(0.0, 1.0);
   for (std::size_t g = 0; g < scenario_.groups.size(); ++g) {
     const PedestrianGroupConfig& group = scenario_.groups[g];
@@ -184,9 +187,10 @@ PowerLawCrowd::PowerLawCrowd(const CrowdScenarioConfig& scenario, std::uint64_t 
           placed = DistanceToSegment(pos, w.p, w.q) >= r + w.half_thickness;
         }
       }
-      FS_THROW_UNLESS(placed, "crowd scenario '", scenario_.name, "': groups[", g, "] cannot place pedestrian ",
-                      k + 1, " of ", group.count, " of radius ", r,
-                      " in its spawn box without overlapping another pedestrian, a wall or the robot start");
+      FS_THROW_UNLESS(
+          placed, "crowd scenario '", scenario_.name, "': groups[", g, "] cannot place pedestrian ",
+          k + 1, " of ", group.count, " of radius ", r,
+          " in its spawn box without overlapping another pedestrian, a wall or the robot start");
       CrowdAgent agent;
       agent.id = static_cast<std::int64_t>(agents_.size());
       agent.position = pos;
@@ -210,9 +214,16 @@ Eigen::Vector2d PowerLawCrowd::SampleBox(const std::vector<double>& box) {
 }
 
 std::vector<Eigen::Vector2d> PowerLawCrowd::Accelerations(const RobotAgent& robot) const {
+  std::vector<Eigen::Vector2d> out(agents_.size());
+  ComputeAccelerations(robot, &out);
+  return out;
+}
+
+void PowerLawCrowd::ComputeAccelerations(const RobotAgent& robot,
+                                         std::vector<Eigen::Vector2d>* accel) const {
   const PowerLawParams& p = scenario_.power_law;
   const double range2 = p.neighbor_dist * p.neighbor_dist;
-  std::vector<Eigen::Vector2d> out(agents_.size());
+  std::vector<Eigen::Vector2d>& out = *accel;
   for (std::size_t i = 0; i < agents_.size(); ++i) {
     const CrowdAgent& a = agents_[i];
     const State& st = state_[i];
@@ -227,12 +238,14 @@ std::vector<Eigen::Vector2d> PowerLawCrowd::Accelerations(const RobotAgent& robo
       if (j == i) continue;
       const Eigen::Vector2d x = a.position - agents_[j].position;
       if (x.squaredNorm() > range2) continue;
-      f += PowerLawInteractionForce(x, a.velocity - agents_[j].velocity, a.radius + agents_[j].radius, p.k, p);
+      f += PowerLawInteractionForce(x, a.velocity - agents_[j].velocity,
+                                    a.radius + agents_[j].radius, p.k, p);
     }
     if (robot.present) {
       const Eigen::Vector2d x = a.position - robot.position;
       if (x.squaredNorm() <= range2)
-        f += PowerLawInteractionForce(x, a.velocity - robot.velocity, a.radius + robot.radius, p.k, p);
+        f += PowerLawInteractionForce(x, a.velocity - robot.velocity, a.radius + robot.radius, p.k,
+                                      p);
     }
     for (const SimWall& w : walls_) {
       Eigen::Vector2d closest;
@@ -244,12 +257,11 @@ std::vector<Eigen::Vector2d> PowerLawCrowd::Accelerations(const RobotAgent& robo
     }
     out[i] = f;
   }
-  return out;
 }
 
 void PowerLawCrowd::Substep(double h, const RobotAgent& robot) {
   const PowerLawParams& p = scenario_.power_law;
-  accel_ = Accelerations(robot);
+  ComputeAccelerations(robot, &accel_);  // no allocation per substep
   for (std::size_t i = 0; i < agents_.size(); ++i) {
     CrowdAgent& a = agents_[i];
     a.velocity = CapNorm(a.velocity + h * CapNorm(accel_[i], p.max_accel), p.max_speed);
@@ -261,7 +273,8 @@ void PowerLawCrowd::Substep(double h, const RobotAgent& robot) {
       const double d = DistanceToSegment(a.position, w.p, w.q, &closest);
       const double radius = a.radius + w.half_thickness;
       if (d >= radius) continue;
-      Eigen::Vector2d n = d > 1e-9 ? Eigen::Vector2d((a.position - closest) / d) : Eigen::Vector2d::Zero();
+      Eigen::Vector2d n =
+          d > 1e-9 ? Eigen::Vector2d((a.position - closest) / d) : Eigen::Vector2d::Zero();
       if (d <= 1e-9) {
         const BodyContact b = Body(previous, w);
         n = b.valid ? b.n : Eigen::Vector2d(1, 0);
@@ -286,7 +299,8 @@ void PowerLawCrowd::Substep(double h, const RobotAgent& robot) {
 }
 
 void PowerLawCrowd::Step(double dt, const RobotAgent& robot) {
-  FS_THROW_UNLESS(std::isfinite(dt) && dt > 0, "Crowd::Step: dt must be a positive finite number, got ", dt);
+  FS_THROW_UNLESS(std::isfinite(dt) && dt > 0,
+                  "Crowd::Step: dt must be a positive finite number, got ", dt);
   const int n = std::max(1, static_cast<int>(std::ceil(dt / scenario_.power_law.substep - 1e-9)));
   for (int s = 0; s < n; ++s) Substep(dt / n, robot);
   time_ += dt;
@@ -302,11 +316,12 @@ CrowdScenarioConfig ReadImplicitCrowdsScenario(const std::string& path) {
     std::vector<std::string> t = Tokens(line);  // '\r' of CRLF files is whitespace to >>
     if (!t.empty()) lines.emplace_back(number, std::move(t));
   }
-  FS_THROW_UNLESS(lines.size() >= 3, path, ": expected 'xmin xmax', 'ymin ymax' and the agent count, got ",
-                  lines.size(), " non-empty lines");
+  FS_THROW_UNLESS(lines.size() >= 3, path,
+                  ": expected 'xmin xmax', 'ymin ymax' and the agent count, got ", lines.size(),
+                  " non-empty lines");
   auto expect = [&](std::size_t i, std::size_t n, const char* what) {
-    FS_THROW_UNLESS(lines[i].second.size() == n, path, ":", lines[i].first, ": expected ", n, " fields (", what,
-                    "), got ", lines[i].second.size());
+    FS_THROW_UNLESS(lines[i].second.size() == n, path, ":", lines[i].first, ": expected ", n,
+                    " fields (", what, "), got ", lines[i].second.size());
   };
   expect(0, 2, "xmin xmax");
   expect(1, 2, "ymin ymax");
@@ -314,13 +329,16 @@ CrowdScenarioConfig ReadImplicitCrowdsScenario(const std::string& path) {
   CrowdScenarioConfig s;
   s.name = std::filesystem::path(path).stem().string();
   s.source = CrowdSource::kSimulated;
-  s.extent = {Number(lines[0].second[0], path, lines[0].first), Number(lines[0].second[1], path, lines[0].first),
-              Number(lines[1].second[0], path, lines[1].first), Number(lines[1].second[1], path, lines[1].first)};
+  s.extent = {Number(lines[0].second[0], path, lines[0].first),
+              Number(lines[0].second[1], path, lines[0].first),
+              Number(lines[1].second[0], path, lines[1].first),
+              Number(lines[1].second[1], path, lines[1].first)};
   const std::optional<long long> count = ParseInteger(lines[2].second[0]);
   FS_THROW_UNLESS(count && *count >= 1, path, ":", lines[2].first, ": '", lines[2].second[0],
                   "' is not a positive agent count");
-  FS_THROW_UNLESS(lines.size() == static_cast<std::size_t>(3 + *count), path, ": the header announces ", *count,
-                  " agents but the file has ", lines.size() - 3, " agent lines");
+  FS_THROW_UNLESS(lines.size() == static_cast<std::size_t>(3 + *count), path,
+                  ": the header announces ", *count, " agents but the file has ", lines.size() - 3,
+                  " agent lines");
   s.walls.clear();
   s.groups.clear();
   double max_speed = 0;
@@ -329,7 +347,8 @@ CrowdScenarioConfig ReadImplicitCrowdsScenario(const std::string& path) {
     const auto& [number, t] = lines[3 + a];
     std::vector<double> v;
     for (std::size_t f = 1; f < 7; ++f) v.push_back(Number(t[f], path, number));
-    FS_THROW_UNLESS(v[4] > 0 && v[5] > 0, path, ":", number, ": preferred speed and radius must be positive");
+    FS_THROW_UNLESS(v[4] > 0 && v[5] > 0, path, ":", number,
+                    ": preferred speed and radius must be positive");
     PedestrianGroupConfig g;
     g.count = 1;
     g.spawn = {v[0], v[0], v[1], v[1]};
@@ -358,15 +377,20 @@ PowerLawParams ReadImplicitCrowdsParameters(const std::string& path, PowerLawPar
     while (!line.empty() && (line.back() == '\r' || line.back() == ' ')) line.pop_back();
     if (line.empty() || line[0] == '#') continue;
     const auto eq = line.find('=');
-    FS_THROW_UNLESS(eq != std::string::npos, path, ":", number, ": expected key=value, got '", line, "'");
+    FS_THROW_UNLESS(eq != std::string::npos, path, ":", number, ": expected key=value, got '", line,
+                    "'");
     const std::string key = line.substr(0, eq);
     const double value = Number(line.substr(eq + 1), path, number);
-    if (key == "k") base.k = value;
-    else if (key == "p") base.exponent = value;
-    else if (key == "t0") base.tau0 = value;
-    else if (key == "neighborDist") base.neighbor_dist = value;
-    else if (key == "ksi" || key == "eps" || key == "repulsive" || key == "newtonIter" || key == "eps_x" ||
-             key == "lbfgsWindow")
+    if (key == "k")
+      base.k = value;
+    else if (key == "p")
+      base.exponent = value;
+    else if (key == "t0")
+      base.tau0 = value;
+    else if (key == "neighborDist")
+      base.neighbor_dist = value;
+    else if (key == "ksi" || key == "eps" || key == "repulsive" || key == "newtonIter" ||
+             key == "eps_x" || key == "lbfgsWindow")
       continue;  // implicit-integrator settings without a counterpart in the force-based model
     else
       Fail(path, ":", number, ": unknown key '", key, "'");

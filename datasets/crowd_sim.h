@@ -5,7 +5,8 @@
 ///
 /// Each pedestrian i (unit mass) feels
 ///   goal force     (v_pref * unit(g_i - x_i) - v_i) / relaxation
-///   interactions   -grad_{x_i} E(tau_ij),  E(tau) = k tau^-m exp(-tau/tau0)   (PRL eq. 1; m = exponent)
+///   interactions   -grad_{x_i} E(tau_ij),  E(tau) = k tau^-m exp(-tau/tau0)   (PRL eq. 1; m =
+///   exponent)
 /// where tau_ij is the time to collision of the discs i and j under constant velocities; other
 /// pedestrians and the robot count as neighbours within neighbor_dist. Walls (and the extent's
 /// border) interact through the same energy on the time to collision with the thick segment (scale
@@ -30,14 +31,14 @@ double TimeToCollision(const Eigen::Vector2d& x, const Eigen::Vector2d& v, doubl
 /// E(tau) = k tau^-m exp(-tau/tau0) (PRL 2014 eq. 1); 0 for tau = inf.
 double PowerLawEnergy(double tau, double k, double exponent, double tau0);
 
-/// -grad_x E(tau(x, v, r)) on agent i for relative position x = x_i - x_j and velocity v = v_i - v_j
-/// (the force of the PRL reference code). With a = v.v, b = x.v, c = x.x - r^2, d = b^2 - a c and
-/// tau = (-b - sqrt d)/a:  grad_x tau = -(v + (b v - a x)/sqrt d)/a,  dE/dtau = -E (m/tau + 1/tau0).
-/// Zero when there is no future collision. Overlapping discs use the effective radius 0.99 |x| (as
-/// the reference code) so that approaching overlaps are pushed apart; tau is clamped below at tau_min
-/// (the force magnitude then is that at tau_min).
-Eigen::Vector2d PowerLawInteractionForce(const Eigen::Vector2d& x, const Eigen::Vector2d& v, double r, double k,
-                                         const PowerLawParams& p);
+/// -grad_x E(tau(x, v, r)) on agent i for relative position x = x_i - x_j and velocity v = v_i -
+/// v_j (the force of the PRL reference code). With a = v.v, b = x.v, c = x.x - r^2, d = b^2 - a c
+/// and tau = (-b - sqrt d)/a:  grad_x tau = -(v + (b v - a x)/sqrt d)/a,  dE/dtau = -E (m/tau +
+/// 1/tau0). Zero when there is no future collision. Overlapping discs use the effective radius 0.99
+/// |x| (as the reference code) so that approaching overlaps are pushed apart; tau is clamped below
+/// at tau_min (the force magnitude then is that at tau_min).
+Eigen::Vector2d PowerLawInteractionForce(const Eigen::Vector2d& x, const Eigen::Vector2d& v,
+                                         double r, double k, const PowerLawParams& p);
 
 /// A wall for the simulator: segment p-q thickened by half_thickness on each side.
 struct SimWall {
@@ -45,16 +46,19 @@ struct SimWall {
   double half_thickness = 0;
 };
 
-/// Time to collision of a disc (centre x, velocity v, radius r) with a static thick segment, or +inf.
-double WallTimeToCollision(const Eigen::Vector2d& x, const Eigen::Vector2d& v, double r, const SimWall& w);
+/// Time to collision of a disc (centre x, velocity v, radius r) with a static thick segment, or
+/// +inf.
+double WallTimeToCollision(const Eigen::Vector2d& x, const Eigen::Vector2d& v, double r,
+                           const SimWall& w);
 /// -grad_x of wall_k tau^-m exp(-tau/tau0) for the wall time to collision (zero without collision).
-Eigen::Vector2d WallInteractionForce(const Eigen::Vector2d& x, const Eigen::Vector2d& v, double r, const SimWall& w,
-                                     const PowerLawParams& p);
+Eigen::Vector2d WallInteractionForce(const Eigen::Vector2d& x, const Eigen::Vector2d& v, double r,
+                                     const SimWall& w, const PowerLawParams& p);
 /// Distance from x to the segment p-q (m), and the closest point.
-double DistanceToSegment(const Eigen::Vector2d& x, const Eigen::Vector2d& p, const Eigen::Vector2d& q,
-                         Eigen::Vector2d* closest = nullptr);
+double DistanceToSegment(const Eigen::Vector2d& x, const Eigen::Vector2d& p,
+                         const Eigen::Vector2d& q, Eigen::Vector2d* closest = nullptr);
 
-/// The simulator's walls of a scenario: its wall segments plus the four sides of the extent (zero thickness).
+/// The simulator's walls of a scenario: its wall segments plus the four sides of the extent (zero
+/// thickness).
 std::vector<SimWall> ScenarioWalls(const CrowdScenarioConfig& scenario);
 
 /// A simulated power-law crowd. Deterministic in (scenario, seed).
@@ -89,6 +93,7 @@ class PowerLawCrowd : public Crowd {
     bool arrived = false;  ///< one-way pedestrians at their goal
   };
   void Substep(double h, const RobotAgent& robot);
+  void ComputeAccelerations(const RobotAgent& robot, std::vector<Eigen::Vector2d>* accel) const;
   Eigen::Vector2d SampleBox(const std::vector<double>& box);
 
   CrowdScenarioConfig scenario_;
@@ -101,12 +106,12 @@ class PowerLawCrowd : public Crowd {
 };
 
 /// Reads an Implicit Crowds scenario (`xmin xmax`, `ymin ymax`, `N`, then N lines
-/// `gid x y goal_x goal_y pref_speed radius`) into a simulated scenario: one one-way group per agent
-/// (degenerate spawn and goal boxes, no speed jitter, the agent's radius), the file's bounds as the
-/// extent, no walls, the PRL 2014 default parameters (PowerLawParams{}) with max_speed raised to
-/// 1.5 x the largest preferred speed. The files contain no robot: robot start and goal are put at
-/// the extent's lower-left and upper-right corners (1 m inside); run them with RobotAgent::present = false.
-/// Malformed files are Errors naming file and line.
+/// `gid x y goal_x goal_y pref_speed radius`) into a simulated scenario: one one-way group per
+/// agent (degenerate spawn and goal boxes, no speed jitter, the agent's radius), the file's bounds
+/// as the extent, no walls, the PRL 2014 default parameters (PowerLawParams{}) with max_speed
+/// raised to 1.5 x the largest preferred speed. The files contain no robot: robot start and goal
+/// are put at the extent's lower-left and upper-right corners (1 m inside); run them with
+/// RobotAgent::present = false. Malformed files are Errors naming file and line.
 CrowdScenarioConfig ReadImplicitCrowdsScenario(const std::string& path);
 
 /// Applies an Implicit Crowds `implicit.ini` (key=value) to `base`: k -> k, p -> exponent,

@@ -18,7 +18,8 @@ namespace {
 std::string DataRootWith(const std::string& relative) {
   std::vector<std::filesystem::path> roots;
   if (const char* data = std::getenv("FORESIGHT_DATA")) roots.emplace_back(data);
-  if (const std::string shared = testing::SharedDataDir(); !shared.empty()) roots.emplace_back(shared);
+  if (const std::string shared = testing::SharedDataDir(); !shared.empty())
+    roots.emplace_back(shared);
   for (const auto& root : roots)
     if (std::filesystem::exists(root / relative)) return root.string();
   return "";
@@ -27,9 +28,10 @@ std::string DataRootWith(const std::string& relative) {
 TEST(CrowdReplay, ReadsThorTrackletsSortedByTime) {
   testing::TempDir dir;
   const std::string path = dir.File("thor.csv");
-  testing::WriteText(path,
-                     "0.43,12001,1.0,2.0,0.1,0.0\n0.02,12001,0.5,2.0,0.1,0.0\n0.10,12002,-1,-1,0.0,0.0\n"
-                     "\n0.84,12001,1.5,2.5,0.1,0.785\n0.51,12002,-1.2,-1,0.5,3.142\n");
+  testing::WriteText(
+      path,
+      "0.43,12001,1.0,2.0,0.1,0.0\n0.02,12001,0.5,2.0,0.1,0.0\n0.10,12002,-1,-1,0.0,0.0\n"
+      "\n0.84,12001,1.5,2.5,0.1,0.785\n0.51,12002,-1.2,-1,0.5,3.142\n");
   const TrackSet set = ReadThorTracks(path);
   ASSERT_EQ(set.tracks.size(), 2u);
   const Track& a = set.tracks[0];
@@ -52,7 +54,8 @@ TEST(CrowdReplay, BadThorInputNamesFileAndLine) {
   testing::ExpectErrorContains([&] { ReadThorTracks(path); }, {path + ":2", "two samples"});
   testing::WriteText(path, "0.02,abc,0.5,2.0,0.1,0\n");
   testing::ExpectErrorContains([&] { ReadThorTracks(path); }, {path + ":1", "person_id", "'abc'"});
-  testing::ExpectErrorContains([&] { ReadThorTracks(dir.File("missing.csv")); }, {"missing.csv", "cannot open"});
+  testing::ExpectErrorContains([&] { ReadThorTracks(dir.File("missing.csv")); },
+                               {"missing.csv", "cannot open"});
 }
 
 TEST(CrowdReplay, ReadsEthObsmatWithYInTheFifthColumnAndInferredFrameStep) {
@@ -83,7 +86,8 @@ TEST(CrowdReplay, ResamplingInterpolatesOnTheGridWithoutExtrapolationAndSplitsGa
   tr.agent_id = 5;
   tr.time = {0.02, 0.43, 0.84, 3.0, 3.41};  // a 2.16 s gap after 0.84
   tr.positions.resize(5, 2);
-  for (int i = 0; i < 5; ++i) tr.positions.row(i) << 1.0 + 2.0 * tr.time[i], -0.5 * tr.time[i];  // linear
+  for (int i = 0; i < 5; ++i)
+    tr.positions.row(i) << 1.0 + 2.0 * tr.time[i], -0.5 * tr.time[i];  // linear
   raw.tracks.push_back(tr);
   const TrackSet out = ResampleTracks(raw, 0.1, 1.0);
   EXPECT_DOUBLE_EQ(out.seconds_per_step, 0.1);
@@ -160,7 +164,8 @@ TEST(CrowdReplay, OverlaidWindowsStartAtZeroAndAgentsAreActiveWhileCovered) {
   ReplayCrowd same(LinearTracks(), rc, 0.4, 5);
   EXPECT_EQ(same.window_starts(), crowd.window_starts());
   rc.duration = 200;
-  testing::ExpectErrorContains([&] { ReplayCrowd c(LinearTracks(), rc, 0.4, 1); }, {"shorter than replay.duration"});
+  testing::ExpectErrorContains([&] { ReplayCrowd c(LinearTracks(), rc, 0.4, 1); },
+                               {"shorter than replay.duration"});
 }
 
 TEST(CrowdReplay, ThorMapRasterUsesTheReadmeMapping) {
@@ -168,7 +173,8 @@ TEST(CrowdReplay, ThorMapRasterUsesTheReadmeMapping) {
   const std::string png = dir.File("map.png");
   // 0.01 m/px from (x, y) = (-11, 13.5): 400 x 300 px covers x in [-11, -8], y in [9.5, 13.5].
   cv::Mat img(400, 300, CV_8UC4, cv::Scalar(255, 255, 255, 255));
-  img(cv::Rect(100, 200, 50, 50)).setTo(cv::Scalar(0, 0, 0, 255));  // x in [-10, -9.5], y in [11, 11.5]
+  img(cv::Rect(100, 200, 50, 50))
+      .setTo(cv::Scalar(0, 0, 0, 255));  // x in [-10, -9.5], y in [11, 11.5]
   ASSERT_TRUE(cv::imwrite(png, img));
   const OccupancyRaster r = ThorMapRaster(png, Eigen::Vector4d(-11, -7, 9.5, 13.5), 0.1);
   EXPECT_EQ(r.cells.rows(), 40);
@@ -178,15 +184,16 @@ TEST(CrowdReplay, ThorMapRasterUsesTheReadmeMapping) {
   EXPECT_FALSE(r.Occupied(-9.75, 11.75));
   EXPECT_TRUE(r.Occupied(-7.5, 11.0));   // beyond the image
   EXPECT_TRUE(r.Occupied(-12.0, 11.0));  // beyond the raster
-  testing::ExpectErrorContains([&] { ThorMapRaster(dir.File("none.png"), Eigen::Vector4d(0, 1, 0, 1), 0.1); },
-                               {"none.png", "not found"});
+  testing::ExpectErrorContains(
+      [&] { ThorMapRaster(dir.File("none.png"), Eigen::Vector4d(0, 1, 0, 1), 0.1); },
+      {"none.png", "not found"});
 }
 
 TEST(CrowdReplay, EthMapRasterMapsObstaclePixelsThroughTheHomography) {
   testing::TempDir dir;
   const std::string png = dir.File("map.png");
   cv::Mat img(100, 200, CV_8UC1, cv::Scalar(0));  // black = free in ETH maps
-  img.row(50).setTo(cv::Scalar(255));              // a white line = obstacle
+  img.row(50).setTo(cv::Scalar(255));             // a white line = obstacle
   ASSERT_TRUE(cv::imwrite(png, img));
   // world x = 0.05 col - 1, world y = -0.05 row + 4  (H maps [row, col, 1] to [x, y, 1]).
   Eigen::Matrix3d H;
@@ -204,7 +211,8 @@ TEST(CrowdReplay, EthMapRasterMapsObstaclePixelsThroughTheHomography) {
 
 TEST(CrowdReplay, RealThorRunReplaysOnFreeSpaceAtWalkingSpeed) {
   const std::string root = DataRootWith("thor/thor1_exp-1-run-2.csv");
-  if (root.empty()) GTEST_SKIP() << "thor/thor1_exp-1-run-2.csv not found under $FORESIGHT_DATA or ../shared/data";
+  if (root.empty())
+    GTEST_SKIP() << "thor/thor1_exp-1-run-2.csv not found under $FORESIGHT_DATA or ../shared/data";
   const TrackSet raw = ReadThorTracks(root + "/thor/thor1_exp-1-run-2.csv");
   EXPECT_EQ(raw.tracks.size(), 87u);  // README
   CrowdScenarioConfig s = DatasetScenario();
@@ -240,13 +248,15 @@ TEST(CrowdReplay, RealThorRunReplaysOnFreeSpaceAtWalkingSpeed) {
   EXPECT_GT(static_cast<double>(on_free) / samples, 0.97);
   EXPECT_GT(median, 0.3);
   EXPECT_LT(median, 1.8);
-  std::cout << "[ thor1 replay, 3 windows ] max active " << max_active << ", median speed " << median
-            << " m/s, on free cells " << 100.0 * on_free / samples << " %\n";
+  std::cout << "[ thor1 replay, 3 windows ] max active " << max_active << ", median speed "
+            << median << " m/s, on free cells " << 100.0 * on_free / samples << " %\n";
 }
 
 TEST(CrowdReplay, RealEthObsmatReplaysOnFreeSpaceAtWalkingSpeed) {
   const std::string root = DataRootWith("eth_ucy/eth_original/seq_eth/obsmat.txt");
-  if (root.empty()) GTEST_SKIP() << "eth_ucy/eth_original/seq_eth/obsmat.txt not found under $FORESIGHT_DATA or ../shared/data";
+  if (root.empty())
+    GTEST_SKIP() << "eth_ucy/eth_original/seq_eth/obsmat.txt not found under $FORESIGHT_DATA or "
+                    "../shared/data";
   CrowdScenarioConfig s;
   s.name = "dataset";
   s.source = CrowdSource::kReplay;

@@ -13,7 +13,8 @@
 namespace foresight {
 namespace {
 
-// The snippets of docs/dataset_schema.md ("Crowd scenarios"): they must stay equal to the factories.
+// The snippets of docs/dataset_schema.md ("Crowd scenarios"): they must stay equal to the
+// factories.
 constexpr const char* kSim1Yaml = R"(
 name: sim1
 source: simulated
@@ -64,16 +65,20 @@ TEST(CrowdScenario, DocumentedSnippetsEqualTheFactories) {
     EXPECT_EQ(config::ToYaml(FromText(text)), text) << s.name;  // round trip
   }
   const std::string table = config::ReferenceTable<CrowdScenarioConfig>();
-  for (const char* key : {"`walls[].x0`", "`groups[].spawn`", "`groups[].round_trip`", "`power_law.tau0`",
-                          "`replay.overlay_spacing`"})
+  for (const char* key : {"`walls[].x0`", "`groups[].spawn`", "`groups[].round_trip`",
+                          "`power_law.tau0`", "`replay.overlay_spacing`"})
     EXPECT_NE(table.find(key), std::string::npos) << key;
 }
 
 TEST(CrowdScenario, ConfigErrorsNameTheKey) {
-  testing::ExpectErrorContains([] { FromText("groups:\n  - {count: 0}\n"); }, {"scene.yaml:2", "'groups[0].count'", ">= 1"});
-  testing::ExpectErrorContains([] { FromText("groups:\n  - {cout: 3}\n"); }, {"unknown key 'groups[0].cout'"});
-  testing::ExpectErrorContains([] { FromText("source: recorded\n"); }, {"'source'", "'simulated'", "'replay'"});
-  testing::ExpectErrorContains([] { FromText("power_law: {max_speed: -1}\n"); }, {"'power_law.max_speed'"});
+  testing::ExpectErrorContains([] { FromText("groups:\n  - {count: 0}\n"); },
+                               {"scene.yaml:2", "'groups[0].count'", ">= 1"});
+  testing::ExpectErrorContains([] { FromText("groups:\n  - {cout: 3}\n"); },
+                               {"unknown key 'groups[0].cout'"});
+  testing::ExpectErrorContains([] { FromText("source: recorded\n"); },
+                               {"'source'", "'simulated'", "'replay'"});
+  testing::ExpectErrorContains([] { FromText("power_law: {max_speed: -1}\n"); },
+                               {"'power_law.max_speed'"});
 }
 
 TEST(CrowdScenario, ValidateRejectsInconsistentScenes) {
@@ -83,17 +88,54 @@ TEST(CrowdScenario, ValidateRejectsInconsistentScenes) {
     edit(&s);
     testing::ExpectErrorContains([&] { s.Validate("scene.yaml"); }, parts);
   };
-  expect([](CrowdScenarioConfig* s) { s->extent = {1, 1, 0, 4}; }, {"scene.yaml", "'extent'", "empty"});
+  expect(
+      [](CrowdScenarioConfig* s) {
+        s->extent = {1, 1, 0, 4};
+      },
+      {"scene.yaml", "'extent'", "empty"});
   expect([](CrowdScenarioConfig* s) { s->extent = {0, 1}; }, {"'extent'", "4 finite"});
-  expect([](CrowdScenarioConfig* s) { s->robot_goal = {12, 0}; }, {"'robot_goal'", "(12, 0)", "not inside"});
-  expect([](CrowdScenarioConfig* s) { s->robot_start = {-9, 0}; }, {"'robot_start'", "[x, y, heading]"});
-  expect([](CrowdScenarioConfig* s) { s->robot_start = {0.2, 2, 0}; }, {"'robot_start'", "collision", "walls[1]"});
-  expect([](CrowdScenarioConfig* s) { s->robot_goal = {0, -3}; }, {"'robot_goal'", "collision", "walls[0]"});
-  expect([](CrowdScenarioConfig* s) { s->walls.push_back({0, 0, 15, 0}); }, {"'walls[2]'", "outside the extent"});
-  expect([](CrowdScenarioConfig* s) { s->groups.clear(); }, {"no pedestrian groups", "empty crowd"});
-  expect([](CrowdScenarioConfig* s) { s->groups[1].spawn = {2, 1, 0, 1}; }, {"'groups[1].spawn'", "malformed"});
-  expect([](CrowdScenarioConfig* s) { s->groups[0].goal = {0, 1, 0}; }, {"'groups[0].goal'", "4 finite"});
-  expect([](CrowdScenarioConfig* s) { s->groups[0].goal = {0, 11, 0, 1}; }, {"'groups[0].goal'", "not inside"});
+  expect(
+      [](CrowdScenarioConfig* s) {
+        s->robot_goal = {12, 0};
+      },
+      {"'robot_goal'", "(12, 0)", "not inside"});
+  expect(
+      [](CrowdScenarioConfig* s) {
+        s->robot_start = {-9, 0};
+      },
+      {"'robot_start'", "[x, y, heading]"});
+  expect(
+      [](CrowdScenarioConfig* s) {
+        s->robot_start = {0.2, 2, 0};
+      },
+      {"'robot_start'", "collision", "walls[1]"});
+  expect(
+      [](CrowdScenarioConfig* s) {
+        s->robot_goal = {0, -3};
+      },
+      {"'robot_goal'", "collision", "walls[0]"});
+  expect(
+      [](CrowdScenarioConfig* s) {
+        s->walls.push_back({0, 0, 15, 0});
+      },
+      {"'walls[2]'", "outside the extent"});
+  expect([](CrowdScenarioConfig* s) { s->groups.clear(); },
+         {"no pedestrian groups", "empty crowd"});
+  expect(
+      [](CrowdScenarioConfig* s) {
+        s->groups[1].spawn = {2, 1, 0, 1};
+      },
+      {"'groups[1].spawn'", "malformed"});
+  expect(
+      [](CrowdScenarioConfig* s) {
+        s->groups[0].goal = {0, 1, 0};
+      },
+      {"'groups[0].goal'", "4 finite"});
+  expect(
+      [](CrowdScenarioConfig* s) {
+        s->groups[0].goal = {0, 11, 0, 1};
+      },
+      {"'groups[0].goal'", "not inside"});
   expect([](CrowdScenarioConfig* s) { s->groups[0].count = 0; }, {"'groups[0].count'"});
   expect(
       [](CrowdScenarioConfig* s) {
@@ -113,9 +155,9 @@ TEST(CrowdScenario, Sim1OccupancyHasTheWallsTheDoorwayAndTheOutside) {
   EXPECT_EQ(r.cells.cols(), 400);
   EXPECT_TRUE(r.Occupied(0.0, 2.5));
   EXPECT_TRUE(r.Occupied(0.08, -2.5));
-  EXPECT_FALSE(r.Occupied(0.0, 0.0));   // the doorway
-  EXPECT_FALSE(r.Occupied(0.2, 2.5));   // beside the wall
-  EXPECT_TRUE(r.Occupied(0.0, 4.1));    // outside the extent
+  EXPECT_FALSE(r.Occupied(0.0, 0.0));  // the doorway
+  EXPECT_FALSE(r.Occupied(0.2, 2.5));  // beside the wall
+  EXPECT_TRUE(r.Occupied(0.0, 4.1));   // outside the extent
   EXPECT_TRUE(r.Occupied(-10.1, 0.0));
   EXPECT_FALSE(r.Occupied(s.robot_start[0], s.robot_start[1]));
   EXPECT_FALSE(r.Occupied(s.robot_goal[0], s.robot_goal[1]));
@@ -128,7 +170,8 @@ TEST(CrowdScenario, Sim1OccupancyHasTheWallsTheDoorwayAndTheOutside) {
 
 TEST(CrowdScenario, EpisodeEndpointsAreJitteredDeterministically) {
   const CrowdScenarioConfig s = Sim1Scenario();
-  const EpisodeEndpoints a = MakeEpisodeEndpoints(s, 3), b = MakeEpisodeEndpoints(s, 3), c = MakeEpisodeEndpoints(s, 4);
+  const EpisodeEndpoints a = MakeEpisodeEndpoints(s, 3), b = MakeEpisodeEndpoints(s, 3),
+                         c = MakeEpisodeEndpoints(s, 4);
   EXPECT_EQ(a.start, b.start);
   EXPECT_EQ(a.goal, b.goal);
   EXPECT_NE(a.start, c.start);
@@ -163,16 +206,17 @@ TEST(CrowdScenario, Sim1CongestsAtTheDoorwayAndNoOneWalksThroughWalls) {
         ++speed_count;
       }
       for (std::size_t j = i + 1; j < n; ++j)
-        min_gap = std::min(min_gap, (a[i].position - a[j].position).norm() - a[i].radius - a[j].radius);
+        min_gap =
+            std::min(min_gap, (a[i].position - a[j].position).norm() - a[i].radius - a[j].radius);
     }
   }
   const double mean_speed = speed_sum / speed_count;
   EXPECT_EQ(through_walls, 0);
-  EXPECT_GT(crossings, 10);        // the flows do get through the doorway
-  EXPECT_LT(mean_speed, 0.75);     // against ~0.9 m/s preferred: congestion
-  EXPECT_GT(min_gap, -0.4);        // pushing, but no pedestrian walks through another
-  std::cout << "[ sim1, 40 s ] doorway crossings " << crossings << ", mean speed after 10 s " << mean_speed
-            << " m/s (preferred 0.8-1.0), min gap " << min_gap << " m\n";
+  EXPECT_GT(crossings, 10);     // the flows do get through the doorway
+  EXPECT_LT(mean_speed, 0.75);  // against ~0.9 m/s preferred: congestion
+  EXPECT_GT(min_gap, -0.4);     // pushing, but no pedestrian walks through another
+  std::cout << "[ sim1, 40 s ] doorway crossings " << crossings << ", mean speed after 10 s "
+            << mean_speed << " m/s (preferred 0.8-1.0), min gap " << min_gap << " m\n";
 }
 
 TEST(CrowdScenario, RecordedTracksCoverEveryPedestrianOfEveryEpisode) {
@@ -191,7 +235,8 @@ TEST(CrowdScenario, RecordedTracksCoverEveryPedestrianOfEveryEpisode) {
     EXPECT_TRUE(tr.positions.allFinite());
     EXPECT_TRUE(tr.positions.isApprox(b.tracks[t].positions));
     for (int k = 1; k < tr.size(); ++k)
-      EXPECT_LE((tr.positions.row(k) - tr.positions.row(k - 1)).norm(), 0.4 * s.power_law.max_speed + 1e-9);
+      EXPECT_LE((tr.positions.row(k) - tr.positions.row(k - 1)).norm(),
+                0.4 * s.power_law.max_speed + 1e-9);
   }
   EXPECT_EQ(ids.size(), a.tracks.size());
   // Episodes differ.

@@ -15,8 +15,8 @@ namespace foresight {
 namespace {
 
 /// d/dx of f at x by central differences (per coordinate).
-Eigen::Vector2d Gradient(const std::function<double(const Eigen::Vector2d&)>& f, const Eigen::Vector2d& x,
-                         double h = 1e-6) {
+Eigen::Vector2d Gradient(const std::function<double(const Eigen::Vector2d&)>& f,
+                         const Eigen::Vector2d& x, double h = 1e-6) {
   Eigen::Vector2d g;
   for (int i = 0; i < 2; ++i) {
     Eigen::Vector2d a = x, b = x;
@@ -28,8 +28,9 @@ Eigen::Vector2d Gradient(const std::function<double(const Eigen::Vector2d&)>& f,
 }
 
 /// A simulated scenario of single pedestrians (one-way) from `starts` to `goals`, no robot walls.
-CrowdScenarioConfig Singles(const std::vector<Eigen::Vector2d>& starts, const std::vector<Eigen::Vector2d>& goals,
-                            double speed, PowerLawParams params = PowerLawParams{}) {
+CrowdScenarioConfig Singles(const std::vector<Eigen::Vector2d>& starts,
+                            const std::vector<Eigen::Vector2d>& goals, double speed,
+                            PowerLawParams params = PowerLawParams{}) {
   CrowdScenarioConfig s;
   s.name = "test";
   s.extent = {-20, 20, -20, 20};
@@ -62,7 +63,8 @@ struct RunResult {
   bool all_arrived = false;
   std::vector<double> arrival;
 };
-RunResult RunCrowd(PowerLawCrowd* crowd, double max_time, const RobotAgent& robot = NoRobot(), double dt = 0.1) {
+RunResult RunCrowd(PowerLawCrowd* crowd, double max_time, const RobotAgent& robot = NoRobot(),
+                   double dt = 0.1) {
   RunResult r;
   const auto n = crowd->agents().size();
   r.arrival.assign(n, -1);
@@ -72,7 +74,8 @@ RunResult RunCrowd(PowerLawCrowd* crowd, double max_time, const RobotAgent& robo
     for (std::size_t i = 0; i < n; ++i) {
       if (r.arrival[i] < 0 && crowd->arrived(static_cast<int>(i))) r.arrival[i] = crowd->time();
       for (std::size_t j = i + 1; j < n; ++j)
-        r.min_gap = std::min(r.min_gap, (a[i].position - a[j].position).norm() - a[i].radius - a[j].radius);
+        r.min_gap =
+            std::min(r.min_gap, (a[i].position - a[j].position).norm() - a[i].radius - a[j].radius);
     }
     bool all = true;
     for (std::size_t i = 0; i < n; ++i) all = all && crowd->arrived(static_cast<int>(i));
@@ -90,10 +93,10 @@ TEST(PowerLaw, TimeToCollisionClosedForms) {
   EXPECT_NEAR(TimeToCollision({-5, 0}, {2, 0}, 1.0), 2.0, 1e-12);
   // Offset 0.6 < r = 1: |x + v t|^2 = 1 at (5 - 2t)^2 = 1 - 0.36.
   EXPECT_NEAR(TimeToCollision({-5, 0.6}, {2, 0}, 1.0), (5 - std::sqrt(0.64)) / 2, 1e-12);
-  EXPECT_TRUE(std::isinf(TimeToCollision({-5, 1.2}, {2, 0}, 1.0)));   // passes by
-  EXPECT_TRUE(std::isinf(TimeToCollision({-5, 0}, {-2, 0}, 1.0)));    // separating
-  EXPECT_TRUE(std::isinf(TimeToCollision({-5, 0}, {0, 0}, 1.0)));     // no relative motion
-  EXPECT_EQ(TimeToCollision({-0.5, 0}, {1, 0}, 1.0), 0.0);            // overlapping and approaching
+  EXPECT_TRUE(std::isinf(TimeToCollision({-5, 1.2}, {2, 0}, 1.0)));  // passes by
+  EXPECT_TRUE(std::isinf(TimeToCollision({-5, 0}, {-2, 0}, 1.0)));   // separating
+  EXPECT_TRUE(std::isinf(TimeToCollision({-5, 0}, {0, 0}, 1.0)));    // no relative motion
+  EXPECT_EQ(TimeToCollision({-0.5, 0}, {1, 0}, 1.0), 0.0);           // overlapping and approaching
   EXPECT_DOUBLE_EQ(PowerLawEnergy(2.0, 1.5, 2.0, 3.0), 1.5 / 4.0 * std::exp(-2.0 / 3.0));
   EXPECT_EQ(PowerLawEnergy(std::numeric_limits<double>::infinity(), 1.5, 2, 3), 0.0);
 }
@@ -116,7 +119,8 @@ TEST(PowerLaw, InteractionForceIsMinusTheGradientOfTheEnergy) {
       };
       const Eigen::Vector2d fd = -Gradient(energy, x);
       const Eigen::Vector2d f = PowerLawInteractionForce(x, v, r, p.k, p);
-      EXPECT_LT((f - fd).norm(), 1e-5 * (1 + fd.norm())) << "x " << x.transpose() << " v " << v.transpose();
+      EXPECT_LT((f - fd).norm(), 1e-5 * (1 + fd.norm()))
+          << "x " << x.transpose() << " v " << v.transpose();
       ++checked;
     }
   }
@@ -138,7 +142,8 @@ TEST(PowerLaw, WallForceIsMinusTheGradientOfTheWallEnergy) {
     const Eigen::Vector2d x(-1.5 + u(rng), 3 * u(rng)), v(1.5 * u(rng), 1.5 * u(rng));
     const double r = 0.4;
     const double tau = WallTimeToCollision(x, v, r, w);
-    if (!std::isfinite(tau) || tau < 2 * p.tau_min || DistanceToSegment(x, w.p, w.q) < r + w.half_thickness + 0.05)
+    if (!std::isfinite(tau) || tau < 2 * p.tau_min ||
+        DistanceToSegment(x, w.p, w.q) < r + w.half_thickness + 0.05)
       continue;
     const auto energy = [&](const Eigen::Vector2d& y) {
       return PowerLawEnergy(WallTimeToCollision(y, v, r, w), p.wall_k, p.exponent, p.tau0);
@@ -148,7 +153,8 @@ TEST(PowerLaw, WallForceIsMinusTheGradientOfTheWallEnergy) {
     const Eigen::Vector2d fd2 = -Gradient(energy, x, 1e-6);
     if ((fd - fd2).norm() > 1e-4 * (1 + fd.norm())) continue;
     const Eigen::Vector2d f = WallInteractionForce(x, v, r, w, p);
-    EXPECT_LT((f - fd).norm(), 1e-4 * (1 + fd.norm())) << "x " << x.transpose() << " v " << v.transpose();
+    EXPECT_LT((f - fd).norm(), 1e-4 * (1 + fd.norm()))
+        << "x " << x.transpose() << " v " << v.transpose();
     const Eigen::Vector2d hit = x + v * tau;
     (std::abs(hit.y()) < 2 ? body : ends)++;
   }
@@ -212,7 +218,8 @@ TEST(PowerLawCrowd, PedestriansReactToTheRobot) {
 }
 
 TEST(PowerLawCrowd, WallsAreNotCrossed) {
-  CrowdScenarioConfig s = Singles({{-3, 0}, {-3, 2.5}}, {{5, 0.5}, {5, 2.5}}, 1.0, PowerLawParams::Aggressive());
+  CrowdScenarioConfig s =
+      Singles({{-3, 0}, {-3, 2.5}}, {{5, 0.5}, {5, 2.5}}, 1.0, PowerLawParams::Aggressive());
   s.walls = {{0, -20, 0, 20}};  // a full partition: the goals are unreachable
   s.wall_thickness = 0.2;
   PowerLawCrowd crowd(s, 4);
@@ -271,14 +278,16 @@ TEST(PowerLawCrowd, OvercrowdedSpawnBoxIsAnError) {
   CrowdScenarioConfig s = Singles({{0, 0}}, {{5, 5}}, 1.0);
   s.groups[0].count = 20;
   s.groups[0].spawn = {0, 1, 0, 1};
-  testing::ExpectErrorContains([&] { PowerLawCrowd c(s, 1); }, {"groups[0]", "cannot place pedestrian", "spawn box"});
+  testing::ExpectErrorContains([&] { PowerLawCrowd c(s, 1); },
+                               {"groups[0]", "cannot place pedestrian", "spawn box"});
 }
 
 // ---- the Implicit Crowds reference scenarios (../shared/data) -------------------------------
 std::string ImplicitCrowdsDir() {
   std::vector<std::filesystem::path> roots;
   if (const char* data = std::getenv("FORESIGHT_DATA")) roots.emplace_back(data);
-  if (const std::string shared = testing::SharedDataDir(); !shared.empty()) roots.emplace_back(shared);
+  if (const std::string shared = testing::SharedDataDir(); !shared.empty())
+    roots.emplace_back(shared);
   for (const auto& root : roots) {
     const auto dir = root / "crowd_scenarios_implicit_crowds";
     if (std::filesystem::exists(dir / "8_agents.csv")) return dir.string();
@@ -289,7 +298,8 @@ std::string ImplicitCrowdsDir() {
 TEST(ImplicitCrowds, ReaderParsesTheFormatAndRejectsBadFiles) {
   testing::TempDir dir;
   const std::string path = dir.File("two.csv");
-  testing::WriteText(path, "-15 15\r\n-10 10\r\n2\r\n0 -9 -1 9 -1 1.3 0.75\r\n1 9 1 -9 1 1.2 0.75\r\n");
+  testing::WriteText(path,
+                     "-15 15\r\n-10 10\r\n2\r\n0 -9 -1 9 -1 1.3 0.75\r\n1 9 1 -9 1 1.2 0.75\r\n");
   const CrowdScenarioConfig s = ReadImplicitCrowdsScenario(path);
   EXPECT_EQ(s.extent, (std::vector<double>{-15, 15, -10, 10}));
   ASSERT_EQ(s.groups.size(), 2u);
@@ -304,9 +314,11 @@ TEST(ImplicitCrowds, ReaderParsesTheFormatAndRejectsBadFiles) {
   testing::WriteText(path, "-15 15\n-10 10\n1\n0 -9 nan 9 -1 1.3 0.75\n");
   testing::ExpectErrorContains([&] { ReadImplicitCrowdsScenario(path); }, {path + ":4", "'nan'"});
   testing::WriteText(path, "-15 15\n-10 10\n1\n0 -9 1 9 -1 1.3\n");
-  testing::ExpectErrorContains([&] { ReadImplicitCrowdsScenario(path); }, {path + ":4", "expected 7 fields"});
+  testing::ExpectErrorContains([&] { ReadImplicitCrowdsScenario(path); },
+                               {path + ":4", "expected 7 fields"});
   testing::WriteText(path, "-15 15\n-10 10\n1\n0 -99 1 9 -1 1.3 0.5\n");
-  testing::ExpectErrorContains([&] { ReadImplicitCrowdsScenario(path); }, {"groups[0].spawn", "extent"});
+  testing::ExpectErrorContains([&] { ReadImplicitCrowdsScenario(path); },
+                               {"groups[0].spawn", "extent"});
   const std::string ini = dir.File("p.ini");
   testing::WriteText(ini, "k=2\r\np=3.25\nt0=2.5\nksi=2\nneighborDist=7\n");
   const PowerLawParams p = ReadImplicitCrowdsParameters(ini, PowerLawParams{});
@@ -316,12 +328,15 @@ TEST(ImplicitCrowds, ReaderParsesTheFormatAndRejectsBadFiles) {
   EXPECT_DOUBLE_EQ(p.neighbor_dist, 7);
   EXPECT_DOUBLE_EQ(p.relaxation, PowerLawParams{}.relaxation);  // ksi is not the relaxation time
   testing::WriteText(ini, "k=2\nfoo=1\n");
-  testing::ExpectErrorContains([&] { ReadImplicitCrowdsParameters(ini, PowerLawParams{}); }, {ini + ":2", "'foo'"});
+  testing::ExpectErrorContains([&] { ReadImplicitCrowdsParameters(ini, PowerLawParams{}); },
+                               {ini + ":2", "'foo'"});
 }
 
 TEST(ImplicitCrowds, EightAgentsAntipodalCircleAllArriveWithoutCollision) {
   const std::string dir = ImplicitCrowdsDir();
-  if (dir.empty()) GTEST_SKIP() << "crowd_scenarios_implicit_crowds not found under $FORESIGHT_DATA or ../shared/data";
+  if (dir.empty())
+    GTEST_SKIP()
+        << "crowd_scenarios_implicit_crowds not found under $FORESIGHT_DATA or ../shared/data";
   const CrowdScenarioConfig base = ReadImplicitCrowdsScenario(dir + "/8_agents.csv");
   ASSERT_EQ(base.groups.size(), 8u);
   CrowdScenarioConfig with_ini = base;
@@ -331,25 +346,29 @@ TEST(ImplicitCrowds, EightAgentsAntipodalCircleAllArriveWithoutCollision) {
     double straight = 0;  // the slowest agent's straight-line time
     for (std::size_t i = 0; i < s.groups.size(); ++i) {
       const auto& g = s.groups[i];
-      straight = std::max(straight, std::hypot(g.goal[0] - g.spawn[0], g.goal[2] - g.spawn[2]) / g.preferred_speed);
+      straight = std::max(
+          straight, std::hypot(g.goal[0] - g.spawn[0], g.goal[2] - g.spawn[2]) / g.preferred_speed);
     }
     const RunResult r = RunCrowd(&crowd, 4 * straight);
     EXPECT_TRUE(r.all_arrived) << "exponent " << s.power_law.exponent;
     EXPECT_GT(r.min_gap, -0.1) << "exponent " << s.power_law.exponent;
     EXPECT_LT(r.time, 1.6 * straight) << "exponent " << s.power_law.exponent;
-    std::cout << "[ implicit 8_agents exponent " << s.power_law.exponent << " ] all arrived after " << r.time
-              << " s (straight-line " << straight << " s), min gap " << r.min_gap << " m\n";
+    std::cout << "[ implicit 8_agents exponent " << s.power_law.exponent << " ] all arrived after "
+              << r.time << " s (straight-line " << straight << " s), min gap " << r.min_gap
+              << " m\n";
   }
 }
 
 TEST(ImplicitCrowds, ThreeAgentsMakeRoomForTheHeadOnAgent) {
   const std::string dir = ImplicitCrowdsDir();
-  if (dir.empty()) GTEST_SKIP() << "crowd_scenarios_implicit_crowds not found under $FORESIGHT_DATA or ../shared/data";
+  if (dir.empty())
+    GTEST_SKIP()
+        << "crowd_scenarios_implicit_crowds not found under $FORESIGHT_DATA or ../shared/data";
   const CrowdScenarioConfig s = ReadImplicitCrowdsScenario(dir + "/3_agents.csv");
   ASSERT_EQ(s.groups.size(), 3u);
-  // The file is mirror-symmetric about y = 0 (pair at y = +-1, the third agent on y = 0), and so is the
-  // deterministic model: the pair splits and the third agent passes between them. Shifted by 0.3 m off
-  // the axis, the third agent swerves as well (and the pair still opens most of the gap).
+  // The file is mirror-symmetric about y = 0 (pair at y = +-1, the third agent on y = 0), and so is
+  // the deterministic model: the pair splits and the third agent passes between them. Shifted by
+  // 0.3 m off the axis, the third agent swerves as well (and the pair still opens most of the gap).
   for (const double shift : {0.0, 0.3}) {
     CrowdScenarioConfig sc = s;
     sc.groups[2].spawn[2] = sc.groups[2].spawn[3] = shift;
@@ -363,23 +382,27 @@ TEST(ImplicitCrowds, ThreeAgentsMakeRoomForTheHeadOnAgent) {
       dev_pair = std::max({dev_pair, a[1].position.y() - 1.0, -1.0 - a[0].position.y()});
       for (int i = 0; i < 3; ++i)
         for (int j = i + 1; j < 3; ++j)
-          min_gap = std::min(min_gap, (a[i].position - a[j].position).norm() - a[i].radius - a[j].radius);
+          min_gap =
+              std::min(min_gap, (a[i].position - a[j].position).norm() - a[i].radius - a[j].radius);
     }
     EXPECT_TRUE(crowd.arrived(0) && crowd.arrived(1) && crowd.arrived(2)) << shift;
     EXPECT_GT(min_gap, -0.1) << shift;
-    EXPECT_GT(dev_pair + dev_single, 0.5) << shift;  // room is made: 2 r = 1.5 m > the pair's 2 m gap - 1.5 m
+    EXPECT_GT(dev_pair + dev_single, 0.5)
+        << shift;  // room is made: 2 r = 1.5 m > the pair's 2 m gap - 1.5 m
     if (shift > 0) {
       EXPECT_GT(dev_single, 0.05);  // off the axis, the head-on agent swerves too
     }
-    std::cout << "[ implicit 3_agents, third agent at y = " << shift << " ] its max deviation " << dev_single
-              << " m, pair's max outward deviation " << dev_pair << " m, min gap " << min_gap
-              << " m, all arrived after " << crowd.time() << " s\n";
+    std::cout << "[ implicit 3_agents, third agent at y = " << shift << " ] its max deviation "
+              << dev_single << " m, pair's max outward deviation " << dev_pair << " m, min gap "
+              << min_gap << " m, all arrived after " << crowd.time() << " s\n";
   }
 }
 
 TEST(ImplicitCrowds, FourHundredCrossingAgentsStayFiniteAndApart) {
   const std::string dir = ImplicitCrowdsDir();
-  if (dir.empty()) GTEST_SKIP() << "crowd_scenarios_implicit_crowds not found under $FORESIGHT_DATA or ../shared/data";
+  if (dir.empty())
+    GTEST_SKIP()
+        << "crowd_scenarios_implicit_crowds not found under $FORESIGHT_DATA or ../shared/data";
   const CrowdScenarioConfig s = ReadImplicitCrowdsScenario(dir + "/crossing_agents.csv");
   ASSERT_EQ(s.groups.size(), 400u);
   PowerLawCrowd crowd(s, 23);
@@ -395,8 +418,8 @@ TEST(ImplicitCrowds, FourHundredCrossingAgentsStayFiniteAndApart) {
   }
   EXPECT_LE(overlaps, 4);
   EXPECT_GT(mean_speed, 0.5);
-  std::cout << "[ implicit crossing_agents ] after 4 s: mean speed " << mean_speed << " m/s, pairs overlapping > 10 %: "
-            << overlaps << "\n";
+  std::cout << "[ implicit crossing_agents ] after 4 s: mean speed " << mean_speed
+            << " m/s, pairs overlapping > 10 %: " << overlaps << "\n";
 }
 
 }  // namespace
