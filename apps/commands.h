@@ -26,3 +26,6 @@ void TrainOccupancy(const std::string& config_path, const std::vector<std::strin
                     const std::string& run_dir, bool resume);
 
 }  // namespace foresight::app
+/// `navigate CONFIG --out DIR [--episodes N]` (SPAN and baselines in a crowd scenario).
+void AddNavigateCommand(CLI::App* app);
+

@@ -11,6 +11,7 @@ int main(int argc, char** argv) {
   foresight::app::AddDataCommands(&app);
   foresight::app::AddBenchCommands(&app);
   foresight::app::AddMapCommands(&app);
+  foresight::app::AddNavigateCommand(&app);
 #ifdef FORESIGHT_WITH_TORCH
   foresight::app::AddTrainCommands(&app);
 #else

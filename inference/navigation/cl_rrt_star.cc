@@ -140,18 +140,28 @@ ControlOutcome ClRrtStarController::Compute(const NavigationInput& input) {
         ob::PlannerTerminationCondition([planner, cap] { return planner->numIterations() >= static_cast<unsigned>(cap); }));
     const ob::PlannerStatus status = ss.solve(ptc);
     out.evaluations = static_cast<int>(planner->numIterations());
-    if (status != ob::PlannerStatus::EXACT_SOLUTION) {
+    const bool exact = status == ob::PlannerStatus::EXACT_SOLUTION;
+    const bool approximate = status == ob::PlannerStatus::APPROXIMATE_SOLUTION;
+    if (exact || approximate) {
+      const og::PathGeometric& g = ss.getSolutionPath();
+      path_.resize(2, static_cast<Eigen::Index>(g.getStateCount()));
+      for (std::size_t i = 0; i < g.getStateCount(); ++i) {
+        const auto* s = g.getState(i)->as<ob::RealVectorStateSpace::StateType>();
+        path_.col(static_cast<Eigen::Index>(i)) = Eigen::Vector2d(s->values[0], s->values[1]);
+      }
+    }
+    // A partial path (the tree's node closest to the goal) is followed when it gets the robot at
+    // least `min_progress` closer; otherwise nothing useful was found and the robot stays put.
+    const bool progress = path_.cols() > 0 && (approximate || exact) &&
+                          (input.robot.position() - input.goal).norm() -
+                                  (path_.col(path_.cols() - 1) - input.goal).norm() >= o.min_progress;
+    if (!(exact || (approximate && progress))) {
       path_.resize(2, 0);
       out.solved = false;
       out.command = {0, 0};
       return out;
     }
     const og::PathGeometric& g = ss.getSolutionPath();
-    path_.resize(2, static_cast<Eigen::Index>(g.getStateCount()));
-    for (std::size_t i = 0; i < g.getStateCount(); ++i) {
-      const auto* s = g.getState(i)->as<ob::RealVectorStateSpace::StateType>();
-      path_.col(static_cast<Eigen::Index>(i)) = Eigen::Vector2d(s->values[0], s->values[1]);
-    }
     out.cost = g.length();
     out.command = PurePursuit(input.robot, path_, o.lookahead, o.limits);
   } catch (const std::exception&) {

@@ -4,7 +4,8 @@
 /// robot to the goal with the pedestrians as disc obstacles at their current positions and the
 /// swept static map, within a planning budget (0.1 s, and an iteration cap so runs are comparable
 /// across machines); a pure-pursuit tracker turns the path into (v, omega). When no path is found
-/// the robot stays put (thesis: "the robot will remain at its current pose").
+/// the robot stays put (thesis: "the robot will remain at its current pose"). As in CL-RRT, the
+/// best partial path towards the goal counts as found when it makes progress (min_progress).
 
 #include <Eigen/Core>
 #include <memory>
@@ -21,6 +22,9 @@ struct ClRrtStarOptions {
   double range = 1.0;             ///< RRT* extension step (m)
   double goal_tolerance = 0.3;    ///< goal region radius of the planner (m)
   double lookahead = 0.8;         ///< pure-pursuit look-ahead distance (m)
+  /// A partial plan (no path reaches the goal region) is followed when its end is at least this
+  /// much closer to the goal than the robot (m); otherwise the robot stays put.
+  double min_progress = 0.3;
   double robot_radius = 0.4, pedestrian_radius = 0.4, epsilon = 0.25;
   double check_resolution = 0.05;  ///< motion validity checking step (m)
   ControlLimits limits;

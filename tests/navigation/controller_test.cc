@@ -235,11 +235,19 @@ TEST(ClRrtStar, PlansThroughTheGapAndStaysPutWhenBlocked) {
   }
   EXPECT_LT(steps, 400) << "goal not reached; at " << s.x << ", " << s.y;
   EXPECT_FALSE(hit);
-  // A goal inside the wall cannot be reached: no plan, stop.
+  // A goal inside the wall cannot be reached. The partial plan towards it is followed when it
+  // makes progress; without accepting partial plans the robot stays put.
   NavigationInput in;
   in.robot = {2, 2, 0};
   in.goal = {5.0, 2.0};
-  const ControlOutcome out = c.Compute(in);
+  ControlOutcome out = c.Compute(in);
+  EXPECT_TRUE(out.solved);
+  EXPECT_GT(out.command.v, 0.0);
+  ASSERT_GT(c.path().cols(), 0);
+  EXPECT_LT((c.path().col(c.path().cols() - 1) - in.goal).norm(), 1.0);
+  o.min_progress = 1e9;
+  ClRrtStarController strict(&field, Eigen::Vector4d(-0.5, 12.5, -0.5, 8.5), o, 1);
+  out = strict.Compute(in);
   EXPECT_FALSE(out.solved);
   EXPECT_EQ(out.command.v, 0.0);
   EXPECT_EQ(out.command.omega, 0.0);

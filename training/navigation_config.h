@@ -1,0 +1,164 @@
+#pragma once
+/// The config of a navigation experiment (configs/navigation/*.yaml, `model: navigation`): the
+/// crowd scenario, where the pedestrian predictor and the static map come from, the controllers
+/// (SPAN and the reactive and CL-RRT* baselines) and the episodes. Torch-free.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/config.h"
+#include "datasets/crowd_scenario.h"
+#include "inference/navigation/cl_rrt_star.h"
+#include "inference/navigation/span_controller.h"
+
+namespace foresight {
+
+/// The SPAN predictor used by the controller.
+struct NavigationPredictorConfig {
+  /// SPAN artifact (model.h5). When it does not exist, `foresight navigate` trains one there first
+  /// (LibTorch builds): tracks from `tracks`, then the SPAN config `train_config` on them.
+  std::string artifact = "runs/navigation_predictor/model.h5";
+  std::string train_config = "configs/navigation/predictor.yaml";
+  /// Training tracks: "scenario" records the simulated crowd of this config's scenario without the
+  /// robot; "replay" reads `replay` (a recorded file other than the one navigated).
+  std::string tracks = "scenario";
+  int record_episodes = 12;      ///< scenario: seeded runs recorded
+  double record_duration = 60;   ///< scenario: seconds per run
+  ReplayConfig replay;           ///< tracks: replay
+
+  template <class A>
+  void Serialize(A* a) {
+    a->Visit("artifact", &artifact, config::Range::Any(), "SPAN artifact; trained there first when missing");
+    a->Visit("train_config", &train_config, config::Range::Any(), "SPAN config used to train a missing artifact");
+    a->Visit("tracks", &tracks, config::Range::Any(), "training tracks: scenario | replay");
+    a->Visit("record_episodes", &record_episodes, config::Range::Closed(1, 10000), "simulated runs recorded");
+    a->Visit("record_duration", &record_duration, config::Range::Positive(), "seconds per recorded run");
+    a->Visit("replay", &replay, config::Range::Any(), "recorded training tracks (tracks: replay)");
+  }
+};
+
+enum class NavigationMapKind { kFastBhm, kGrid };
+
+/// The static occupancy map: an artifact, or built from the scenario's obstacles.
+struct NavigationMapConfig {
+  std::string artifact;            ///< occupancy-map artifact; empty: build DIR/map.h5 from the scenario
+  NavigationMapKind kind = NavigationMapKind::kFastBhm;
+  double raster_resolution = 0.1;  ///< m, scenario obstacles sampled at this step (labelled points)
+  double spacing = 0.25;           ///< m, Fast-BHM inducing-point spacing (gamma scales as spacing^-2)
+  double field_resolution = 0.05;  ///< m, raster of the swept occupancy used by the controllers
+
+  template <class A>
+  void Serialize(A* a) {
+    a->Visit("artifact", &artifact, config::Range::Any(), "occupancy-map artifact; empty: build from the scenario");
+    a->VisitEnum("kind", &kind,
+                 config::EnumNames<NavigationMapKind>{{NavigationMapKind::kFastBhm, "fast_bhm"},
+                                                      {NavigationMapKind::kGrid, "grid"}},
+                 "map built from the scenario");
+    a->Visit("raster_resolution", &raster_resolution, config::Range::Closed(0.01, 1.0),
+             "sampling step of the scenario obstacles (m)");
+    a->Visit("spacing", &spacing, config::Range::Closed(0.05, 2.0), "Fast-BHM inducing-point spacing (m)");
+    a->Visit("field_resolution", &field_resolution, config::Range::Closed(0.01, 0.4),
+             "resolution of the swept-occupancy raster (m)");
+  }
+};
+
+struct SpanControllerConfig {
+  nav::SpanControllerOptions options;
+  template <class A>
+  void Serialize(A* a) {
+    auto& o = options;
+    a->Visit("kappa", &o.kappa, config::Range::NonNegative(), "weight of the inverse time-to-collision");
+    a->Visit("epsilon", &o.epsilon, config::Range::Open(0, 1), "chance threshold of a collision");
+    a->Visit("horizon", &o.horizon, config::Range::Positive(), "look-ahead horizon T (s)");
+    a->Visit("initialisations", &o.initialisations, config::Range::Closed(1, 100), "COBYLA starts per cycle");
+    a->Visit("max_evaluations", &o.max_evaluations, config::Range::Closed(3, 10000), "COBYLA evaluations per start");
+    a->Visit("xtol", &o.xtol, config::Range::Positive(), "COBYLA tolerance on the controls");
+    a->Visit("initial_step", &o.initial_step, config::Range::Positive(), "COBYLA initial trust radius");
+  }
+};
+
+struct ReactiveControllerConfig {
+  double heading_weight = 0.5;  ///< m per rad of heading error in the one-step cost
+  template <class A>
+  void Serialize(A* a) {
+    a->Visit("heading_weight", &heading_weight, config::Range::NonNegative(), "cost of heading error (m/rad)");
+  }
+};
+
+struct ClRrtStarConfig {
+  nav::ClRrtStarOptions options;
+  template <class A>
+  void Serialize(A* a) {
+    auto& o = options;
+    a->Visit("budget_s", &o.budget_s, config::Range::Positive(), "planning time budget per cycle (s)");
+    a->Visit("max_iterations", &o.max_iterations, config::Range::AtLeast(1), "RRT* iterations per cycle");
+    a->Visit("range", &o.range, config::Range::Positive(), "RRT* extension step (m)");
+    a->Visit("goal_tolerance", &o.goal_tolerance, config::Range::Positive(), "planner goal radius (m)");
+    a->Visit("lookahead", &o.lookahead, config::Range::Positive(), "pure-pursuit look-ahead (m)");
+    a->Visit("check_resolution", &o.check_resolution, config::Range::Positive(), "edge checking step (m)");
+    a->Visit("min_progress", &o.min_progress, config::Range::NonNegative(),
+             "a partial plan is followed when it ends this much closer to the goal (m)");
+  }
+};
+
+struct NavigationVideoConfig {
+  bool enabled = true;
+  std::string method = "span";  ///< whose episode is filmed
+  int episode = 0;
+  int samples = 3;              ///< sampled predicted futures drawn per pedestrian
+  double pixels_per_metre = 30;
+  template <class A>
+  void Serialize(A* a) {
+    a->Visit("enabled", &enabled, config::Range::Any(), "write DIR/episode.avi");
+    a->Visit("method", &method, config::Range::Any(), "method of the filmed episode");
+    a->Visit("episode", &episode, config::Range::AtLeast(0), "filmed episode");
+    a->Visit("samples", &samples, config::Range::Closed(0, 20), "predicted futures drawn per pedestrian");
+    a->Visit("pixels_per_metre", &pixels_per_metre, config::Range::Closed(5, 200), "video scale");
+  }
+};
+
+struct NavigationExperimentConfig {
+  std::string model = "navigation";
+  std::int64_t seed = 0;
+  CrowdScenarioConfig scenario;
+  NavigationPredictorConfig predictor;
+  NavigationMapConfig map;
+  std::vector<std::string> methods{"span", "reactive", "cl_rrt_star"};
+  int episodes = 20;
+  double max_time = 60;          ///< s per episode
+  double dt = 0.1;               ///< s, control period and simulation step
+  double goal_tolerance = 0.5;   ///< m
+  double sensing_range = 10;     ///< m, pedestrians farther from the robot are not observed
+  double v_max = 1.0, omega_max = 1.0;  ///< control limits (v in [-v_max, v_max])
+  SpanControllerConfig span;
+  ReactiveControllerConfig reactive;
+  ClRrtStarConfig cl_rrt_star;
+  NavigationVideoConfig video;
+
+  template <class A>
+  void Serialize(A* a) {
+    a->Visit("model", &model, config::Range::Any(), "experiment type (navigation)");
+    a->Visit("seed", &seed, config::Range::Any(), "seed of the episodes (episode i uses seed + i)");
+    a->Visit("scenario", &scenario, config::Range::Any(), "crowd scenario");
+    a->Visit("predictor", &predictor, config::Range::Any(), "SPAN pedestrian predictor");
+    a->Visit("map", &map, config::Range::Any(), "static occupancy map");
+    a->Visit("methods", &methods, config::Range::Any(), "controllers compared: span | reactive | cl_rrt_star");
+    a->Visit("episodes", &episodes, config::Range::Closed(1, 100000), "episodes per method");
+    a->Visit("max_time", &max_time, config::Range::Positive(), "time limit of an episode (s)");
+    a->Visit("dt", &dt, config::Range::Closed(0.01, 1.0), "control period and simulation step (s)");
+    a->Visit("goal_tolerance", &goal_tolerance, config::Range::Positive(), "goal reached within this distance (m)");
+    a->Visit("sensing_range", &sensing_range, config::Range::Positive(), "observation range of pedestrians (m)");
+    a->Visit("v_max", &v_max, config::Range::Positive(), "linear velocity limit (m/s)");
+    a->Visit("omega_max", &omega_max, config::Range::Positive(), "angular velocity limit (rad/s)");
+    a->Visit("span", &span, config::Range::Any(), "SPAN controller");
+    a->Visit("reactive", &reactive, config::Range::Any(), "reactive baseline");
+    a->Visit("cl_rrt_star", &cl_rrt_star, config::Range::Any(), "CL-RRT* baseline");
+    a->Visit("video", &video, config::Range::Any(), "video of one episode");
+  }
+};
+
+/// Loads and validates a navigation config (strict YAML + scenario and method checks).
+NavigationExperimentConfig LoadNavigationConfig(const std::string& path, const std::vector<std::string>& overrides = {});
+
+}  // namespace foresight
