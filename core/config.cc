@@ -87,6 +87,29 @@ namespace {
 // yaml-cpp's Node::operator= assigns through the handle, so walk by recursion (copy-construct only).
 void SetPath(YAML::Node node, const std::vector<std::string>& keys, std::size_t i,
              const YAML::Node& value, const std::string& assignment) {
+  // `name[k]`: element k of an existing list of mappings (e.g. groups[0].count=5).
+  const auto bracket = keys[i].find('[');
+  if (bracket != std::string::npos) {
+    const std::string name = keys[i].substr(0, bracket);
+    const std::string index_text = keys[i].substr(bracket + 1, keys[i].size() - bracket - 2);
+    const std::optional<long long> index = ParseInteger(index_text);
+    FS_THROW_UNLESS(!name.empty() && keys[i].back() == ']' && index && *index >= 0, "override '",
+                    assignment, "': '", keys[i], "' is not of the form key[index]");
+    YAML::Node list = node[name];
+    FS_THROW_UNLESS(list.IsSequence(), "override '", assignment, "': '", name,
+                    "' is not a list in the config");
+    FS_THROW_UNLESS(static_cast<std::size_t>(*index) < list.size(), "override '", assignment, "': '",
+                    name, "' has ", list.size(), " elements, no index ", *index);
+    if (i + 1 == keys.size()) {
+      list[static_cast<std::size_t>(*index)] = value;
+      return;
+    }
+    YAML::Node element = list[static_cast<std::size_t>(*index)];
+    FS_THROW_UNLESS(element.IsMap(), "override '", assignment, "': '", keys[i],
+                    "' is not a mapping in the config");
+    SetPath(element, keys, i + 1, value, assignment);
+    return;
+  }
   if (i + 1 == keys.size()) {
     node[keys[i]] = value;
     return;

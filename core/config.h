@@ -311,7 +311,8 @@ class DocCollector {
 };
 
 // --------------------------------------------------------------------------------------------
-/// Applies `a.b.c=value` overrides to a YAML tree (value parsed as YAML).
+/// Applies `a.b.c=value` overrides to a YAML tree (value parsed as YAML); `list[i]` addresses an
+/// existing element of a list (`groups[0].count=5`).
 void ApplyOverride(YAML::Node root, const std::string& assignment);
 
 /// Parses YAML text; errors name `source`.

@@ -241,7 +241,7 @@ void PowerLawCrowd::ComputeAccelerations(const RobotAgent& robot,
       f += PowerLawInteractionForce(x, a.velocity - agents_[j].velocity,
                                     a.radius + agents_[j].radius, p.k, p);
     }
-    if (robot.present) {
+    if (robot.present && robot.position.allFinite() && robot.velocity.allFinite()) {
       const Eigen::Vector2d x = a.position - robot.position;
       if (x.squaredNorm() <= range2)
         f += PowerLawInteractionForce(x, a.velocity - robot.velocity, a.radius + robot.radius, p.k,

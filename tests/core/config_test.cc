@@ -158,6 +158,22 @@ TEST(Config, VectorOfStructsErrorsNameTheElementPath) {
   testing::ExpectErrorContains([] { ParseScene("segments: [3]\n"); }, {"'segments[0]'", "'3'", "a mapping"});
 }
 
+TEST(Config, OverridesReachListElements) {
+  const std::string text = "segments:\n  - {x0: 1}\n  - {x0: 2}\n";
+  const Scene s = config::FromYaml<Scene>(config::ParseYaml(text, "s.yaml"), "s.yaml",
+                                          {"segments[1].x1=9", "segments[0].box=[3, 4]"});
+  EXPECT_DOUBLE_EQ(s.segments[1].x1, 9);
+  EXPECT_DOUBLE_EQ(s.segments[1].x0, 2);
+  EXPECT_EQ(s.segments[0].box, (std::vector<double>{3, 4}));
+  const auto parse = [&](const std::string& o) {
+    config::FromYaml<Scene>(config::ParseYaml(text, "s.yaml"), "s.yaml", {o});
+  };
+  testing::ExpectErrorContains([&] { parse("segments[2].x0=1"); }, {"has 2 elements", "index 2"});
+  testing::ExpectErrorContains([&] { parse("segments[a].x0=1"); }, {"key[index]"});
+  testing::ExpectErrorContains([&] { parse("name[0].x0=1"); }, {"'name' is not a list"});
+  testing::ExpectErrorContains([&] { parse("segments[0].y9=1"); }, {"unknown key 'segments[0].y9'"});
+}
+
 TEST(Config, VectorOfStructsRoundTripsAndIsDocumented) {
   const Scene s = ParseScene("name: t\nsegments:\n  - {x0: 0.25, x1: 7, box: [1]}\n  - {x0: -3}\n");
   const std::string text = config::ToYaml(s);
