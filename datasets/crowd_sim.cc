@@ -166,6 +166,9 @@ std::vector<SimWall> ScenarioWalls(const CrowdScenarioConfig& s) {
 // --------------------------------------------------------------------------------------------
 PowerLawCrowd::PowerLawCrowd(const CrowdScenarioConfig& scenario, std::uint64_t seed)
     : scenario_(scenario), walls_(ScenarioWalls(scenario)), rng_(seed) {
+  scenario_.Validate("crowd scenario '" + scenario_.name + "'");
+  FS_THROW_UNLESS(scenario_.source == CrowdSource::kSimulated, "crowd scenario '", scenario_.name,
+                  "': PowerLawCrowd needs source: simulated");
   const PowerLawParams& p = scenario_.power_law;
   const Eigen::Vector2d robot_start(scenario_.robot_start[0], scenario_.robot_start[1]);
   const double robot_clearance =

@@ -280,6 +280,9 @@ TEST(PowerLawCrowd, OvercrowdedSpawnBoxIsAnError) {
   s.groups[0].spawn = {0, 1, 0, 1};
   testing::ExpectErrorContains([&] { PowerLawCrowd c(s, 1); },
                                {"groups[0]", "cannot place pedestrian", "spawn box"});
+  s.groups[0].count = 1;
+  s.groups[0].spawn = {0, 1};
+  testing::ExpectErrorContains([&] { PowerLawCrowd c(s, 1); }, {"'groups[0].spawn'", "4 finite"});
 }
 
 // ---- the Implicit Crowds reference scenarios (../shared/data) -------------------------------
