@@ -1,0 +1,119 @@
+// The navigation harness: a short episode per method end to end, summary.json keys, and the
+// load-time errors of bad configs (unreachable or blocked goals, starts in collision, empty crowds,
+// artifacts of the wrong kind).
+#include "training/navigation_run.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "tests/test_util.h"
+
+namespace foresight {
+namespace {
+
+NavigationExperimentConfig SmallConfig(const testing::TempDir& dir) {
+  NavigationExperimentConfig c;
+  c.scenario = Sim2Scenario();
+  for (auto& g : c.scenario.groups) g.count = 2;
+  c.scenario.extent = {-6, 6, -6, 6};
+  c.scenario.groups = {c.scenario.groups[0], c.scenario.groups[1]};
+  c.scenario.groups[0].spawn = {-5.5, -4.5, -2, 2};
+  c.scenario.groups[0].goal = {4.5, 5.5, -2, 2};
+  c.scenario.groups[1].spawn = {4.5, 5.5, -2, 2};
+  c.scenario.groups[1].goal = {-5.5, -4.5, -2, 2};
+  c.scenario.robot_start = {-4.5, -4.5, 0.785};
+  c.scenario.robot_goal = {4.5, 4.5};
+  c.max_time = 25;
+  c.episodes = 1;
+  c.span.options.initialisations = 6;
+  c.cl_rrt_star.options.max_iterations = 300;
+  c.video.pixels_per_metre = 10;
+  testing::RandomSpanSpec spec;
+  spec.observed = 5;
+  spec.predicted = 40;
+  spec.seconds_per_step = 0.1;
+  c.predictor.artifact = dir.File("predictor.h5");
+  testing::WriteRandomSpanArtifact(c.predictor.artifact, spec);
+  return c;
+}
+
+TEST(NavigationRun, EveryMethodRunsAnEpisodeAndTheSummaryHasItsKeys) {
+  testing::TempDir dir;
+  const NavigationExperimentConfig c = SmallConfig(dir);
+  const std::vector<MethodSummary> s = RunNavigation(c, dir.path(), 1);
+  ASSERT_EQ(s.size(), 3u);
+  for (const MethodSummary& m : s) {
+    EXPECT_EQ(m.episodes, 1);
+    EXPECT_GE(m.cycle_ms_median, 0.0);
+  }
+  EXPECT_EQ(s[1].method, "reactive");
+  EXPECT_EQ(s[1].success_rate, 1.0) << "the reactive robot crosses a nearly empty square";
+  std::ifstream in(dir.File("summary.json"));
+  std::stringstream text;
+  text << in.rdbuf();
+  for (const char* key : {"\"span\"", "\"reactive\"", "\"cl_rrt_star\"", "success_rate", "collision_free_rate", "ttg_mean",
+                          "doc_mean", "min_clearance", "cycle_ms_median", "cycle_ms_p99"})
+    EXPECT_NE(text.str().find(key), std::string::npos) << key;
+  for (const char* f : {"episodes.csv", "paths.png", "episode.avi", "map.h5"})
+    EXPECT_TRUE(std::filesystem::exists(dir.File(f))) << f;
+  EXPECT_GT(std::filesystem::file_size(dir.File("episode.avi")), 1000u);
+}
+
+TEST(NavigationRun, EpisodesAreDeterministicForReplayFreeMethods) {
+  testing::TempDir dir;
+  NavigationExperimentConfig c = SmallConfig(dir);
+  c.methods = {"reactive"};
+  const NavigationResources res = PrepareNavigation(c, dir.path());
+  const EpisodeResult a = RunEpisode(c, res, "reactive", 0), b = RunEpisode(c, res, "reactive", 0);
+  EXPECT_EQ(a.path, b.path);
+  EXPECT_EQ(a.doc, b.doc);
+}
+
+TEST(NavigationRun, BadScenesAndArtifactsAreClearErrors) {
+  testing::TempDir dir;
+  NavigationExperimentConfig c = SmallConfig(dir);
+  c.methods = {"reactive"};
+  // A goal inside a wall.
+  NavigationExperimentConfig bad = c;
+  bad.scenario.walls = {{0, -6, 0, 6}};
+  bad.scenario.robot_goal = {0.0, 4.5};
+  testing::ExpectErrorContains([&] { RunNavigation(bad, dir.path(), 1); }, {"robot_goal"});
+  // A wall across the whole square: the goal is unreachable.
+  bad.scenario.robot_goal = {4.5, 4.5};
+  testing::ExpectErrorContains([&] { RunNavigation(bad, dir.path(), 1); }, {"robot_goal", "unreachable"});
+  // A start in collision with the border.
+  bad = c;
+  bad.scenario.robot_start = {-5.9, -4.5, 0};
+  testing::ExpectErrorContains([&] { RunNavigation(bad, dir.path(), 1); }, {"robot_start"});
+  // No pedestrians in a simulated scene.
+  bad = c;
+  bad.scenario.groups.clear();
+  EXPECT_THROW(RunNavigation(bad, dir.path(), 1), Error);
+  // A map artifact where the predictor belongs, and the predictor where the map belongs.
+  bad = c;
+  bad.methods = {"span"};
+  RunNavigation(c, dir.path(), 1);  // writes map.h5
+  bad.predictor.artifact = dir.File("map.h5");
+  testing::ExpectErrorContains([&] { PrepareNavigation(bad, dir.path()); }, {"map.h5", "span_predictor"});
+  bad = c;
+  bad.map.artifact = c.predictor.artifact;
+  EXPECT_THROW(PrepareNavigation(bad, dir.path()), Error);
+  // A predictor that observes every 0.15 s cannot be fed at dt = 0.1 s.
+  bad = c;
+  bad.methods = {"span"};
+  testing::RandomSpanSpec spec;
+  spec.observed = 5;
+  spec.seconds_per_step = 0.15;
+  bad.predictor.artifact = dir.File("odd.h5");
+  testing::WriteRandomSpanArtifact(bad.predictor.artifact, spec);
+  testing::ExpectErrorContains([&] { PrepareNavigation(bad, dir.path()); }, {"odd.h5", "multiple of dt"});
+  bad = c;
+  bad.methods = {"teleport"};
+  testing::ExpectErrorContains([&] { PrepareNavigation(bad, dir.path()); }, {"methods", "teleport"});
+}
+
+}  // namespace
+}  // namespace foresight
