@@ -16,6 +16,10 @@ void AddBenchMapCommand(CLI::App* bench);  // bench map (under `bench`)
 /// `train` for builds without LibTorch: occupancy configs only.
 void AddOccupancyOnlyTrainCommand(CLI::App* app);
 
+/// True when the YAML file's `model` is `directional` (continuous directional maps; needs LibTorch).
+bool IsDirectionalConfig(const std::string& path);
+/// `bench directional` (under `bench`; needs LibTorch for the comparison).
+void AddBenchDirectionalCommand(CLI::App* bench);
 /// True when the YAML file's `model` is occupancy.* (so `train` runs the occupancy pipeline).
 bool IsOccupancyConfig(const std::string& path);
 /// Evaluates run_dir/model.h5 (any occupancy map) on the config's test scans; prints JSON.

@@ -8,6 +8,8 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "embedded_config.h"
+#include "training/directional_config.h"
+#include "training/directional_pipeline.h"
 #include "training/occupancy_config.h"
 #include "training/span_eval.h"
 #include "training/span_pipeline.h"
@@ -30,6 +32,22 @@ std::string DefaultRunDir(const std::string& config_path) {
   return "runs/" + stem;
 }
 
+/// Cross-validated directional maps into run_dir (resume continues unfinished fold networks).
+void RunDirectional(const std::string& config_path, const std::vector<std::string>& overrides,
+                    const std::string& run_dir, bool resume) {
+  const DirectionalExperimentConfig c = LoadDirectionalConfig(config_path, overrides);
+  DirectionalRunResult r;
+  {
+    const ScopedInterruptFlag interrupt;
+    TrainHooks hooks;
+    hooks.interrupt = interrupt.flag();
+    r = RunDirectionalExperiment(c, run_dir, resume, hooks);
+  }
+  if (r.interrupted) Fail("interrupted; continue with --resume --run-dir ", run_dir);
+  std::cout << r.report.BriefReport() << "\n"
+            << "wrote " << run_dir << "/model.h5, eval.json, eval.csv and plots/*.png\n";
+}
+
 struct TrainArgs {
   std::string config, run_dir;
   std::vector<std::string> overrides;
@@ -38,7 +56,15 @@ struct TrainArgs {
 
 }  // namespace
 
+bool IsDirectionalConfig(const std::string& path) {
+  if (path.empty() || path == "default") return false;
+  const YAML::Node root = config::LoadYamlFile(path);
+  if (!root.IsMap() || !root["model"] || !root["model"].IsScalar()) return false;
+  return root["model"].as<std::string>() == "directional";
+}
+
 void AddTrainCommands(CLI::App* app) {
+  AddBenchDirectionalCommand(app->get_subcommand("bench"));  // `bench` is registered first (main.cc)
   auto targs = std::make_shared<TrainArgs>();
   auto* train = app->add_subcommand("train", "train a model from a YAML config, export it and evaluate it");
   train->add_option("config", targs->config, "config file, or 'default' for the embedded quickstart")->required();
@@ -50,6 +76,10 @@ void AddTrainCommands(CLI::App* app) {
     const std::string run_dir = targs->run_dir.empty() ? DefaultRunDir(targs->config) : targs->run_dir;
     if (IsOccupancyConfig(targs->config)) {
       TrainOccupancy(targs->config, targs->overrides, run_dir, targs->resume);
+      return;
+    }
+    if (IsDirectionalConfig(targs->config)) {
+      RunDirectional(targs->config, targs->overrides, run_dir, targs->resume);
       return;
     }
     const SpanExperimentConfig c = LoadConfig(targs->config, targs->overrides);
@@ -95,6 +125,12 @@ void AddTrainCommands(CLI::App* app) {
       EvalOccupancy(eargs->config, eargs->overrides, eargs->run_dir);
       return;
     }
+    if (IsDirectionalConfig(eargs->config)) {
+      // Re-evaluates every fold with the trained networks (resume skips finished training).
+      const DirectionalExperimentConfig c = LoadDirectionalConfig(eargs->config, eargs->overrides);
+      std::cout << RunDirectionalExperiment(c, eargs->run_dir, true).report.ToJson();
+      return;
+    }
     const SpanExperimentConfig c = LoadConfig(eargs->config, eargs->overrides);
     const std::string artifact = eargs->run_dir + "/model.h5";
     FS_THROW_UNLESS(fs::exists(artifact), artifact, ": not found (run `foresight export ", eargs->run_dir, "` first)");
@@ -115,7 +151,10 @@ void AddTrainCommands(CLI::App* app) {
         config::ReferenceTable<SpanExperimentConfig>() +
         "\n## Occupancy-map experiments\n\nEvery key of an occupancy config (`configs/occupancy/*.yaml`, "
         "`model: occupancy.*`) with its default.\n\n" +
-        config::ReferenceTable<OccupancyExperimentConfig>();
+        config::ReferenceTable<OccupancyExperimentConfig>() +
+        "\n## Directional-map experiments\n\nEvery key of a directional config (`configs/directional/*.yaml`, "
+        "`model: directional`) with its default.\n\n" +
+        config::ReferenceTable<DirectionalExperimentConfig>();
     if (docs_out->empty()) std::cout << text;
     else std::ofstream(*docs_out) << text;
   });

@@ -1,0 +1,130 @@
+// `foresight bench directional`: query latency of the directional-map engine (Eigen) against
+// LibTorch on the same exported network, side by side in one run, one thread: batch 1 (median of
+// single queries) and batch 1024 (median of repeated batches). Both sides go from (x, y, t) to the
+// mixture parameters; the LibTorch side gets the features from the same feature code.
+// A benchmark that prints figures, not a test.
+
+#include <torch/torch.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <random>
+
+#include "apps/commands.h"
+#include "core/error.h"
+#include "inference/directional/directional_map.h"
+#include "training/directional_pipeline.h"
+
+namespace foresight::app {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using RowMatrixF = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
+double Median(std::vector<double> v) {
+  std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
+double Us(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double, std::micro>(b - a).count(); }
+
+struct BenchDirectionalArgs {
+  std::string artifact;
+  int calls = 5000;
+  int repeats = 15;
+  bool json = false;
+};
+
+void RunDirectionalBench(const BenchDirectionalArgs& a) {
+  torch::set_num_threads(1);
+  const DirectionalMap map = DirectionalMap::Load(a.artifact);
+  const DirectionalFeatureConfig& fc = map.features().config();
+  const int n = 1024;
+  std::mt19937_64 rng(1);
+  std::uniform_real_distribution<double> ux(fc.x_min, fc.x_max), uy(fc.y_min, fc.y_max), ut(fc.t_min, fc.t_max);
+  Eigen::VectorXd x(n), y(n), t(n);
+  for (int i = 0; i < n; ++i) x[i] = ux(rng), y[i] = uy(rng), t[i] = ut(rng);
+
+  // Engine, batch 1.
+  auto ws = map.MakeWorkspace();
+  std::vector<double> e1;
+  for (int i = 0; i < a.calls + 200; ++i) {
+    const int k = i % n;
+    const auto t0 = Clock::now();
+    map.QueryOne(x[k], y[k], t[k], &ws);
+    const auto t1 = Clock::now();
+    if (i >= 200) e1.push_back(Us(t0, t1));
+  }
+  // Engine, batch 1024.
+  VonMisesMixtureBatch batch;
+  map.Query(x, y, t, &ws, &batch);
+  std::vector<double> eb;
+  for (int r = 0; r < a.repeats; ++r) {
+    const auto t0 = Clock::now();
+    map.Query(x, y, t, &ws, &batch);
+    eb.push_back(Us(t0, Clock::now()));
+  }
+
+  // LibTorch on the same network: features (same code) -> forward -> decode.
+  LoadedDirectionalNet net = LoadDirectionalNetFromArtifact(a.artifact);
+  const DirectionalFeatures& feats = map.features();
+  c10::InferenceMode guard;
+  auto torch_query = [&](int begin, int len, std::vector<double>* forward_only) {
+    const auto t0 = Clock::now();
+    RowMatrixF s(len, feats.spatial_size()), tm(len, feats.time_size());
+    feats.SpatialBatch(x.segment(begin, len), y.segment(begin, len), s);
+    feats.TemporalBatch(t.segment(begin, len), tm);
+    const auto ts = torch::from_blob(s.data(), {s.rows(), s.cols()}, torch::kFloat32);
+    const auto tt = torch::from_blob(tm.data(), {tm.rows(), tm.cols()}, torch::kFloat32);
+    const auto t1 = Clock::now();
+    const auto p = DecodeDirectionalHead(net.net->forward(ts, tt), net.net->components());
+    (void)p.kappa.sum().item<float>();
+    const auto t2 = Clock::now();
+    if (forward_only) forward_only->push_back(Us(t1, t2));
+    return Us(t0, t2);
+  };
+  std::vector<double> l1, l1f;
+  const int torch_calls = std::max(200, a.calls / 5);
+  for (int i = 0; i < torch_calls + 50; ++i) {
+    const double us = torch_query(i % n, 1, i >= 50 ? &l1f : nullptr);
+    if (i >= 50) l1.push_back(us);
+  }
+  std::vector<double> lb, lbf;
+  torch_query(0, n, nullptr);
+  for (int r = 0; r < a.repeats; ++r) lb.push_back(torch_query(0, n, &lbf));
+
+  const double engine1 = Median(e1), engine_b = Median(eb), torch1 = Median(l1), torch_b = Median(lb);
+  if (a.json) {
+    std::cout << "{\"artifact\": \"" << a.artifact << "\", \"variant\": \"" << VariantName(map.variant())
+              << "\", \"inducing_points\": " << feats.spatial_size() << ", \"time_points\": " << feats.time_size()
+              << ", \"threads\": 1, \"engine_batch1_us\": " << engine1 << ", \"libtorch_batch1_us\": " << torch1
+              << ", \"libtorch_batch1_forward_us\": " << Median(l1f) << ", \"engine_batch1024_us\": " << engine_b
+              << ", \"libtorch_batch1024_us\": " << torch_b << ", \"libtorch_batch1024_forward_us\": " << Median(lbf)
+              << "}\n";
+    return;
+  }
+  std::printf("directional map %s: %d x %d inducing points x %d times, R = %d, 1 thread\n",
+              VariantName(map.variant()), fc.cells_x, fc.cells_y, fc.time_points, map.components());
+  std::printf("batch 1    engine (median of %d):   %10.2f us\n", a.calls, engine1);
+  std::printf("batch 1    libtorch (features+net):  %10.2f us   (net only %.2f us)   ratio %.1f x\n", torch1,
+              Median(l1f), torch1 / engine1);
+  std::printf("batch 1024 engine (median of %d):     %10.1f us   (%.2f us/query)\n", a.repeats, engine_b, engine_b / n);
+  std::printf("batch 1024 libtorch (features+net):  %10.1f us   (net only %.1f us)   ratio %.2f x\n", torch_b,
+              Median(lbf), torch_b / engine_b);
+}
+
+}  // namespace
+
+void AddBenchDirectionalCommand(CLI::App* bench) {
+  auto a = std::make_shared<BenchDirectionalArgs>();
+  auto* cmd = bench->add_subcommand("directional", "directional map: engine vs LibTorch query latency (batch 1, 1024)");
+  cmd->add_option("--artifact", a->artifact, "exported directional model .h5 (RUN_DIR/model.h5)")->required();
+  cmd->add_option("--calls", a->calls, "timed single queries")->check(CLI::Range(100, 10000000));
+  cmd->add_option("--repeats", a->repeats, "timed batches of 1024")->check(CLI::Range(1, 10000));
+  cmd->add_flag("--json", a->json, "print one JSON object");
+  cmd->callback([a] { RunDirectionalBench(*a); });
+}
+
+}  // namespace foresight::app
