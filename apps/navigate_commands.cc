@@ -6,9 +6,11 @@
 
 #include "apps/commands.h"
 #include "core/error.h"
+#include "embedded_navigation_config.h"
 #include "training/navigation_config.h"
 #include "training/navigation_run.h"
 #ifdef FORESIGHT_WITH_TORCH
+#include "embedded_navigation_predictor_config.h"
 #include "training/navigation_predictor.h"
 #endif
 
@@ -39,19 +41,25 @@ void PrintTable(const std::vector<MethodSummary>& rows) {
 void AddNavigateCommand(CLI::App* app) {
   auto args = std::make_shared<NavigateArgs>();
   auto* nav = app->add_subcommand("navigate", "run SPAN and the reactive and CL-RRT* baselines through a crowd scenario");
-  nav->add_option("config", args->config, "navigation config (configs/navigation/*.yaml)")->required();
+  nav->add_option("config", args->config,
+                  "navigation config (configs/navigation/*.yaml), or 'default' for the embedded configs/navigation/sim1.yaml")
+      ->required();
   nav->add_option("overrides", args->overrides, "key.path=value overrides of the config");
   nav->add_option("--out", args->out, "output directory (default runs/navigate_<config name>)");
   nav->add_option("--episodes", args->episodes, "episodes per method (default: the config's)")->check(CLI::Range(1, 100000));
   nav->callback([args] {
-    const NavigationExperimentConfig c = LoadNavigationConfig(args->config, args->overrides);
-    const std::string out = args->out.empty() ? "runs/navigate_" + fs::path(args->config).stem().string() : args->out;
+    const bool embedded = args->config == "default";
+    const NavigationExperimentConfig c =
+        embedded ? NavigationConfigFromYaml(kEmbeddedNavigationConfig, "<embedded configs/navigation/sim1.yaml>", args->overrides)
+                 : LoadNavigationConfig(args->config, args->overrides);
+    const std::string out =
+        !args->out.empty() ? args->out : "runs/navigate_" + (embedded ? std::string("sim1") : fs::path(args->config).stem().string());
     fs::create_directories(out);
     std::ofstream(out + "/config.yaml") << config::ToYaml(c);
     const bool needs_predictor = std::find(c.methods.begin(), c.methods.end(), "span") != c.methods.end();
     if (needs_predictor && !fs::exists(c.predictor.artifact)) {
 #ifdef FORESIGHT_WITH_TORCH
-      EnsureNavigationPredictor(c);
+      EnsureNavigationPredictor(c, kEmbeddedNavigationPredictorConfig);
 #else
       Fail("predictor.artifact: ", c.predictor.artifact,
            " not found; this build has no LibTorch to train it (train it with a LibTorch build first)");

@@ -19,21 +19,26 @@ struct NavigationPredictorConfig {
   /// SPAN artifact (model.h5). When it does not exist, `foresight navigate` trains one there first
   /// (LibTorch builds): tracks from `tracks`, then the SPAN config `train_config` on them.
   std::string artifact = "runs/navigation_predictor/model.h5";
-  std::string train_config = "configs/navigation/predictor.yaml";
+  std::string train_config = "default";  ///< "default": the embedded configs/navigation/predictor.yaml
   /// Training tracks: "scenario" records the simulated crowd of this config's scenario without the
   /// robot; "replay" reads `replay` (a recorded file other than the one navigated).
   std::string tracks = "scenario";
   int record_episodes = 12;      ///< scenario: seeded runs recorded
   double record_duration = 60;   ///< scenario: seconds per run
+  /// Std of Gaussian noise added to recorded simulated positions (m): a tracker's measurement noise.
+  /// Noise-free simulated tracks make the matrix-normal likelihood degenerate (near-zero residuals).
+  double position_noise = 0.02;
   ReplayConfig replay;           ///< tracks: replay
 
   template <class A>
   void Serialize(A* a) {
     a->Visit("artifact", &artifact, config::Range::Any(), "SPAN artifact; trained there first when missing");
-    a->Visit("train_config", &train_config, config::Range::Any(), "SPAN config used to train a missing artifact");
+    a->Visit("train_config", &train_config, config::Range::Any(), "SPAN config used to train a missing artifact ('default': the embedded configs/navigation/predictor.yaml)");
     a->Visit("tracks", &tracks, config::Range::Any(), "training tracks: scenario | replay");
     a->Visit("record_episodes", &record_episodes, config::Range::Closed(1, 10000), "simulated runs recorded");
     a->Visit("record_duration", &record_duration, config::Range::Positive(), "seconds per recorded run");
+    a->Visit("position_noise", &position_noise, config::Range::NonNegative(),
+             "std of measurement noise added to recorded simulated positions (m)");
     a->Visit("replay", &replay, config::Range::Any(), "recorded training tracks (tracks: replay)");
   }
 };
@@ -75,6 +80,8 @@ struct SpanControllerConfig {
     a->Visit("max_evaluations", &o.max_evaluations, config::Range::Closed(3, 10000), "COBYLA evaluations per start");
     a->Visit("xtol", &o.xtol, config::Range::Positive(), "COBYLA tolerance on the controls");
     a->Visit("initial_step", &o.initial_step, config::Range::Positive(), "COBYLA initial trust radius");
+    a->Visit("geodesic_goal", &o.geodesic_goal, config::Range::Any(),
+             "goal term as the distance around static obstacles (false: ||x(T) - g|| as printed)");
   }
 };
 
@@ -160,5 +167,8 @@ struct NavigationExperimentConfig {
 
 /// Loads and validates a navigation config (strict YAML + scenario and method checks).
 NavigationExperimentConfig LoadNavigationConfig(const std::string& path, const std::vector<std::string>& overrides = {});
+/// The same from YAML text (`source` names it in errors), e.g. the embedded default.
+NavigationExperimentConfig NavigationConfigFromYaml(const std::string& yaml_text, const std::string& source,
+                                                    const std::vector<std::string>& overrides = {});
 
 }  // namespace foresight

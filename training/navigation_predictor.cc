@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <random>
 
 #include "core/error.h"
 #include "core/log.h"
@@ -14,7 +15,7 @@
 namespace foresight {
 namespace fs = std::filesystem;
 
-std::string EnsureNavigationPredictor(const NavigationExperimentConfig& c) {
+std::string EnsureNavigationPredictor(const NavigationExperimentConfig& c, const std::string& embedded_default) {
   const NavigationPredictorConfig& p = c.predictor;
   if (fs::exists(p.artifact)) return p.artifact;
   const fs::path artifact(p.artifact);
@@ -32,6 +33,10 @@ std::string EnsureNavigationPredictor(const NavigationExperimentConfig& c) {
                       "scenario; for replays set predictor.tracks: replay and predictor.replay to other recordings");
       tracks = RecordCrowdTracks(c.scenario, p.record_episodes, p.record_duration, c.dt,
                                  static_cast<std::uint64_t>(c.seed) + 1000003);
+      std::mt19937_64 rng(static_cast<std::uint64_t>(c.seed) + 7);
+      std::normal_distribution<double> noise(0.0, p.position_noise);
+      if (p.position_noise > 0)
+        for (Track& t : tracks.tracks) t.positions += t.positions.unaryExpr([&](double) { return noise(rng); });
     }
     FS_THROW_UNLESS(!tracks.tracks.empty(), "predictor: no training tracks from ", p.tracks);
     WriteTrackStore(tracks_file + ".tmp", tracks);
@@ -39,9 +44,13 @@ std::string EnsureNavigationPredictor(const NavigationExperimentConfig& c) {
     log::Info("predictor: ", tracks.tracks.size(), " training tracks (", tracks.NumPoints(), " points) -> ", tracks_file);
   }
   const TrackSet stored = ReadTrackStore(tracks_file);
-  SpanExperimentConfig span = LoadSpanConfig(
-      p.train_config, {"data.format=track_store", "data.root=", "data.train_files=[" + tracks_file + "]",
-                       "data.seconds_per_step=" + std::to_string(stored.seconds_per_step)});
+  const std::vector<std::string> data = {"data.format=track_store", "data.root=",
+                                         "data.train_files=[" + tracks_file + "]",
+                                         "data.seconds_per_step=" + std::to_string(stored.seconds_per_step)};
+  const SpanExperimentConfig span =
+      p.train_config == "default"
+          ? SpanConfigFromYaml(embedded_default, "<embedded configs/navigation/predictor.yaml>", data)
+          : LoadSpanConfig(p.train_config, data);
   const bool resume = fs::exists(run_dir + "/checkpoints/last.pt");
   std::cout << "training the SPAN predictor into " << run_dir << (resume ? " (resuming)" : "") << "\n";
   TrainingSummary s;

@@ -290,6 +290,7 @@ EpisodeResult RunEpisode(const NavigationExperimentConfig& c, const NavigationRe
     ++out.cycles;
     // Metrics at the new state.
     double clear = res.StaticDistance(s.x, s.y) - r_robot;
+    if (clear < 0) out.doc_static += c.dt;
     for (const CrowdAgent& a : crowd->agents())
       if (a.active) clear = std::min(clear, (a.position - s.position()).norm() - r_robot - a.radius);
     if (clear < 0) out.doc += c.dt;
@@ -374,14 +375,14 @@ std::vector<MethodSummary> RunNavigation(const NavigationExperimentConfig& c, co
   }
   std::vector<EpisodeResult> results;
   std::ofstream csv(out_dir + "/episodes.csv");
-  csv << "method,episode,seed,reached,ttg,doc,min_clearance,path_length,cycles,solve_failures,cycle_ms_median,cycle_ms_p99\n";
+  csv << "method,episode,seed,reached,ttg,doc,doc_static,min_clearance,path_length,cycles,solve_failures,cycle_ms_median,cycle_ms_p99\n";
   for (const std::string& method : c.methods) {
     for (int e = 0; e < n; ++e) {
       std::unique_ptr<VideoRecorder> video;
       if (c.video.enabled && method == c.video.method && e == c.video.episode)
         video = std::make_unique<VideoRecorder>(out_dir + "/episode.avi", res.raster, c.video, c.dt, c.seed);
       EpisodeResult r = RunEpisode(c, res, method, e, video.get());
-      csv << r.method << ',' << r.episode << ',' << r.seed << ',' << r.reached << ',' << r.ttg << ',' << r.doc << ','
+      csv << r.method << ',' << r.episode << ',' << r.seed << ',' << r.reached << ',' << r.ttg << ',' << r.doc << ',' << r.doc_static << ','
           << r.min_clearance << ',' << r.path_length << ',' << r.cycles << ',' << r.solve_failures << ','
           << Percentile(r.cycle_ms, 0.5) << ',' << Percentile(r.cycle_ms, 0.99) << '\n';
       csv.flush();

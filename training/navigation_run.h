@@ -41,6 +41,7 @@ struct EpisodeResult {
   bool reached = false;
   double ttg = 0;            ///< s (time of arrival; max_time when not reached)
   double doc = 0;            ///< s in collision with a pedestrian or a static obstacle
+  double doc_static = 0;     ///< s of `doc` in contact with a static obstacle
   double min_clearance = 0;  ///< m, smallest gap to a pedestrian or obstacle (negative: overlap)
   double path_length = 0;    ///< m
   int cycles = 0, solve_failures = 0;

@@ -41,8 +41,15 @@ Normalisation FitNormalisation(const Eigen::MatrixXd& x) {
   Normalisation n;
   n.mean = x.colwise().mean().transpose();
   n.std = ((x.rowwise() - n.mean.transpose()).array().square().colwise().mean()).sqrt().transpose();
-  for (Eigen::Index i = 0; i < n.std.size(); ++i)
-    if (!(n.std[i] > 1e-6)) n.std[i] = 1.0;  // constant features (the ego origin) pass through
+  // Constant features (the ego origin) pass through. Nearly constant ones are floored at 1 cm:
+  // e.g. the ego y of the first point is 0 except in the rare windows too short to rotate (standing
+  // pedestrians), and dividing those by a micrometre-scale std feeds the network inputs of 1e3+
+  // (non-finite losses on crowd data with many standing pedestrians).
+  constexpr double kMinStd = 0.01;  // m
+  for (Eigen::Index i = 0; i < n.std.size(); ++i) {
+    if (!(n.std[i] > 1e-6)) n.std[i] = 1.0;
+    else n.std[i] = std::max(n.std[i], kMinStd);
+  }
   return n;
 }
 

@@ -158,7 +158,8 @@ double SpanController::Cost(const UnicycleState& robot, const Eigen::Vector2d& g
       t_collide = k * options_.dt;
   }
   if (tau) *tau = t_collide;
-  const double distance = (s.position() - goal).norm();
+  const double distance = !goal_field_.empty() && goal_field_.goal() == goal ? goal_field_.Distance(s.position())
+                                                                            : (s.position() - goal).norm();
   return std::isfinite(t_collide) ? distance + options_.kappa / t_collide : distance;
 }
 
@@ -166,9 +167,13 @@ ControlOutcome SpanController::Compute(const NavigationInput& input) {
   ControlOutcome out;
   try {
     Forecast(input);
+    if (options_.geodesic_goal && field_ && (goal_field_.empty() || goal_field_.goal() != input.goal))
+      goal_field_ = GoalDistanceField(*field_, input.goal, options_.epsilon);
     Problem problem;
     problem.cost = [&](const Control& u) { return Cost(input.robot, input.goal, u, nullptr); };
-    const double lower = std::max(0.0, (input.robot.position() - input.goal).norm() - options_.limits.v_max * options_.horizon);
+    const double here = goal_field_.empty() || goal_field_.goal() != input.goal ? (input.robot.position() - input.goal).norm()
+                                                                                : goal_field_.Distance(input.robot.position());
+    const double lower = std::max(0.0, here - options_.limits.v_max * options_.horizon);
     const auto [best, cost] = MinimiseFromStarts(options_, Starts(options_, input.robot, input.goal,
                                                                   has_previous_ ? &previous_ : nullptr),
                                                  options_.initialisations, lower, &problem);
@@ -210,8 +215,16 @@ double ReactiveController::Cost(const UnicycleState& robot, const Eigen::Vector2
   const bool hit = (field_ && field_->Collides(p.x(), p.y(), options_.epsilon, &map_ws_)) ||
                    forecast_.Collides(1, p, options_.robot_radius + options_.pedestrian_radius, threshold_);
   if (collides) *collides = hit;
-  const double bearing = std::atan2(goal.y() - p.y(), goal.x() - p.x());
-  return (p - goal).norm() + heading_weight_ * std::abs(WrapToPi(bearing - s.heading)) + (hit ? options_.kappa : 0.0);
+  double bearing = std::atan2(goal.y() - p.y(), goal.x() - p.x());
+  double distance = (p - goal).norm();
+  if (!goal_field_.empty() && goal_field_.goal() == goal) {
+    distance = goal_field_.Distance(p);
+    const double h = 0.1;  // steepest descent of the geodesic distance by central differences
+    const double gx = goal_field_.Distance(p + Eigen::Vector2d(h, 0)) - goal_field_.Distance(p - Eigen::Vector2d(h, 0));
+    const double gy = goal_field_.Distance(p + Eigen::Vector2d(0, h)) - goal_field_.Distance(p - Eigen::Vector2d(0, h));
+    if (std::hypot(gx, gy) > 1e-9) bearing = std::atan2(-gy, -gx);
+  }
+  return distance + heading_weight_ * std::abs(WrapToPi(bearing - s.heading)) + (hit ? options_.kappa : 0.0);
 }
 
 ControlOutcome ReactiveController::Compute(const NavigationInput& input) {
@@ -220,6 +233,8 @@ ControlOutcome ReactiveController::Compute(const NavigationInput& input) {
     Eigen::MatrixXd clean;
     const int n = input.past_rows ? CleanObservations(*input.past_rows, &clean, &current_) : 0;
     forecast_.FromCurrentPositions(current_.leftCols(n), 1);
+    if (options_.geodesic_goal && field_ && (goal_field_.empty() || goal_field_.goal() != input.goal))
+      goal_field_ = GoalDistanceField(*field_, input.goal, options_.epsilon);
     Problem problem;
     problem.cost = [&](const Control& u) { return Cost(input.robot, input.goal, u, nullptr); };
     const auto [best, cost] = MinimiseFromStarts(options_, Starts(options_, input.robot, input.goal, nullptr),

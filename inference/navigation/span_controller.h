@@ -15,6 +15,7 @@
 
 #include "inference/navigation/controller.h"
 #include "inference/navigation/crowd_forecast.h"
+#include "inference/navigation/goal_distance.h"
 #include "inference/navigation/static_clearance.h"
 #include "inference/prediction/span_predictor.h"
 
@@ -32,6 +33,9 @@ struct SpanControllerOptions {
   int max_evaluations = 40;        ///< per start
   double xtol = 1e-3;              ///< COBYLA tolerance on u
   double initial_step = 0.4;       ///< COBYLA initial trust radius on u
+  /// With a static map: measure the goal term as the geodesic distance around obstacles
+  /// (GoalDistanceField) instead of ||x(T) - g||; identical where the way to the goal is free.
+  bool geodesic_goal = true;
   /// Describe problems (names the offending field) or return an empty string.
   std::string Problems() const;
 };
@@ -68,13 +72,16 @@ class SpanController final : public NavigationController {
   Eigen::Matrix2Xd current_;
   Control previous_;
   bool has_previous_ = false;
+  GoalDistanceField goal_field_;  ///< rebuilt when the goal changes
 };
 
 /// The reactive baseline (thesis ch 5, "Experimental Evaluation"): optimises the next step only,
 /// without anticipation. Pedestrians are taken at their current positions; the cost is the distance
-/// to the goal after one step plus `heading_weight` times the heading error to the goal, with kappa
-/// added when the step collides (pedestrian discs or the swept static map). Stops when every
-/// candidate collides.
+/// to the goal after one step plus `heading_weight` times the heading error to the direction of
+/// travel, with kappa added when the step collides (pedestrian discs or the swept static map).
+/// Stops when every candidate collides. With a static map the distance and the direction of
+/// travel come from the same geodesic GoalDistanceField as SPAN's (same map knowledge; the
+/// baselines differ only in anticipation).
 class ReactiveController final : public NavigationController {
  public:
   ReactiveController(const StaticCollisionField* field, SpanControllerOptions options, double heading_weight = 0.5);
@@ -88,6 +95,7 @@ class ReactiveController final : public NavigationController {
   double heading_weight_;
   ChanceThreshold threshold_;
   CrowdForecast forecast_;
+  GoalDistanceField goal_field_;
   Eigen::Matrix2Xd current_;
   mutable MapWorkspace map_ws_;
 };

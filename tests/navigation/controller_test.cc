@@ -7,6 +7,7 @@
 
 #include "inference/mapping/grid_map.h"
 #include "inference/navigation/cl_rrt_star.h"
+#include "inference/navigation/goal_distance.h"
 #include "inference/navigation/span_controller.h"
 #include "inference/navigation/static_clearance.h"
 #include "tests/test_util.h"
@@ -65,6 +66,27 @@ TEST(StaticCollisionField, TabulatesTheSweptOccupancy) {
   EXPECT_FALSE(field.Collides(4.2, 2.0, 0.25, &ws));  // clear of it
   EXPECT_FALSE(field.Collides(5.0, 5.75, 0.25, &ws));  // in the gap
   EXPECT_TRUE(field.Collides(-3.0, 2.0, 0.25, &ws));  // outside the map: prior 0.5
+}
+
+TEST(GoalDistanceField, IsEuclideanInOpenSpaceAndGoesAroundWalls) {
+  const GridMap open = Room(false), walled = Room(true);
+  const StaticCollisionField open_field(open, 0.4, 0.05), walled_field(walled, 0.4, 0.05);
+  const Eigen::Vector2d goal(9, 2);
+  const GoalDistanceField free_space(open_field, goal, 0.25), around(walled_field, goal, 0.25);
+  // Away from walls: the straight-line distance up to the 8-connected grid error (<= 8 %).
+  for (const Eigen::Vector2d x : {Eigen::Vector2d(3, 2), Eigen::Vector2d(5, 4), Eigen::Vector2d(7, 3.5)}) {
+    const double euclid = (x - goal).norm();
+    EXPECT_GE(free_space.Distance(x), euclid - 0.05);
+    EXPECT_LE(free_space.Distance(x), 1.09 * euclid + 0.05);
+  }
+  // Behind the wall (x = 5, gap at y in [5, 6.5]): the way leads through the gap.
+  const Eigen::Vector2d x(3, 2), gap(5, 5.75);
+  const double via_gap = (x - gap).norm() + (gap - goal).norm();
+  EXPECT_GT(around.Distance(x), via_gap - 0.1);
+  EXPECT_LT(around.Distance(x), 1.09 * via_gap + 1.5);  // grid error plus the wall-margin cost
+  EXPECT_GT(around.Distance(x), 1.3 * (x - goal).norm());
+  // Inside the wall there is no free path: the Euclidean distance plus the penalty.
+  EXPECT_GT(around.Distance(Eigen::Vector2d(5.0, 2.0)), around.unreachable_penalty);
 }
 
 SpanControllerOptions Options() {
