@@ -116,5 +116,20 @@ if [ "${FORESIGHT_WITH_TORCH:-1}" = "1" ] || [ "${FORESIGHT_WITH_TORCH}" = "ON" 
   head -c 2000 "$RUN/model.h5" > "$TMP/trunc.h5"
   expect_error "trunc.h5" bench engine --artifact "$TMP/trunc.h5"
   expect_error "normalisation.h5" bench engine --artifact "$RUN/normalisation.h5"
+  # Directional maps: crossing synthetic, 2 folds, few epochs; eval.json has the four methods.
+  DIR_RUN="$TMP/dirmap"
+  "$BIN" train configs/directional/crossing.yaml --run-dir "$DIR_RUN" eval.folds=2 train.epochs=2 \
+    network.spatial_epochs=4 network.hidden=24 data.crossing.num_tracks=120 eval.plot_steps=20 train.progress=none \
+    >/dev/null 2>"$TMP/dir.log" || { cat "$TMP/dir.log"; fail "directional train"; }
+  check_json "$DIR_RUN/eval.json"
+  for m in spatiotemporal spatial grid_um grid_mm; do
+    grep -q "\"$m\": {\"al\": [0-9]" "$DIR_RUN/eval.json" || fail "directional eval.json lacks $m al"
+  done
+  [ -s "$DIR_RUN/model.h5" ] && [ -s "$DIR_RUN/plots/trajectories.png" ] || fail "directional run dir"
+  expect_error "already holds a run" train configs/directional/crossing.yaml --run-dir "$DIR_RUN"
+  expect_error "expected 'span_predictor'" bench engine --artifact "$DIR_RUN/model.h5"
+  expect_error "expected 'directional_map'" bench directional --artifact "$RUN/model.h5"
+  "$BIN" bench directional --artifact "$DIR_RUN/model.h5" --json --calls 200 --repeats 2 | grep -q engine_batch1024_us ||
+    fail "bench directional"
 fi
 echo "cli ok"

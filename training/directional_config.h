@@ -78,6 +78,7 @@ struct DirectionalNetworkConfig {
   double lambda_alpha = 0.001;  ///< L2 on the mixing-weight head (added to the loss, errata)
   double lambda_mu = 0.0;
   double lambda_kappa = 0.001;
+  int spatial_epochs = 0;       ///< epochs of the spatial-only network (0: train.epochs)
   int Hidden() const { return hidden > 0 ? hidden : 40 * components; }
 
   template <class A>
@@ -88,6 +89,8 @@ struct DirectionalNetworkConfig {
     a->Visit("lambda_alpha", &lambda_alpha, Range::NonNegative(), "L2 penalty on the alpha head weights");
     a->Visit("lambda_mu", &lambda_mu, Range::NonNegative(), "L2 penalty on the mu head weights");
     a->Visit("lambda_kappa", &lambda_kappa, Range::NonNegative(), "L2 penalty on the kappa head weights");
+    a->Visit("spatial_epochs", &spatial_epochs, Range::AtLeast(0),
+             "epochs of the spatial-only network (0: train.epochs); it is linear in the features and cheap");
   }
 };
 
@@ -102,8 +105,8 @@ struct DirectionalEvalConfig {
   double grid_length_scale = 0;  ///< RBF blending of the dense grids (m); 0: the cell spacing
   bool plots = true;
   int plot_trajectories = 12;  ///< generated trajectories per panel
-  double plot_step = 0;        ///< step of generated trajectories (m); 0: 1/3 of the cell spacing
-  int plot_steps = 150;        ///< steps per generated trajectory
+  double plot_step = 0;        ///< step of generated trajectories (m); 0: 1/6 of the cell spacing
+  int plot_steps = 200;        ///< steps per generated trajectory (it ends where it leaves the map)
 
   template <class A>
   void Serialize(A* a) {
@@ -121,7 +124,7 @@ struct DirectionalEvalConfig {
              "RBF blending length of the dense grids (m; 0: the cell spacing)");
     a->Visit("plots", &plots, Range::Any(), "write plots/directions.png and plots/trajectories.png");
     a->Visit("plot_trajectories", &plot_trajectories, Range::Closed(0, 1000), "generated trajectories per panel");
-    a->Visit("plot_step", &plot_step, Range::NonNegative(), "step of generated trajectories (m; 0: cell / 3)");
+    a->Visit("plot_step", &plot_step, Range::NonNegative(), "step of generated trajectories (m; 0: cell / 6)");
     a->Visit("plot_steps", &plot_steps, Range::Closed(1, 100000), "steps per generated trajectory");
   }
 };

@@ -43,17 +43,6 @@ std::vector<Eigen::Index> RandomSubset(Eigen::Index n, double fraction, std::uin
   return idx;
 }
 
-/// Spatial and temporal features of samples as tensors [n, M_s] and [n, M_t].
-std::pair<torch::Tensor, torch::Tensor> FeatureTensors(const DirectionalFeatures& f, const Eigen::VectorXd& x,
-                                                       const Eigen::VectorXd& y, const Eigen::VectorXd& t) {
-  RowMatrixF s(x.size(), f.spatial_size()), tm(x.size(), f.time_size());
-  f.SpatialBatch(x, y, s);
-  f.TemporalBatch(t, tm);
-  auto ts = torch::from_blob(s.data(), {s.rows(), s.cols()}, torch::kFloat32).clone();
-  auto tt = torch::from_blob(tm.data(), {tm.rows(), tm.cols()}, torch::kFloat32).clone();
-  return {ts, tt};
-}
-
 torch::Tensor ToTensor(const Eigen::VectorXd& v) {
   Eigen::VectorXf f = v.cast<float>();
   return torch::from_blob(f.data(), {f.size()}, torch::kFloat32).clone();
@@ -76,8 +65,7 @@ class DirectionalTask : public TrainingTask {
     const auto* p = idx.data_ptr<std::int64_t>();
     Eigen::VectorXd x(b), y(b), t(b);
     for (std::int64_t i = 0; i < b; ++i) x[i] = train_.x[p[i]], y[i] = train_.y[p[i]], t[i] = train_.t[p[i]];
-    const auto [s, tt] = FeatureTensors(features_, x, y, t);
-    return DirectionalLoss(*net_, s, tt, theta_train_.index_select(0, idx), penalty_);
+    return DirectionalLossFromRaw(*net_, Forward(x, y, t), theta_train_.index_select(0, idx), penalty_);
   }
 
   double ValidationLoss() override {
@@ -87,9 +75,7 @@ class DirectionalTask : public TrainingTask {
     double sum = 0;
     for (Eigen::Index b = 0; b < n; b += 512) {
       const Eigen::Index len = std::min<Eigen::Index>(512, n - b);
-      const auto [s, tt] = FeatureTensors(features_, val_.x.segment(b, len), val_.y.segment(b, len),
-                                          val_.t.segment(b, len));
-      const auto raw = net_->forward(s, tt);
+      const auto raw = Forward(val_.x.segment(b, len), val_.y.segment(b, len), val_.t.segment(b, len));
       sum += VonMisesMixtureNll(DecodeDirectionalHead(raw, net_->components()), theta_val_.narrow(0, b, len))
                  .sum()
                  .item<double>();
@@ -98,8 +84,24 @@ class DirectionalTask : public TrainingTask {
   }
 
  private:
+  /// Raw outputs from sparse spatial features (embedding bag) and dense temporal ones.
+  torch::Tensor Forward(const Eigen::VectorXd& x, const Eigen::VectorXd& y, const Eigen::VectorXd& t) {
+    features_.SpatialSparseBatch(x, y, &index_, &value_, &offsets_);
+    RowMatrixF tm(t.size(), features_.time_size());
+    features_.TemporalBatch(t, tm);
+    const auto n = static_cast<std::int64_t>(index_.size());
+    const auto ti = torch::from_blob(index_.data(), {n}, torch::kInt64).clone();
+    const auto tv = torch::from_blob(value_.data(), {n}, torch::kFloat32).clone();
+    const auto to =
+        torch::from_blob(offsets_.data(), {static_cast<std::int64_t>(offsets_.size())}, torch::kInt64).clone();
+    const auto tt = torch::from_blob(tm.data(), {tm.rows(), tm.cols()}, torch::kFloat32).clone();
+    return net_->forward_sparse(ti, tv, to, tt);
+  }
+
   DirectionalNet net_;
   DirectionalFeatures features_;
+  std::vector<std::int64_t> index_, offsets_;
+  std::vector<float> value_;
   const DirectionalSamples& train_;
   const DirectionalSamples& val_;
   DirectionalPenalty penalty_;
@@ -295,7 +297,9 @@ TrainingSummary TrainDirectionalNet(const DirectionalExperimentConfig& c, const 
   torch::manual_seed(static_cast<std::uint64_t>(c.seed));
   DirectionalNet net = MakeNet(c, features, variant);
   DirectionalTask task(net, DirectionalFeatures(features), train, val, PenaltyOf(c.network));
-  TrainingSummary s = Train(&task, c.train, run, static_cast<std::uint64_t>(c.seed), can_resume, hooks);
+  TrainConfig tc = c.train;
+  if (variant == DirectionalVariant::kSpatial && c.network.spatial_epochs > 0) tc.epochs = c.network.spatial_epochs;
+  TrainingSummary s = Train(&task, tc, run, static_cast<std::uint64_t>(c.seed), can_resume, hooks);
   std::ofstream(dir + "/training_summary.json") << s.ToJson();
   if (s.reason == TerminationReason::kInterrupted) return s;
   const std::string ckpt = fs::exists(run.BestCheckpoint()) ? run.BestCheckpoint() : run.Checkpoint();

@@ -19,7 +19,12 @@ Eigen::Matrix<double, Eigen::Dynamic, 2> GenerateTrajectory(const DirectionalMap
   path.row(0) = start.transpose();
   std::uniform_real_distribution<double> u01(0.0, 1.0);
   Eigen::Vector2d p = start;
+  const DirectionalFeatureConfig& f = map.features().config();
   for (int n = 0; n < steps; ++n) {
+    if (p.x() < f.x_min || p.x() > f.x_max || p.y() < f.y_min || p.y() > f.y_max) {
+      path.conservativeResize(n + 1, 2);  // left the map
+      break;
+    }
     map.QueryOne(p.x(), p.y(), t, &ws);
     double u = u01(*rng), acc = 0;
     int r = 0;
@@ -78,6 +83,7 @@ void Draw(const DirectionalSamples& data, const std::vector<Panel>& panels, cons
       cv::circle(canvas, cv_.Px(data.x[i], data.y[i], x0, y0), 1, cv::Scalar(c[0], c[1], c[2]), -1);
     }
     auto ws = p.map->MakeWorkspace();
+    cv::Mat roi = canvas(cv::Rect(x0, y0, cv_.w + 1, cv_.h + 1));  // drawing clipped to the panel
     if (!trajectories) {
       // Arrows on a grid of at most 24 x 24 points.
       const int nx = std::min(24, std::max(4, f.cells_x)), ny = std::min(24, std::max(4, f.cells_y));
@@ -90,24 +96,23 @@ void Draw(const DirectionalSamples& data, const std::vector<Panel>& panels, cons
           for (int r = 0; r < p.map->components(); ++r) {
             if (ws.alpha[r] < 0.1) continue;
             const double l = len * std::sqrt(ws.alpha[r]);
-            cv::arrowedLine(canvas, cv_.Px(x, y, x0, y0),
-                            cv_.Px(x + l * std::cos(ws.mu[r]), y + l * std::sin(ws.mu[r]), x0, y0), {40, 40, 40}, 1,
-                            cv::LINE_AA, 0, 0.3);
+            cv::arrowedLine(roi, cv_.Px(x, y, 0, 0), cv_.Px(x + l * std::cos(ws.mu[r]), y + l * std::sin(ws.mu[r]), 0, 0),
+                            {40, 40, 40}, 1, cv::LINE_AA, 0, 0.3);
           }
         }
     } else if (data.size() > 0) {
       std::mt19937_64 rng(seed + 7);
       std::uniform_int_distribution<Eigen::Index> pick(0, data.size() - 1);
-      const double step = eval.plot_step > 0 ? eval.plot_step : cell / 3.0;
+      const double step = eval.plot_step > 0 ? eval.plot_step : cell / 6.0;
       for (int n = 0; n < eval.plot_trajectories; ++n) {
         Eigen::Index i = pick(rng);
         for (int tries = 0; tries < 50 && std::abs(data.t[i] - p.t) > p.window; ++tries) i = pick(rng);
         const auto path = GenerateTrajectory(*p.map, {data.x[i], data.y[i]}, p.t, step, eval.plot_steps, &rng);
         const cv::Scalar colour((37 * n) % 200, (91 * n + 60) % 200, 200);
         for (Eigen::Index s = 0; s + 1 < path.rows(); ++s)
-          cv::line(canvas, cv_.Px(path(s, 0), path(s, 1), x0, y0), cv_.Px(path(s + 1, 0), path(s + 1, 1), x0, y0),
-                   colour, 2, cv::LINE_AA);
-        cv::circle(canvas, cv_.Px(path(0, 0), path(0, 1), x0, y0), 4, {0, 0, 220}, -1);
+          cv::line(roi, cv_.Px(path(s, 0), path(s, 1), 0, 0), cv_.Px(path(s + 1, 0), path(s + 1, 1), 0, 0), colour, 2,
+                   cv::LINE_AA);
+        cv::circle(roi, cv_.Px(path(0, 0), path(0, 1), 0, 0), 4, {0, 0, 220}, -1);
       }
     }
     cv::putText(canvas, p.title, {x0 + 4, 17}, cv::FONT_HERSHEY_SIMPLEX, 0.45, {0, 0, 0}, 1);

@@ -100,6 +100,27 @@ void DirectionalFeatures::TemporalBatch(
   for (Eigen::Index i = 0; i < t.size(); ++i) Temporal(t[i], out.row(i).transpose());
 }
 
+void DirectionalFeatures::SpatialSparseBatch(const Eigen::Ref<const Eigen::VectorXd>& x,
+                                             const Eigen::Ref<const Eigen::VectorXd>& y,
+                                             std::vector<std::int64_t>* index, std::vector<float>* value,
+                                             std::vector<std::int64_t>* offsets) const {
+  FS_THROW_UNLESS(x.size() == y.size(), "directional features: batch shapes x ", x.size(), ", y ", y.size());
+  index->clear();
+  value->clear();
+  offsets->assign(1, 0);
+  for (Eigen::Index i = 0; i < x.size(); ++i) {
+    const Window w = SpatialWindow(x[i], y[i]);
+    for (int iy = w.iy0; iy < w.iy1; ++iy)
+      for (int ix = w.ix0; ix < w.ix1; ++ix) {
+        const float phi = static_cast<float>(SpatialKernel(x[i], y[i], ix, iy));
+        if (phi == 0.0f) continue;
+        index->push_back(static_cast<std::int64_t>(iy) * config_.cells_x + ix);
+        value->push_back(phi);
+      }
+    offsets->push_back(static_cast<std::int64_t>(index->size()));
+  }
+}
+
 DirectionalFeatureConfig ResolveExtent(const DirectionalFeatureConfig& config,
                                        const Eigen::Ref<const Eigen::VectorXd>& x,
                                        const Eigen::Ref<const Eigen::VectorXd>& y,

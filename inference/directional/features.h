@@ -22,6 +22,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <vector>
 
 #include "core/config.h"
 
@@ -95,6 +96,12 @@ class DirectionalFeatures {
                     Eigen::Ref<Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> out) const;
   void TemporalBatch(const Eigen::Ref<const Eigen::VectorXd>& t,
                      Eigen::Ref<Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> out) const;
+  /// Sparse spatial features of n samples (the non-zero entries only, the same float values as
+  /// Spatial): sample i owns entries offsets[i] .. offsets[i + 1] - 1 of `index` (inducing point j)
+  /// and `value`. `offsets` gets n + 1 entries. (Training uses this with an embedding bag.)
+  void SpatialSparseBatch(const Eigen::Ref<const Eigen::VectorXd>& x, const Eigen::Ref<const Eigen::VectorXd>& y,
+                          std::vector<std::int64_t>* index, std::vector<float>* value,
+                          std::vector<std::int64_t>* offsets) const;
 
  private:
   DirectionalFeatureConfig config_;

@@ -12,7 +12,14 @@ DirectionalNetImpl::DirectionalNetImpl(DirectionalVariant variant, int spatial_s
                   "DirectionalNet: spatial_size ", spatial_size, ", components ", components, ", hidden ", hidden);
   int width = spatial_size;
   if (variant == DirectionalVariant::kSpatiotemporal) {
-    lstm_ = register_module("lstm", torch::nn::LSTM(torch::nn::LSTMOptions(spatial_size, hidden).batch_first(true)));
+    // PyTorch's LSTM parameters and initialisation: U(-1/sqrt(H), 1/sqrt(H)).
+    lstm_ = register_module("lstm", std::make_shared<torch::nn::Module>("LSTM"));
+    const double k = 1.0 / std::sqrt(static_cast<double>(hidden));
+    auto u = [k](std::vector<int64_t> shape) { return torch::empty(shape).uniform_(-k, k); };
+    weight_ih_ = lstm_->register_parameter("weight_ih_l0", u({4 * hidden, spatial_size}));
+    weight_hh_ = lstm_->register_parameter("weight_hh_l0", u({4 * hidden, hidden}));
+    bias_ih_ = lstm_->register_parameter("bias_ih_l0", u({4 * hidden}));
+    bias_hh_ = lstm_->register_parameter("bias_hh_l0", u({4 * hidden}));
     width = hidden;
   } else {
     hidden_ = 0;
@@ -27,14 +34,42 @@ DirectionalNetImpl::DirectionalNetImpl(DirectionalVariant variant, int spatial_s
   kappa_->bias.zero_();
 }
 
+torch::Tensor DirectionalNetImpl::Heads(const torch::Tensor& z) {
+  return torch::cat({alpha_->forward(z), mu_->forward(z), kappa_->forward(z)}, 1);
+}
+
+torch::Tensor DirectionalNetImpl::Recur(const torch::Tensor& proj, const torch::Tensor& phi_t) {
+  const auto bias = bias_ih_ + bias_hh_;
+  torch::Tensor h, c;
+  for (int64_t k = 0; k < phi_t.size(1); ++k) {
+    auto gates = proj * phi_t.narrow(1, k, 1) + bias;
+    if (k > 0) gates = gates + torch::matmul(h, weight_hh_.t());  // h = 0 before the first step
+    const auto g = gates.chunk(4, 1);
+    const auto i = torch::sigmoid(g[0]), f = torch::sigmoid(g[1]), cand = torch::tanh(g[2]), o = torch::sigmoid(g[3]);
+    c = k > 0 ? f * c + i * cand : i * cand;
+    h = o * torch::tanh(c);
+  }
+  return h;
+}
+
 torch::Tensor DirectionalNetImpl::forward(const torch::Tensor& phi_s, const torch::Tensor& phi_t) {
-  if (variant_ == DirectionalVariant::kSpatial)
-    return torch::cat({alpha_->forward(phi_s), mu_->forward(phi_s), kappa_->forward(phi_s)}, 1);
-  // Sequence over the temporal inducing points: step k is phi_s * phi_t[k]  -> [B, M_t, M_s].
-  const auto seq = phi_t.unsqueeze(2) * phi_s.unsqueeze(1);
-  const auto out = std::get<0>(lstm_->forward(seq));
-  const auto h = out.select(1, out.size(1) - 1);
-  return torch::cat({alpha_->forward(h), mu_->forward(h), kappa_->forward(h)}, 1);
+  if (variant_ == DirectionalVariant::kSpatial) return Heads(phi_s);
+  return Heads(Recur(torch::matmul(phi_s, weight_ih_.t()), phi_t));
+}
+
+torch::Tensor DirectionalNetImpl::forward_sparse(const torch::Tensor& index, const torch::Tensor& value,
+                                                 const torch::Tensor& offsets, const torch::Tensor& phi_t) {
+  namespace F = torch::nn::functional;
+  auto bag = [&](const torch::Tensor& weight_t) {  // sum_j value_j weight_t[index_j] per sample
+    return F::embedding_bag(index, weight_t,
+                            F::EmbeddingBagFuncOptions().offsets(offsets).mode(torch::kSum).per_sample_weights(value)
+                                .include_last_offset(true));
+  };
+  if (variant_ == DirectionalVariant::kSpatial) {
+    const auto w = torch::cat({alpha_->weight, mu_->weight, kappa_->weight}, 0).t().contiguous();
+    return bag(w) + torch::cat({alpha_->bias, mu_->bias, kappa_->bias}, 0);
+  }
+  return Heads(Recur(bag(weight_ih_.t().contiguous()), phi_t));
 }
 
 VonMisesMixtureTensors DecodeDirectionalHead(const torch::Tensor& raw, int R) {
@@ -57,10 +92,14 @@ torch::Tensor HeadPenalty(DirectionalNetImpl& net, const DirectionalPenalty& c) 
          c.lambda_kappa * net.kappa_head()->weight.square().sum();
 }
 
+torch::Tensor DirectionalLossFromRaw(DirectionalNetImpl& net, const torch::Tensor& raw, const torch::Tensor& theta,
+                                     const DirectionalPenalty& penalty) {
+  return VonMisesMixtureNll(DecodeDirectionalHead(raw, net.components()), theta).mean() + HeadPenalty(net, penalty);
+}
+
 torch::Tensor DirectionalLoss(DirectionalNetImpl& net, const torch::Tensor& phi_s, const torch::Tensor& phi_t,
                               const torch::Tensor& theta, const DirectionalPenalty& penalty) {
-  const auto raw = net.forward(phi_s, phi_t);
-  return VonMisesMixtureNll(DecodeDirectionalHead(raw, net.components()), theta).mean() + HeadPenalty(net, penalty);
+  return DirectionalLossFromRaw(net, net.forward(phi_s, phi_t), theta, penalty);
 }
 
 }  // namespace foresight

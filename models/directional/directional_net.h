@@ -3,6 +3,12 @@
 /// of the spatiotemporal network"): kernel features -> LSTM (width 40R) -> three heads giving a
 /// mixture of R von Mises; the spatial variant feeds the spatial features straight into the heads.
 /// Module names ("lstm", "alpha", "mu", "kappa") are the tensor names of the exported artifact.
+///
+/// The LSTM is PyTorch's single-layer LSTM written out (same parameters lstm.weight_ih_l0,
+/// weight_hh_l0, bias_ih_l0, bias_hh_l0, gate order i, f, g, o, zero initial state) so that the
+/// input projection can be taken once per sample: step k's input is phi_s * phi_t[k], hence
+/// W_ih x_k = phi_t[k] (W_ih phi_s), and W_ih phi_s is an embedding bag over the few non-zero
+/// spatial features (forward_sparse). The dense forward gives the same values (tests, parity).
 
 #include <torch/torch.h>
 
@@ -17,6 +23,10 @@ class DirectionalNetImpl : public torch::nn::Module {
   /// @param phi_s [B, M_s] spatial features; @param phi_t [B, M_t] temporal features (ignored by
   /// the spatial variant). @return raw head outputs [B, 3R]: alpha logits, means, log kappa.
   torch::Tensor forward(const torch::Tensor& phi_s, const torch::Tensor& phi_t);
+  /// The same from sparse spatial features (DirectionalFeatures::SpatialSparseBatch): `index` and
+  /// `value` [nnz], `offsets` [B + 1] (int64, last = nnz).
+  torch::Tensor forward_sparse(const torch::Tensor& index, const torch::Tensor& value, const torch::Tensor& offsets,
+                               const torch::Tensor& phi_t);
 
   DirectionalVariant variant() const { return variant_; }
   int components() const { return components_; }
@@ -26,9 +36,14 @@ class DirectionalNetImpl : public torch::nn::Module {
   torch::nn::Linear kappa_head() const { return kappa_; }
 
  private:
+  torch::Tensor Heads(const torch::Tensor& z);
+  /// LSTM over the M_t steps from the input projection proj = W_ih phi_s [B, 4H]: last h [B, H].
+  torch::Tensor Recur(const torch::Tensor& proj, const torch::Tensor& phi_t);
+
   DirectionalVariant variant_;
   int components_ = 5, hidden_ = 0;
-  torch::nn::LSTM lstm_{nullptr};
+  std::shared_ptr<torch::nn::Module> lstm_;
+  torch::Tensor weight_ih_, weight_hh_, bias_ih_, bias_hh_;
   torch::nn::Linear alpha_{nullptr}, mu_{nullptr}, kappa_{nullptr};
 };
 TORCH_MODULE(DirectionalNet);
@@ -55,5 +70,8 @@ torch::Tensor HeadPenalty(DirectionalNetImpl& net, const DirectionalPenalty& pen
 /// Thesis L_reg = mean NLL + HeadPenalty (the penalty added; spec/errata.md ch 4).
 torch::Tensor DirectionalLoss(DirectionalNetImpl& net, const torch::Tensor& phi_s, const torch::Tensor& phi_t,
                               const torch::Tensor& theta, const DirectionalPenalty& penalty);
+/// The same from raw head outputs [B, 3R] of `net`.
+torch::Tensor DirectionalLossFromRaw(DirectionalNetImpl& net, const torch::Tensor& raw, const torch::Tensor& theta,
+                                     const DirectionalPenalty& penalty);
 
 }  // namespace foresight

@@ -94,6 +94,54 @@ INSTANTIATE_TEST_SUITE_P(Directional, Parity,
                            return std::string(VariantName(p.param));
                          });
 
+TEST(DirectionalNet, WrittenOutLstmMatchesTorchLstmAndSparseMatchesDense) {
+  const DirectionalFeatures feats(Features());
+  torch::manual_seed(9);
+  DirectionalNet net(DirectionalVariant::kSpatiotemporal, feats.spatial_size(), 4, 24);
+  // torch::nn::LSTM with the same parameters on the sequence phi_s * phi_t[k].
+  torch::nn::LSTM ref(torch::nn::LSTMOptions(feats.spatial_size(), 24).batch_first(true));
+  {
+    torch::NoGradGuard no_grad;
+    auto mine = net->named_parameters();
+    auto theirs = ref->named_parameters();
+    for (const char* name : {"weight_ih_l0", "weight_hh_l0", "bias_ih_l0", "bias_hh_l0"})
+      theirs[name].copy_(mine[std::string("lstm.") + name]);
+  }
+  const int B = 16;
+  Eigen::VectorXd x = Eigen::VectorXd::Random(B) * 6 + Eigen::VectorXd::Constant(B, 4);
+  Eigen::VectorXd y = Eigen::VectorXd::Random(B) * 4 + Eigen::VectorXd::Constant(B, 3);
+  Eigen::VectorXd t = Eigen::VectorXd::Random(B) * 30 + Eigen::VectorXd::Constant(B, 25);
+  Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> s(B, feats.spatial_size()),
+      tm(B, feats.time_size());
+  feats.SpatialBatch(x, y, s);
+  feats.TemporalBatch(t, tm);
+  const auto ts = torch::from_blob(s.data(), {B, s.cols()}, torch::kFloat32).clone();
+  const auto tt = torch::from_blob(tm.data(), {B, tm.cols()}, torch::kFloat32).clone();
+  torch::NoGradGuard no_grad;
+  const auto seq = tt.unsqueeze(2) * ts.unsqueeze(1);
+  const auto out = std::get<0>(ref->forward(seq));
+  const auto h = out.select(1, out.size(1) - 1);
+  const auto expected = torch::cat({net->alpha_head()->forward(h), net->mu_head()->forward(h),
+                                    net->kappa_head()->forward(h)}, 1);
+  const auto dense = net->forward(ts, tt);
+  EXPECT_LT((dense - expected).abs().max().item<float>(), 1e-5f);
+  std::vector<std::int64_t> index, offsets;
+  std::vector<float> value;
+  feats.SpatialSparseBatch(x, y, &index, &value, &offsets);
+  EXPECT_LT(index.size(), static_cast<std::size_t>(B * feats.spatial_size()));
+  const auto n = static_cast<std::int64_t>(index.size());
+  const auto sparse = net->forward_sparse(torch::from_blob(index.data(), {n}, torch::kInt64),
+                                          torch::from_blob(value.data(), {n}, torch::kFloat32),
+                                          torch::from_blob(offsets.data(), {B + 1}, torch::kInt64), tt);
+  EXPECT_LT((sparse - dense).abs().max().item<float>(), 1e-5f);
+  DirectionalNet spatial(DirectionalVariant::kSpatial, feats.spatial_size(), 4, 0);
+  const auto sd = spatial->forward(ts, tt);
+  const auto ss = spatial->forward_sparse(torch::from_blob(index.data(), {n}, torch::kInt64),
+                                          torch::from_blob(value.data(), {n}, torch::kFloat32),
+                                          torch::from_blob(offsets.data(), {B + 1}, torch::kInt64), tt);
+  EXPECT_LT((sd - ss).abs().max().item<float>(), 1e-5f);
+}
+
 TEST(DirectionalLoss, NllMatchesCoreVonMisesMixture) {
   torch::manual_seed(1);
   const int B = 64, R = 5;
