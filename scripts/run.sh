@@ -1,11 +1,19 @@
 #!/usr/bin/env bash
-# Installs missing packages, builds Release and runs the main job on the embedded default config:
-# train the SPAN pedestrian predictor on synthetic crowds, export it, evaluate it with the engine.
+# Installs missing packages, builds Release and runs the main job on the embedded defaults:
+# 1. the navigation quickstart (`foresight navigate default` = configs/navigation/sim1.yaml): train
+#    the SPAN predictor on simulated crowd tracks, build the map, navigate sim1 with SPAN and the
+#    reactive and CL-RRT* baselines, write summary.json, paths.png and a video;
+# 2. the SPAN predictor quickstart on synthetic tracks (train, export, engine eval and bench);
+# 3. Fast-BHM occupancy maps of a simulated floor plan, fused between two robots.
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/setup.sh"
 install_missing
 configure_and_build "$ROOT/build"
 cd "$ROOT"
+# The navigation quickstart. The predictor (runs/navigation_predictor_sim1) is trained once and
+# reused by later runs; delete that directory to retrain it.
+rm -rf runs/navigate_quickstart
+./build/bin/foresight navigate default --out runs/navigate_quickstart --episodes 3
 # Each run of the main job starts afresh (train refuses to start a new run in a directory that
 # holds one), unless it continues the last one with --resume.
 [[ " $* " == *" --resume "* ]] || rm -rf runs/quickstart

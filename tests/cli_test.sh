@@ -67,6 +67,23 @@ grep -q "occ_coarse/model.h5" "$TMP/err" || fail "refused fusion does not name t
 "$BIN" map info "$TMP/occ_grid/model.h5" | grep -q '"model_type": "occupancy.grid"' || fail "map info of a grid"
 expect_error "tracks.h5: not a foresight artifact" map info "$TMP/tracks.h5"
 
+# Navigation (torch-free with the reactive and CL-RRT* baselines; SPAN needs a predictor artifact).
+NAV="$TMP/nav"
+"$BIN" navigate configs/navigation/sim2.yaml "methods=[reactive, cl_rrt_star]" max_time=4 video.enabled=false \
+  cl_rrt_star.max_iterations=200 --episodes 1 --out "$NAV" >/dev/null 2>"$TMP/nav.log" || { cat "$TMP/nav.log"; fail "navigate"; }
+for f in summary.json episodes.csv paths.png map.h5 config.yaml; do
+  [ -s "$NAV/$f" ] || fail "navigate output lacks $f"
+done
+check_json "$NAV/summary.json"
+for k in reactive cl_rrt_star success_rate collision_free_rate ttg_mean doc_mean min_clearance cycle_ms_median cycle_ms_p99; do
+  grep -q "\"$k\"" "$NAV/summary.json" || fail "summary.json lacks $k"
+done
+expect_error "unknown method 'teleport'" navigate configs/navigation/sim2.yaml "methods=[teleport]" --out "$TMP/nav2"
+expect_error "robot_goal" navigate configs/navigation/sim2.yaml "methods=[reactive]" "scenario.robot_goal=[30, 0]" --out "$TMP/nav3"
+expect_error "unknown key 'span.kapa'" navigate configs/navigation/sim2.yaml span.kapa=3 --out "$TMP/nav4"
+expect_error "span_predictor" navigate configs/navigation/sim2.yaml "methods=[span]" predictor.artifact="$NAV/map.h5" \
+  --episodes 1 --out "$TMP/nav5"
+
 if [ "${FORESIGHT_WITH_TORCH:-1}" = "1" ] || [ "${FORESIGHT_WITH_TORCH}" = "ON" ]; then
   printf 'model: span_predictor\ntrain: {epochs: 2, learning_rat: 0.1}\n' > "$TMP/typo.yaml"
   expect_error "unknown key 'train.learning_rat'" train "$TMP/typo.yaml" --run-dir "$TMP/r0"
