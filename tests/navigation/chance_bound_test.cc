@@ -7,6 +7,7 @@
 #include <random>
 
 #include "inference/navigation/crowd_forecast.h"
+#include "inference/prediction/span_predictor.h"
 #include "tests/test_util.h"
 
 namespace foresight::nav {
@@ -84,6 +85,46 @@ TEST(CrowdForecast, StandingPedestriansCollideWithinTheSumOfRadii) {
   EXPECT_FALSE(f.Collides(3, Eigen::Vector2d(0.81, 0), 0.8, t));
   EXPECT_TRUE(f.Collides(2, Eigen::Vector2d(5.5, 0.5), 0.8, t));
   EXPECT_EQ(f.MaxBound(1, Eigen::Vector2d(2.5, 0), 0.8), 0.0);
+}
+
+
+TEST(CrowdForecast, TablesThePredictorAndAgreesWithTheBoundByBruteForce) {
+  for (int components : {1, 3}) {
+    testing::TempDir dir;
+    testing::RandomSpanSpec spec;
+    spec.observed = 5;
+    spec.seconds_per_step = 0.1;
+    spec.components = components;
+    testing::WriteRandomSpanArtifact(dir.File("p.h5"), spec);
+    const SpanPredictor model = SpanPredictor::Load(dir.File("p.h5"));
+    auto ws = model.MakeWorkspace();
+    std::vector<TrajectoryDistribution> dists{model.MakeDistribution(), model.MakeDistribution()};
+    Eigen::MatrixXd rows(2, 10);
+    rows << 0, 0, 0.1, 0, 0.2, 0, 0.3, 0, 0.4, 0,  //
+        3, 1, 3, 0.9, 3, 0.8, 3, 0.7, 3, 0.6;
+    model.PredictBatch(rows, &ws, &dists);
+    CrowdForecast f;
+    f.FromPredictions(dists, 2, 20, 0.1);
+    ASSERT_EQ(f.components(), components);
+    Eigen::Vector2d mean;
+    Eigen::Matrix2d cov;
+    dists[1].Position(0.7, components - 1, &mean, &cov);
+    EXPECT_TRUE(f.Mean(1, 7, components - 1).isApprox(mean, 1e-12));
+    EXPECT_TRUE(f.Cov(1, 7, components - 1).isApprox(cov, 1e-12));
+    const ChanceThreshold t(0.25);
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<double> u(-2, 5);
+    int checked = 0;
+    for (int i = 0; i < 3000; ++i) {
+      const Eigen::Vector2d x(u(rng), u(rng));
+      const int k = 1 + i % 20;
+      const double bound = f.MaxBound(k, x, 0.8);
+      if (std::abs(bound - 0.25) < 1e-6) continue;
+      EXPECT_EQ(f.Collides(k, x, 0.8, t), bound > 0.25) << "k " << k << " x " << x.transpose() << " bound " << bound;
+      ++checked;
+    }
+    EXPECT_GT(checked, 2900);
+  }
 }
 
 }  // namespace
