@@ -61,7 +61,7 @@ struct DirectionalDataConfig {
                  config::EnumNames<DirectionalSource>{{DirectionalSource::kCrossing, "crossing"},
                                                       {DirectionalSource::kGridCsv, "grid_csv"},
                                                       {DirectionalSource::kEdinburgh, "edinburgh"}},
-                 "crossing (synthetic time-varying flow) | grid_csv (P1/P2 csv) | edinburgh (tracks file)");
+                 "crossing: synthetic time-varying flow; grid_csv: P1/P2 csv; edinburgh: tracks file");
     a->Visit("root", &root, Range::Any(), "directory for relative file names (empty: $FORESIGHT_DATA or ../shared/data)");
     a->Visit("file", &file, Range::Any(), "data file (grid_csv, edinburgh)");
     a->Visit("train_fraction", &train_fraction, Range::OpenClosed(0, 1),
