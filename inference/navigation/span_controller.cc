@@ -18,7 +18,8 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 
 double WrapToPi(double a) { return std::remainder(a, 2.0 * M_PI); }
 
-/// Starts of the per-cycle COBYLA runs: the previous solution, a goal-directed turn, then a fan.
+/// Starts of the per-cycle COBYLA runs: the previous solution, a goal-directed turn, a fan, then
+/// quasi-random points of the control box (a fixed Halton sequence) up to `initialisations`.
 std::vector<Control> Starts(const SpanControllerOptions& o, const UnicycleState& robot, const Eigen::Vector2d& goal,
                             const Control* previous) {
   std::vector<Control> s;
@@ -31,6 +32,14 @@ std::vector<Control> Starts(const SpanControllerOptions& o, const UnicycleState&
     for (double w : {0.0, -0.5, 0.5, -1.0, 1.0}) s.push_back({v, w * o.limits.omega_max});
   s.push_back({0.5 * o.limits.v_min, 0.0});
   s.push_back({0.0, turn});
+  auto halton = [](int i, int base) {
+    double f = 1.0, r = 0.0;
+    for (; i > 0; i /= base) r += (f /= base) * (i % base);
+    return r;
+  };
+  for (int i = 1; static_cast<int>(s.size()) < o.initialisations; ++i)
+    s.push_back({o.limits.v_min + (o.limits.v_max - o.limits.v_min) * halton(i, 2),
+                 o.limits.omega_max * (2.0 * halton(i, 3) - 1.0)});
   return s;
 }
 
