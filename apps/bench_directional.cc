@@ -79,7 +79,7 @@ void RunDirectionalBench(const BenchDirectionalArgs& a) {
     const auto ts = torch::from_blob(s.data(), {s.rows(), s.cols()}, torch::kFloat32);
     const auto tt = torch::from_blob(tm.data(), {tm.rows(), tm.cols()}, torch::kFloat32);
     const auto t1 = Clock::now();
-    const auto p = DecodeDirectionalHead(net.net->forward(ts, tt), net.net->components());
+    const auto p = DecodeDirectionalHead(net.net->forward(ts, tt), net.net->components(), net.net->max_kappa());
     (void)p.kappa.sum().item<float>();
     const auto t2 = Clock::now();
     if (forward_only) forward_only->push_back(Us(t1, t2));

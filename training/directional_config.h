@@ -79,6 +79,7 @@ struct DirectionalNetworkConfig {
   double lambda_mu = 0.0;
   double lambda_kappa = 0.001;
   int spatial_epochs = 0;       ///< epochs of the spatial-only network (0: train.epochs)
+  double max_kappa = 100.0;     ///< cap on every concentration: networks and grid baselines alike
   int Hidden() const { return hidden > 0 ? hidden : 40 * components; }
 
   template <class A>
@@ -89,6 +90,8 @@ struct DirectionalNetworkConfig {
     a->Visit("lambda_alpha", &lambda_alpha, Range::NonNegative(), "L2 penalty on the alpha head weights");
     a->Visit("lambda_mu", &lambda_mu, Range::NonNegative(), "L2 penalty on the mu head weights");
     a->Visit("lambda_kappa", &lambda_kappa, Range::NonNegative(), "L2 penalty on the kappa head weights");
+    a->Visit("max_kappa", &max_kappa, Range::Closed(1e-3, 1e8),
+             "cap on every von Mises concentration, for the networks (log-kappa clamp) and the grid maps alike");
     a->Visit("spatial_epochs", &spatial_epochs, Range::AtLeast(0),
              "epochs of the spatial-only network (0: train.epochs); it is linear in the features and cheap");
   }

@@ -76,7 +76,8 @@ class DirectionalTask : public TrainingTask {
     for (Eigen::Index b = 0; b < n; b += 512) {
       const Eigen::Index len = std::min<Eigen::Index>(512, n - b);
       const auto raw = Forward(val_.x.segment(b, len), val_.y.segment(b, len), val_.t.segment(b, len));
-      sum += VonMisesMixtureNll(DecodeDirectionalHead(raw, net_->components()), theta_val_.narrow(0, b, len))
+      sum += VonMisesMixtureNll(DecodeDirectionalHead(raw, net_->components(), net_->max_kappa()),
+                                theta_val_.narrow(0, b, len))
                  .sum()
                  .item<double>();
     }
@@ -113,7 +114,7 @@ DirectionalPenalty PenaltyOf(const DirectionalNetworkConfig& n) {
 }
 
 DirectionalNet MakeNet(const DirectionalExperimentConfig& c, const DirectionalFeatureConfig& f, DirectionalVariant v) {
-  return DirectionalNet(v, f.cells_x * f.cells_y, c.network.components, c.network.Hidden());
+  return DirectionalNet(v, f.cells_x * f.cells_y, c.network.components, c.network.Hidden(), c.network.max_kappa);
 }
 
 void WriteParam(h5::File* f, const std::string& name, const torch::Tensor& value) {
@@ -180,6 +181,7 @@ DirectionalGridConfig GridConfig(const DirectionalExperimentConfig& c, const Dir
   const double spacing = 0.5 * ((f.x_max - f.x_min) / f.cells_x + (f.y_max - f.y_min) / f.cells_y);
   g.length_scale = c.eval.grid_length_scale > 0 ? c.eval.grid_length_scale : spacing;
   g.seed = static_cast<std::uint64_t>(c.seed);
+  g.max_kappa = c.network.max_kappa;  // one cap for every method
   return g;
 }
 
@@ -236,7 +238,7 @@ void WriteDirectionalArtifact(DirectionalNetImpl& net, const DirectionalFeatureC
     f.SetAttr("/model", "components", static_cast<std::int64_t>(net.components()));
     f.SetAttr("/model", "hidden", static_cast<std::int64_t>(net.hidden()));
     f.SetAttr("/model", "log_kappa_min", kDirectionalLogKappaMin);
-    f.SetAttr("/model", "log_kappa_max", kDirectionalLogKappaMax);
+    f.SetAttr("/model", "log_kappa_max", std::log(net.max_kappa()));
     const std::string g = "/model/features";
     f.SetAttr(g, "x_min", fc.x_min);
     f.SetAttr(g, "x_max", fc.x_max);
@@ -267,7 +269,7 @@ LoadedDirectionalNet LoadDirectionalNetFromArtifact(const std::string& path) {
   LoadedDirectionalNet out;
   out.features = map.features().config();
   const int hidden = map.variant() == DirectionalVariant::kSpatial ? 0 : map.lstm().hidden_size();
-  out.net = DirectionalNet(map.variant(), map.features().spatial_size(), map.components(), hidden);
+  out.net = DirectionalNet(map.variant(), map.features().spatial_size(), map.components(), hidden, map.max_kappa());
   torch::NoGradGuard no_grad;
   for (auto& item : out.net->named_parameters()) {
     const std::string& key = item.key();

@@ -13,8 +13,9 @@ const char* VariantName(DirectionalVariant v) {
 }
 
 DirectionalMap::DirectionalMap(DirectionalVariant variant, const DirectionalFeatureConfig& features, Lstm lstm,
-                               DirectionalHeads heads)
-    : variant_(variant), features_(features), lstm_(std::move(lstm)), heads_(std::move(heads)) {
+                               DirectionalHeads heads, double max_kappa)
+    : variant_(variant), features_(features), lstm_(std::move(lstm)), heads_(std::move(heads)),
+      log_kappa_max_(std::log(max_kappa)) {
   Check();
 }
 
@@ -30,6 +31,9 @@ void DirectionalMap::Check() const {
   if (variant_ == DirectionalVariant::kSpatiotemporal)
     FS_THROW_UNLESS(lstm_.input_size() == features_.spatial_size(), "directional map: the LSTM takes ",
                     lstm_.input_size(), " inputs, the features have M_s = ", features_.spatial_size());
+  FS_THROW_UNLESS(std::isfinite(log_kappa_max_) && log_kappa_max_ > kDirectionalLogKappaMin,
+                  "directional map: max kappa ", std::exp(log_kappa_max_), " must be finite and above exp(",
+                  kDirectionalLogKappaMin, ")");
   FS_THROW_UNLESS(heads_.alpha_w.allFinite() && heads_.mu_w.allFinite() && heads_.kappa_w.allFinite() &&
                       heads_.alpha_b.allFinite() && heads_.mu_b.allFinite() && heads_.kappa_b.allFinite(),
                   "directional map: non-finite head weights");
@@ -65,6 +69,7 @@ DirectionalMap DirectionalMap::Load(const std::string& path) {
   } catch (const Error& e) {
     Fail(path, ": ", e.what());
   }
+  m.log_kappa_max_ = f.GetDoubleAttr("/model", "log_kappa_max");
   const auto R = f.GetIntAttr("/model", "components");
   FS_THROW_UNLESS(R >= 1 && R <= 1000, path, ": implausible number of components ", R);
   auto read_head = [&](const std::string& name, Eigen::MatrixXf* w, Eigen::VectorXf* b) {
@@ -156,7 +161,7 @@ void DirectionalMap::QueryOne(double x, double y, double t, Workspace* ws) const
   for (int r = 0; r < R; ++r) {
     ws->mu[r] = WrapAngle(static_cast<double>(ws->raw[R + r]));
     ws->kappa[r] = std::exp(
-        std::clamp(static_cast<double>(ws->raw[2 * R + r]), kDirectionalLogKappaMin, kDirectionalLogKappaMax));
+        std::clamp(static_cast<double>(ws->raw[2 * R + r]), kDirectionalLogKappaMin, log_kappa_max_));
   }
 }
 

@@ -15,6 +15,7 @@
 /// batch are sized.
 
 #include <Eigen/Core>
+#include <cmath>
 #include <string>
 
 #include "core/von_mises.h"
@@ -28,9 +29,11 @@ inline constexpr const char* kDirectionalModelType = "directional_map";
 enum class DirectionalVariant { kSpatiotemporal, kSpatial };
 const char* VariantName(DirectionalVariant v);
 
-/// log kappa is clamped to this range in the head (training and engine alike).
+/// log kappa is clamped to [kDirectionalLogKappaMin, log max_kappa] in the head (training and engine
+/// alike); max_kappa is a model parameter (artifact attribute log_kappa_max), by default the cap of
+/// the directional grid maps (100), so that no method wins AL by spikes on repeated headings.
 inline constexpr double kDirectionalLogKappaMin = -10.0;
-inline constexpr double kDirectionalLogKappaMax = 10.0;
+inline constexpr double kDirectionalDefaultMaxKappa = 100.0;
 
 struct DirectionalHeads {
   Eigen::MatrixXf alpha_w, mu_w, kappa_w;  ///< [R x D] each
@@ -53,13 +56,14 @@ class DirectionalMap {
   static DirectionalMap Load(const std::string& path);
   /// Builds a map from parts (tests). `lstm` is ignored for the spatial variant.
   DirectionalMap(DirectionalVariant variant, const DirectionalFeatureConfig& features, Lstm lstm,
-                 DirectionalHeads heads);
+                 DirectionalHeads heads, double max_kappa = kDirectionalDefaultMaxKappa);
 
   DirectionalVariant variant() const { return variant_; }
   int components() const { return static_cast<int>(heads_.alpha_b.size()); }
   const DirectionalFeatures& features() const { return features_; }
   const Lstm& lstm() const { return lstm_; }
   const DirectionalHeads& heads() const { return heads_; }
+  double max_kappa() const { return std::exp(log_kappa_max_); }
 
   Workspace MakeWorkspace() const;
 
@@ -83,6 +87,7 @@ class DirectionalMap {
   DirectionalFeatures features_;
   Lstm lstm_;
   DirectionalHeads heads_;
+  double log_kappa_max_ = std::log(kDirectionalDefaultMaxKappa);
 };
 
 }  // namespace foresight

@@ -6,8 +6,11 @@
 
 namespace foresight {
 
-DirectionalNetImpl::DirectionalNetImpl(DirectionalVariant variant, int spatial_size, int components, int hidden)
-    : variant_(variant), components_(components), hidden_(hidden) {
+DirectionalNetImpl::DirectionalNetImpl(DirectionalVariant variant, int spatial_size, int components, int hidden,
+                                       double max_kappa)
+    : variant_(variant), components_(components), hidden_(hidden), max_kappa_(max_kappa) {
+  FS_THROW_UNLESS(std::isfinite(max_kappa) && max_kappa > std::exp(kDirectionalLogKappaMin),
+                  "DirectionalNet: max_kappa ", max_kappa);
   FS_THROW_UNLESS(spatial_size >= 1 && components >= 1 && (variant == DirectionalVariant::kSpatial || hidden >= 1),
                   "DirectionalNet: spatial_size ", spatial_size, ", components ", components, ", hidden ", hidden);
   int width = spatial_size;
@@ -72,11 +75,11 @@ torch::Tensor DirectionalNetImpl::forward_sparse(const torch::Tensor& index, con
   return Heads(Recur(bag(weight_ih_.t().contiguous()), phi_t));
 }
 
-VonMisesMixtureTensors DecodeDirectionalHead(const torch::Tensor& raw, int R) {
+VonMisesMixtureTensors DecodeDirectionalHead(const torch::Tensor& raw, int R, double max_kappa) {
   VonMisesMixtureTensors p;
   p.log_alpha = torch::log_softmax(raw.narrow(1, 0, R), 1);
   p.mu = raw.narrow(1, R, R);
-  p.kappa = torch::exp(torch::clamp(raw.narrow(1, 2 * R, R), kDirectionalLogKappaMin, kDirectionalLogKappaMax));
+  p.kappa = torch::exp(torch::clamp(raw.narrow(1, 2 * R, R), kDirectionalLogKappaMin, std::log(max_kappa)));
   return p;
 }
 
@@ -94,7 +97,8 @@ torch::Tensor HeadPenalty(DirectionalNetImpl& net, const DirectionalPenalty& c) 
 
 torch::Tensor DirectionalLossFromRaw(DirectionalNetImpl& net, const torch::Tensor& raw, const torch::Tensor& theta,
                                      const DirectionalPenalty& penalty) {
-  return VonMisesMixtureNll(DecodeDirectionalHead(raw, net.components()), theta).mean() + HeadPenalty(net, penalty);
+  return VonMisesMixtureNll(DecodeDirectionalHead(raw, net.components(), net.max_kappa()), theta).mean() +
+         HeadPenalty(net, penalty);
 }
 
 torch::Tensor DirectionalLoss(DirectionalNetImpl& net, const torch::Tensor& phi_s, const torch::Tensor& phi_t,

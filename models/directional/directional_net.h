@@ -19,7 +19,9 @@ namespace foresight {
 class DirectionalNetImpl : public torch::nn::Module {
  public:
   /// @param spatial_size M_s; @param components R; @param hidden LSTM width (spatiotemporal only).
-  DirectionalNetImpl(DirectionalVariant variant, int spatial_size, int components, int hidden);
+  /// @param max_kappa cap of the concentrations (log-kappa head clamp).
+  DirectionalNetImpl(DirectionalVariant variant, int spatial_size, int components, int hidden,
+                     double max_kappa = kDirectionalDefaultMaxKappa);
   /// @param phi_s [B, M_s] spatial features; @param phi_t [B, M_t] temporal features (ignored by
   /// the spatial variant). @return raw head outputs [B, 3R]: alpha logits, means, log kappa.
   torch::Tensor forward(const torch::Tensor& phi_s, const torch::Tensor& phi_t);
@@ -31,6 +33,7 @@ class DirectionalNetImpl : public torch::nn::Module {
   DirectionalVariant variant() const { return variant_; }
   int components() const { return components_; }
   int hidden() const { return hidden_; }
+  double max_kappa() const { return max_kappa_; }
   torch::nn::Linear alpha_head() const { return alpha_; }
   torch::nn::Linear mu_head() const { return mu_; }
   torch::nn::Linear kappa_head() const { return kappa_; }
@@ -42,6 +45,7 @@ class DirectionalNetImpl : public torch::nn::Module {
 
   DirectionalVariant variant_;
   int components_ = 5, hidden_ = 0;
+  double max_kappa_ = kDirectionalDefaultMaxKappa;
   std::shared_ptr<torch::nn::Module> lstm_;
   torch::Tensor weight_ih_, weight_hh_, bias_ih_, bias_hh_;
   torch::nn::Linear alpha_{nullptr}, mu_{nullptr}, kappa_{nullptr};
@@ -52,8 +56,9 @@ TORCH_MODULE(DirectionalNet);
 struct VonMisesMixtureTensors {
   torch::Tensor log_alpha, mu, kappa;
 };
-/// softmax / identity / exp(clamp(., kDirectionalLogKappaMin, kDirectionalLogKappaMax)).
-VonMisesMixtureTensors DecodeDirectionalHead(const torch::Tensor& raw, int components);
+/// softmax / identity / exp(clamp(., kDirectionalLogKappaMin, log max_kappa)).
+VonMisesMixtureTensors DecodeDirectionalHead(const torch::Tensor& raw, int components,
+                                             double max_kappa = kDirectionalDefaultMaxKappa);
 
 /// log I0(kappa), finite for any kappa >= 0: log(i0e(kappa)) + kappa (spec/errata.md ch 4).
 torch::Tensor LogBesselI0(const torch::Tensor& kappa);

@@ -110,6 +110,7 @@ TEST_P(EngineVariants, MatchesDenseReferenceAndIsAProperMixture) {
     m.QueryOne(x, y, t, &ws);
     EXPECT_NEAR(ws.alpha.sum(), 1.0, 1e-12);
     EXPECT_TRUE((ws.kappa.array() > 0).all());
+    EXPECT_TRUE((ws.kappa.array() <= m.max_kappa() * (1 + 1e-12)).all());
     EXPECT_TRUE((ws.mu.array() >= -M_PI).all() && (ws.mu.array() < M_PI).all());
     // The density integrates to one over the circle (midpoint rule, periodic: spectrally accurate).
     const int n = 4000;
@@ -171,12 +172,13 @@ INSTANTIATE_TEST_SUITE_P(Directional, EngineVariants,
 TEST(DirectionalArtifact, RoundTripAndWrongKinds) {
   testing::TempDir dir;
   for (const DirectionalVariant v : {DirectionalVariant::kSpatiotemporal, DirectionalVariant::kSpatial}) {
-    const DirectionalMap m = testing::RandomDirectionalMap(v, SmallFeatureConfig(), 8, 3, 2);
+    const DirectionalMap m = testing::RandomDirectionalMap(v, SmallFeatureConfig(), 8, 3, 2, 2.0f, 50.0);
     const std::string path = dir.File(std::string(VariantName(v)) + ".h5");
     testing::WriteDirectionalArtifact(m, path);
     const DirectionalMap loaded = DirectionalMap::Load(path);
     EXPECT_EQ(loaded.variant(), v);
     EXPECT_EQ(loaded.components(), 3);
+    EXPECT_NEAR(loaded.max_kappa(), 50.0, 1e-9);
     auto w1 = m.MakeWorkspace(), w2 = loaded.MakeWorkspace();
     m.RawOutput(3.3, 1.1, 20, &w1);
     loaded.RawOutput(3.3, 1.1, 20, &w2);

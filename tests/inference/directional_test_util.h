@@ -29,7 +29,8 @@ inline DirectionalFeatureConfig SmallFeatureConfig() {
 
 /// Random LSTM and heads; weights ~ N(0, scale^2).
 inline DirectionalMap RandomDirectionalMap(DirectionalVariant v, const DirectionalFeatureConfig& f, int hidden,
-                                           int components, std::uint64_t seed, float scale = 0.5f) {
+                                           int components, std::uint64_t seed, float scale = 0.5f,
+                                           double max_kappa = kDirectionalDefaultMaxKappa) {
   std::mt19937_64 rng(seed);
   std::normal_distribution<float> n(0.0f, scale);
   auto mat = [&](long r, long c) { return Eigen::MatrixXf(Eigen::MatrixXf::NullaryExpr(r, c, [&] { return n(rng); })); };
@@ -43,7 +44,7 @@ inline DirectionalMap RandomDirectionalMap(DirectionalVariant v, const Direction
   }
   DirectionalHeads h{mat(components, d), mat(components, d), mat(components, d), vec(components), vec(components),
                      vec(components)};
-  return DirectionalMap(v, f, std::move(lstm), std::move(h));
+  return DirectionalMap(v, f, std::move(lstm), std::move(h), max_kappa);
 }
 
 /// Writes `map` as a directional_map artifact (the schema of docs/artifact_schema.md).
@@ -53,6 +54,7 @@ inline void WriteDirectionalArtifact(const DirectionalMap& map, const std::strin
   const DirectionalFeatureConfig& c = map.features().config();
   f.SetAttr("/model", "variant", std::string(VariantName(map.variant())));
   f.SetAttr("/model", "components", static_cast<std::int64_t>(map.components()));
+  f.SetAttr("/model", "log_kappa_max", std::log(map.max_kappa()));
   const std::string g = "/model/features";
   f.SetAttr(g, "x_min", c.x_min);
   f.SetAttr(g, "x_max", c.x_max);
