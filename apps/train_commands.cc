@@ -10,6 +10,7 @@
 #include "embedded_config.h"
 #include "training/directional_config.h"
 #include "training/directional_pipeline.h"
+#include "training/navigation_config.h"
 #include "training/occupancy_config.h"
 #include "training/span_eval.h"
 #include "training/span_pipeline.h"
@@ -154,7 +155,10 @@ void AddTrainCommands(CLI::App* app) {
         config::ReferenceTable<OccupancyExperimentConfig>() +
         "\n## Directional-map experiments\n\nEvery key of a directional config (`configs/directional/*.yaml`, "
         "`model: directional`) with its default.\n\n" +
-        config::ReferenceTable<DirectionalExperimentConfig>();
+        config::ReferenceTable<DirectionalExperimentConfig>() +
+        "\n## Navigation experiments\n\nEvery key of a navigation config (`configs/navigation/*.yaml`, "
+        "`model: navigation`, run by `foresight navigate`) with its default.\n\n" +
+        config::ReferenceTable<NavigationExperimentConfig>();
     if (docs_out->empty()) std::cout << text;
     else std::ofstream(*docs_out) << text;
   });

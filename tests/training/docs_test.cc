@@ -6,6 +6,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "training/navigation_config.h"
 #include "training/occupancy_config.h"
 #include "training/span_config.h"
 
@@ -23,6 +24,20 @@ TEST(Docs, ConfigReferenceIsCurrent) {
       << "docs/config_reference.md is stale: run `build/bin/foresight docs config -o docs/config_reference.md`";
   EXPECT_NE(ss.str().find(config::ReferenceTable<OccupancyExperimentConfig>()), std::string::npos)
       << "docs/config_reference.md is stale: run `build/bin/foresight docs config -o docs/config_reference.md`";
+  EXPECT_NE(ss.str().find(config::ReferenceTable<NavigationExperimentConfig>()), std::string::npos)
+      << "docs/config_reference.md is stale: run `build/bin/foresight docs config -o docs/config_reference.md`";
+}
+
+TEST(Docs, ShippedNavigationConfigsLoad) {
+  const std::string src = std::getenv("FORESIGHT_SOURCE_DIR");
+  for (const char* name : {"sim1", "sim2", "dataset"}) {
+    const NavigationExperimentConfig c = LoadNavigationConfig(src + "/configs/navigation/" + name + ".yaml");
+    EXPECT_EQ(c.scenario.name, name);
+    EXPECT_EQ(c.methods.size(), 3u);
+    EXPECT_GE(c.episodes, 20);
+  }
+  for (const char* name : {"predictor", "predictor_thor"})
+    EXPECT_NO_THROW(LoadSpanConfig(src + "/configs/navigation/" + name + ".yaml", {})) << name;
 }
 
 TEST(Docs, ShippedConfigsLoad) {
