@@ -179,7 +179,10 @@ struct CrowdScenarioConfig {
 
 /// The `sim1` default: a 20 m x 8 m hall split by a wall with a 2 m central doorway; two opposing
 /// flows of 12 pedestrians each go through the doorway (round trips) while the robot crosses the
-/// hall through the same doorway -> congestion.
+/// hall through the same doorway -> congestion. Note: the shipped configs/navigation/sim1.yaml is
+/// a different scene (two flows crossing a 20 m x 10 m hall with two pillars): here the flows clog
+/// the doorway for minutes, so no controller gets through without pushing; this one stays as the
+/// simulator's test scene.
 CrowdScenarioConfig Sim1Scenario();
 /// The `sim2` default: an open 20 m x 20 m area with 24 pedestrians in four loosely crossing flows.
 CrowdScenarioConfig Sim2Scenario();
