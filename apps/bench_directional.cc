@@ -85,6 +85,24 @@ void RunDirectionalBench(const BenchDirectionalArgs& a) {
     if (forward_only) forward_only->push_back(Us(t1, t2));
     return Us(t0, t2);
   };
+  // The training path: sparse spatial features through an embedding bag.
+  std::vector<std::int64_t> index, offsets;
+  std::vector<float> value;
+  auto torch_sparse = [&](int begin, int len) {
+    const auto t0 = Clock::now();
+    feats.SpatialSparseBatch(x.segment(begin, len), y.segment(begin, len), &index, &value, &offsets);
+    RowMatrixF tm(len, feats.time_size());
+    feats.TemporalBatch(t.segment(begin, len), tm);
+    const auto nnz = static_cast<std::int64_t>(index.size());
+    const auto p = DecodeDirectionalHead(
+        net.net->forward_sparse(torch::from_blob(index.data(), {nnz}, torch::kInt64),
+                                torch::from_blob(value.data(), {nnz}, torch::kFloat32),
+                                torch::from_blob(offsets.data(), {len + 1}, torch::kInt64),
+                                torch::from_blob(tm.data(), {tm.rows(), tm.cols()}, torch::kFloat32)),
+        net.net->components(), net.net->max_kappa());
+    (void)p.kappa.sum().item<float>();
+    return Us(t0, Clock::now());
+  };
   std::vector<double> l1, l1f;
   const int torch_calls = std::max(200, a.calls / 5);
   for (int i = 0; i < torch_calls + 50; ++i) {
@@ -94,6 +112,13 @@ void RunDirectionalBench(const BenchDirectionalArgs& a) {
   std::vector<double> lb, lbf;
   torch_query(0, n, nullptr);
   for (int r = 0; r < a.repeats; ++r) lb.push_back(torch_query(0, n, &lbf));
+  std::vector<double> s1, sb;
+  for (int i = 0; i < torch_calls + 50; ++i) {
+    const double us = torch_sparse(i % n, 1);
+    if (i >= 50) s1.push_back(us);
+  }
+  torch_sparse(0, n);
+  for (int r = 0; r < a.repeats; ++r) sb.push_back(torch_sparse(0, n));
 
   const double engine1 = Median(e1), engine_b = Median(eb), torch1 = Median(l1), torch_b = Median(lb);
   if (a.json) {
@@ -102,6 +127,7 @@ void RunDirectionalBench(const BenchDirectionalArgs& a) {
               << ", \"threads\": 1, \"engine_batch1_us\": " << engine1 << ", \"libtorch_batch1_us\": " << torch1
               << ", \"libtorch_batch1_forward_us\": " << Median(l1f) << ", \"engine_batch1024_us\": " << engine_b
               << ", \"libtorch_batch1024_us\": " << torch_b << ", \"libtorch_batch1024_forward_us\": " << Median(lbf)
+              << ", \"libtorch_sparse_batch1_us\": " << Median(s1) << ", \"libtorch_sparse_batch1024_us\": " << Median(sb)
               << "}\n";
     return;
   }
@@ -113,6 +139,9 @@ void RunDirectionalBench(const BenchDirectionalArgs& a) {
   std::printf("batch 1024 engine (median of %d):     %10.1f us   (%.2f us/query)\n", a.repeats, engine_b, engine_b / n);
   std::printf("batch 1024 libtorch (features+net):  %10.1f us   (net only %.1f us)   ratio %.2f x\n", torch_b,
               Median(lbf), torch_b / engine_b);
+  std::printf("libtorch, sparse features (embedding bag, the training path): batch 1 %.2f us (ratio %.1f x), "
+              "batch 1024 %.1f us (ratio %.2f x)\n",
+              Median(s1), Median(s1) / engine1, Median(sb), Median(sb) / engine_b);
 }
 
 }  // namespace

@@ -36,12 +36,13 @@ Lstm Lstm::Load(const h5::File& file, const std::string& prefix) {
 
 Lstm::Workspace Lstm::MakeWorkspace() const {
   const int h = hidden_size();
-  return {Eigen::VectorXf::Zero(4 * h), Eigen::VectorXf::Zero(h), Eigen::VectorXf::Zero(h)};
+  return {Eigen::VectorXf::Zero(4 * h), Eigen::VectorXf::Zero(h), Eigen::VectorXf::Zero(h), true};
 }
 
 void Lstm::Reset(Workspace* ws) const {
   ws->h.setZero();
   ws->c.setZero();
+  ws->zero_state = true;
 }
 
 namespace {
@@ -50,7 +51,8 @@ inline float Sigmoid(float v) { return 1.0f / (1.0f + std::exp(-v)); }
 
 void Lstm::Finish(Workspace* ws) const {
   const int h = hidden_size();
-  ws->gates.noalias() += w_.weight_hh * ws->h;
+  if (!ws->zero_state) ws->gates.noalias() += w_.weight_hh * ws->h;
+  ws->zero_state = false;
   for (int j = 0; j < h; ++j) {
     const float i = Sigmoid(ws->gates[j]);
     const float f = Sigmoid(ws->gates[h + j]);

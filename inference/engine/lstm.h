@@ -25,6 +25,7 @@ class Lstm {
   struct Workspace {
     Eigen::VectorXf gates;  ///< [4H]
     Eigen::VectorXf h, c;   ///< [H] state
+    bool zero_state = true;  ///< h = c = 0 (after Reset): the recurrent product is skipped
   };
 
   Lstm() = default;
