@@ -29,7 +29,8 @@ void EvalOccupancy(const std::string& config_path, const std::vector<std::string
 void TrainOccupancy(const std::string& config_path, const std::vector<std::string>& overrides,
                     const std::string& run_dir, bool resume);
 
-}  // namespace foresight::app
 /// `navigate CONFIG --out DIR [--episodes N]` (SPAN and baselines in a crowd scenario).
 void AddNavigateCommand(CLI::App* app);
+
+}  // namespace foresight::app
 
