@@ -19,6 +19,7 @@
 #include "core/log.h"
 #include "inference/mapping/grid_map.h"
 #include "inference/navigation/cl_rrt_star.h"
+#include "inference/navigation/goal_distance.h"
 #include "inference/navigation/span_controller.h"
 #include "models/occupancy/fast_bhm.h"
 #include "training/navigation_render.h"
@@ -85,16 +86,18 @@ void BuildScenarioMap(const NavigationExperimentConfig& c, const OccupancyRaster
   learner.ToMap().Save(path, yaml, c.seed);
 }
 
-/// Distance (m) from each raster cell to the nearest occupied cell.
+/// Distance (m) from each raster cell to the nearest occupied cell or the outside of the raster
+/// (outside the scene is occupied: a one-cell occupied border is added before the transform).
 Eigen::MatrixXf DistanceToObstacles(const OccupancyRaster& r) {
-  cv::Mat free(static_cast<int>(r.cells.rows()), static_cast<int>(r.cells.cols()), CV_8U);
-  for (int i = 0; i < free.rows; ++i)
-    for (int j = 0; j < free.cols; ++j) free.at<std::uint8_t>(i, j) = r.cells(i, j) ? 0 : 255;
+  const int rows = static_cast<int>(r.cells.rows()), cols = static_cast<int>(r.cells.cols());
+  cv::Mat free(rows + 2, cols + 2, CV_8U, cv::Scalar(0));
+  for (int i = 0; i < rows; ++i)
+    for (int j = 0; j < cols; ++j) free.at<std::uint8_t>(i + 1, j + 1) = r.cells(i, j) ? 0 : 255;
   cv::Mat dist;
   cv::distanceTransform(free, dist, cv::DIST_L2, cv::DIST_MASK_PRECISE);
-  Eigen::MatrixXf out(free.rows, free.cols);
-  for (int i = 0; i < free.rows; ++i)
-    for (int j = 0; j < free.cols; ++j) out(i, j) = dist.at<float>(i, j) * static_cast<float>(r.resolution);
+  Eigen::MatrixXf out(rows, cols);
+  for (int i = 0; i < rows; ++i)
+    for (int j = 0; j < cols; ++j) out(i, j) = dist.at<float>(i + 1, j + 1) * static_cast<float>(r.resolution);
   return out;
 }
 
@@ -237,10 +240,17 @@ EpisodeResult RunEpisode(const NavigationExperimentConfig& c, const NavigationRe
   nav::UnicycleState s{ends.start[0], ends.start[1], ends.start[2]};
   const Eigen::Vector2d goal = ends.goal;
   const double r_robot = c.scenario.robot_radius;
+  controller->Prepare(goal);  // per-goal set-up (distance field) outside the timed cycles
   const int max_cycles = static_cast<int>(std::ceil(c.max_time / c.dt));
   std::vector<Eigen::Vector2d> path{s.position()};
   Eigen::MatrixXd rows;
-  double t = 0.0, min_clear = kInf;
+  auto clearance = [&] {
+    double clear = res.StaticDistance(s.x, s.y) - r_robot;
+    for (const CrowdAgent& a : crowd->agents())
+      if (a.active) clear = std::min(clear, (a.position - s.position()).norm() - r_robot - a.radius);
+    return clear;
+  };
+  double t = 0.0, min_clear = clearance();
   for (int cycle = 0; cycle < max_cycles; ++cycle) {
     if ((s.position() - goal).norm() <= c.goal_tolerance) {
       out.reached = true;
@@ -269,7 +279,7 @@ EpisodeResult RunEpisode(const NavigationExperimentConfig& c, const NavigationRe
     nav::ControlOutcome u;
     try {
       u = controller->Compute(in);
-    } catch (const std::exception& e) {  // controllers do not throw; count it if one ever does
+    } catch (const std::exception&) {  // controllers do not throw; count it if one ever does
       u = nav::ControlOutcome{};
       u.solved = false;
     }
@@ -295,12 +305,15 @@ EpisodeResult RunEpisode(const NavigationExperimentConfig& c, const NavigationRe
       if (a.active) clear = std::min(clear, (a.position - s.position()).norm() - r_robot - a.radius);
     if (clear < 0) out.doc += c.dt;
     min_clear = std::min(min_clear, clear);
-    if (recorder) {
+    if (recorder) try {
       const auto* span = dynamic_cast<const nav::SpanController*>(controller.get());
       Eigen::Matrix2Xd so_far(2, static_cast<Eigen::Index>(path.size()));
       for (std::size_t i = 0; i < path.size(); ++i) so_far.col(static_cast<Eigen::Index>(i)) = path[i];
       recorder->Frame(t, s, goal, crowd->agents(), span ? &span->predictions() : nullptr,
                       span ? span->forecast().pedestrians() : 0, so_far);
+    } catch (const std::exception& e) {  // a video problem must not lose the episode
+      log::Warn("video: ", e.what(), "; no more frames");
+      recorder = nullptr;
     }
   }
   if (!out.reached && (s.position() - goal).norm() <= c.goal_tolerance) out.reached = true;
@@ -334,8 +347,8 @@ MethodSummary Summarise(const std::string& method, const std::vector<EpisodeResu
   m.collision_free_rate = static_cast<double>(free) / m.episodes;
   m.ttg_mean = ttg.empty() ? std::nan("") : std::accumulate(ttg.begin(), ttg.end(), 0.0) / static_cast<double>(ttg.size());
   m.doc_mean = doc / m.episodes;
-  m.min_clearance = clear / m.episodes;
-  m.min_clearance_worst = worst;
+  m.min_clearance_mean = clear / m.episodes;
+  m.min_clearance = worst;
   m.cycle_ms_median = Percentile(cycles, 0.5);
   m.cycle_ms_p99 = Percentile(cycles, 0.99);
   m.cycle_ms_max = cycles.empty() ? std::nan("") : *std::max_element(cycles.begin(), cycles.end());
@@ -344,12 +357,17 @@ MethodSummary Summarise(const std::string& method, const std::vector<EpisodeResu
 
 std::string SummaryJson(const NavigationExperimentConfig& c, int episodes, const std::vector<MethodSummary>& s) {
   std::ostringstream j;
-  j << "{\n  \"scenario\": \"" << c.scenario.name << "\",\n  \"episodes\": " << episodes << ",\n  \"seed\": " << c.seed;
+  std::string name;
+  for (char ch : c.scenario.name) {
+    if (ch == '"' || ch == '\\') name += '\\';
+    if (static_cast<unsigned char>(ch) >= 0x20) name += ch;
+  }
+  j << "{\n  \"scenario\": \"" << name << "\",\n  \"episodes\": " << episodes << ",\n  \"seed\": " << c.seed;
   for (const MethodSummary& m : s) {
     j << ",\n  \"" << m.method << "\": {\"success_rate\": " << Json(m.success_rate)
       << ", \"collision_free_rate\": " << Json(m.collision_free_rate) << ", \"ttg_mean\": " << Json(m.ttg_mean)
       << ", \"doc_mean\": " << Json(m.doc_mean) << ", \"min_clearance\": " << Json(m.min_clearance)
-      << ", \"min_clearance_worst\": " << Json(m.min_clearance_worst) << ", \"cycle_ms_median\": " << Json(m.cycle_ms_median)
+      << ", \"min_clearance_mean\": " << Json(m.min_clearance_mean) << ", \"cycle_ms_median\": " << Json(m.cycle_ms_median)
       << ", \"cycle_ms_p99\": " << Json(m.cycle_ms_p99) << ", \"cycle_ms_max\": " << Json(m.cycle_ms_max)
       << ", \"solve_failures\": " << m.solve_failures << ", \"episodes\": " << m.episodes << "}";
   }
@@ -372,6 +390,15 @@ std::vector<MethodSummary> RunNavigation(const NavigationExperimentConfig& c, co
                     ") of episode ", e, " is inside or too close to a static obstacle");
     FS_THROW_UNLESS(Reachable(res, start, ends.goal, r), "scenario.robot_goal: (", ends.goal.transpose(),
                     ") of episode ", e, " is unreachable from the start on the static map");
+    // The controllers see the map artifact (through the swept field), not the raster: check there too.
+    MapWorkspace ws = res.field->MakeWorkspace();
+    const double eps = c.span.options.epsilon;
+    FS_THROW_UNLESS(!res.field->Collides(start.x(), start.y(), eps, &ws), "scenario.robot_start: (", start.transpose(),
+                    ") of episode ", e, " is in collision on the map artifact (swept occupancy above epsilon ", eps, ")");
+    FS_THROW_UNLESS(!res.field->Collides(ends.goal.x(), ends.goal.y(), eps, &ws), "scenario.robot_goal: (",
+                    ends.goal.transpose(), ") of episode ", e, " is occupied on the map artifact");
+    FS_THROW_UNLESS(nav::GoalDistanceField(*res.field, ends.goal, eps).Reaches(start), "scenario.robot_goal: (",
+                    ends.goal.transpose(), ") of episode ", e, " is unreachable from the start on the map artifact");
   }
   std::vector<EpisodeResult> results;
   std::ofstream csv(out_dir + "/episodes.csv");

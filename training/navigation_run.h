@@ -68,8 +68,9 @@ struct MethodSummary {
   int episodes = 0;
   double success_rate = 0, collision_free_rate = 0;
   double ttg_mean = 0;  ///< over reached episodes (NaN -> null when none)
-  double doc_mean = 0, min_clearance = 0;  ///< min_clearance: mean over episodes of the episode minimum
-  double min_clearance_worst = 0;
+  double doc_mean = 0;
+  double min_clearance = 0;       ///< m, smallest gap over all episodes (negative: overlap)
+  double min_clearance_mean = 0;  ///< m, mean over episodes of each episode's smallest gap
   double cycle_ms_median = 0, cycle_ms_p99 = 0, cycle_ms_max = 0;
   int solve_failures = 0;
 };

@@ -66,6 +66,7 @@ struct ClRrtStarController::Impl {
   const StaticCollisionField* field = nullptr;
   MapWorkspace map_ws;
   Eigen::Matrix2Xd pedestrians;  ///< current positions [2 x n]
+  Eigen::Vector2d start = Eigen::Vector2d::Zero();
   std::shared_ptr<ob::RealVectorStateSpace> space;
   std::shared_ptr<og::SimpleSetup> setup;
 
@@ -75,6 +76,9 @@ struct ClRrtStarController::Impl {
     const double r = options.robot_radius + options.pedestrian_radius;
     for (Eigen::Index i = 0; i < pedestrians.cols(); ++i)
       if ((pedestrians.col(i) - Eigen::Vector2d(x, y)).squaredNorm() < r * r) return false;
+    // The static check spares a small ball around the robot: a tracker that cut a corner into the
+    // epsilon band would otherwise make every plan start invalid and freeze the robot for good.
+    if ((Eigen::Vector2d(x, y) - start).squaredNorm() < options.start_exemption * options.start_exemption) return true;
     return !(field && field->Collides(x, y, options.epsilon, const_cast<MapWorkspace*>(&map_ws)));
   }
 };
@@ -104,7 +108,7 @@ ClRrtStarController::ClRrtStarController(const StaticCollisionField* field, cons
   impl_->setup = std::make_shared<og::SimpleSetup>(impl_->space);
   Impl* impl = impl_.get();
   impl_->setup->setStateValidityChecker([impl](const ob::State* s) { return impl->Valid(s); });
-  const double span = std::max(extent[1] - extent[0], extent[3] - extent[2]);
+  const double span = std::hypot(extent[1] - extent[0], extent[3] - extent[2]);  // OMPL: fraction of the diagonal
   impl_->setup->getSpaceInformation()->setStateValidityCheckingResolution(options.check_resolution / span);
   impl_->setup->setOptimizationObjective(
       std::make_shared<ob::PathLengthOptimizationObjective>(impl_->setup->getSpaceInformation()));
@@ -116,8 +120,9 @@ ControlOutcome ClRrtStarController::Compute(const NavigationInput& input) {
   ControlOutcome out;
   try {
     Eigen::MatrixXd clean;
-    if (input.past_rows) CleanObservations(*input.past_rows, &clean, &impl_->pedestrians);
-    else impl_->pedestrians.resize(2, 0);
+    const int n = input.past_rows ? CleanObservations(*input.past_rows, &clean, &impl_->pedestrians) : 0;
+    impl_->pedestrians.conservativeResize(2, n);  // rows without any finite point were dropped
+    impl_->start = input.robot.position();
     const auto& o = impl_->options;
     if ((input.robot.position() - input.goal).norm() <= o.goal_tolerance) {
       out.command = {0, 0};

@@ -25,6 +25,9 @@ struct ClRrtStarOptions {
   /// A partial plan (no path reaches the goal region) is followed when its end is at least this
   /// much closer to the goal than the robot (m); otherwise the robot stays put.
   double min_progress = 0.3;
+  /// Radius around the robot where the static map is not checked (m): the tracker may graze the
+  /// epsilon band at corners; pedestrians are always checked.
+  double start_exemption = 0.15;
   double robot_radius = 0.4, pedestrian_radius = 0.4, epsilon = 0.25;
   double check_resolution = 0.05;  ///< motion validity checking step (m)
   ControlLimits limits;

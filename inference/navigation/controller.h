@@ -31,6 +31,8 @@ class NavigationController {
  public:
   virtual ~NavigationController() = default;
   virtual std::string name() const = 0;
+  /// Per-goal set-up outside the timed control loop (e.g. the goal-distance field). Optional.
+  virtual void Prepare(const Eigen::Vector2d& goal) {}
   virtual ControlOutcome Compute(const NavigationInput& input) = 0;
 };
 

@@ -8,7 +8,7 @@ namespace foresight::nav {
 
 GoalDistanceField::GoalDistanceField(const StaticCollisionField& field, const Eigen::Vector2d& goal, double epsilon,
                                      double margin, double margin_weight)
-    : goal_(goal), origin_(field.origin()), resolution_(field.resolution()) {
+    : goal_(goal), origin_(field.origin()), resolution_(field.resolution()), margin_weight_(margin_weight) {
   const Eigen::MatrixXf& occ = field.raster();
   const int rows = static_cast<int>(occ.rows()), cols = static_cast<int>(occ.cols());
   constexpr float kInf = std::numeric_limits<float>::infinity();

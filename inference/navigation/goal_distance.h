@@ -28,10 +28,13 @@ class GoalDistanceField {
   /// the goal: the Euclidean distance plus `unreachable_penalty`.
   double Distance(const Eigen::Vector2d& x) const;
   double unreachable_penalty = 50.0;
+  double margin_weight() const { return margin_weight_; }
+  /// True when x lies on a cell that reaches the goal.
+  bool Reaches(const Eigen::Vector2d& x) const { return Distance(x) < (x - goal_).norm() + 0.5 * unreachable_penalty; }
 
  private:
   Eigen::Vector2d goal_ = Eigen::Vector2d::Zero(), origin_ = Eigen::Vector2d::Zero();
-  double resolution_ = 0.05;
+  double resolution_ = 0.05, margin_weight_ = 0;
   Eigen::MatrixXf distance_;  ///< [rows x cols] like the field's raster; +inf where unreachable
 };
 

@@ -140,6 +140,11 @@ SpanController::SpanController(const SpanPredictor* predictor, const StaticColli
   }
 }
 
+void SpanController::Prepare(const Eigen::Vector2d& goal) {
+  if (options_.geodesic_goal && field_ && (goal_field_.empty() || goal_field_.goal() != goal))
+    goal_field_ = GoalDistanceField(*field_, goal, options_.epsilon);
+}
+
 void SpanController::Forecast(const NavigationInput& input) {
   const int n = input.past_rows ? CleanObservations(*input.past_rows, &clean_rows_, &current_) : 0;
   if (predictor_ == nullptr || n == 0) {
@@ -176,13 +181,14 @@ ControlOutcome SpanController::Compute(const NavigationInput& input) {
   ControlOutcome out;
   try {
     Forecast(input);
-    if (options_.geodesic_goal && field_ && (goal_field_.empty() || goal_field_.goal() != input.goal))
-      goal_field_ = GoalDistanceField(*field_, input.goal, options_.epsilon);
+    Prepare(input.goal);
     Problem problem;
     problem.cost = [&](const Control& u) { return Cost(input.robot, input.goal, u, nullptr); };
     const double here = goal_field_.empty() || goal_field_.goal() != input.goal ? (input.robot.position() - input.goal).norm()
                                                                                 : goal_field_.Distance(input.robot.position());
-    const double lower = std::max(0.0, here - options_.limits.v_max * options_.horizon);
+    // The weighted geodesic distance can drop faster than v_max near walls (up to 1 + margin_weight).
+    const double rate = goal_field_.empty() ? 1.0 : 1.0 + goal_field_.margin_weight();
+    const double lower = std::max(0.0, here - rate * options_.limits.v_max * options_.horizon);
     const auto [best, cost] = MinimiseFromStarts(options_, Starts(options_, input.robot, input.goal,
                                                                   has_previous_ ? &previous_ : nullptr),
                                                  options_.initialisations, lower, &problem);
@@ -236,14 +242,18 @@ double ReactiveController::Cost(const UnicycleState& robot, const Eigen::Vector2
   return distance + heading_weight_ * std::abs(WrapToPi(bearing - s.heading)) + (hit ? options_.kappa : 0.0);
 }
 
+void ReactiveController::Prepare(const Eigen::Vector2d& goal) {
+  if (options_.geodesic_goal && field_ && (goal_field_.empty() || goal_field_.goal() != goal))
+    goal_field_ = GoalDistanceField(*field_, goal, options_.epsilon);
+}
+
 ControlOutcome ReactiveController::Compute(const NavigationInput& input) {
   ControlOutcome out;
   try {
     Eigen::MatrixXd clean;
     const int n = input.past_rows ? CleanObservations(*input.past_rows, &clean, &current_) : 0;
     forecast_.FromCurrentPositions(current_.leftCols(n), 1);
-    if (options_.geodesic_goal && field_ && (goal_field_.empty() || goal_field_.goal() != input.goal))
-      goal_field_ = GoalDistanceField(*field_, input.goal, options_.epsilon);
+    Prepare(input.goal);
     Problem problem;
     problem.cost = [&](const Control& u) { return Cost(input.robot, input.goal, u, nullptr); };
     const auto [best, cost] = MinimiseFromStarts(options_, Starts(options_, input.robot, input.goal, nullptr),

@@ -46,6 +46,7 @@ class SpanController final : public NavigationController {
   /// @param field swept static map (null or empty: no static obstacles). Both must outlive the controller.
   SpanController(const SpanPredictor* predictor, const StaticCollisionField* field, SpanControllerOptions options);
   std::string name() const override { return "span"; }
+  void Prepare(const Eigen::Vector2d& goal) override;
   ControlOutcome Compute(const NavigationInput& input) override;
 
   /// J(u) from `robot` towards `goal` against the current forecast; `tau` receives the TTC (inf: none).
@@ -86,6 +87,7 @@ class ReactiveController final : public NavigationController {
  public:
   ReactiveController(const StaticCollisionField* field, SpanControllerOptions options, double heading_weight = 0.5);
   std::string name() const override { return "reactive"; }
+  void Prepare(const Eigen::Vector2d& goal) override;
   ControlOutcome Compute(const NavigationInput& input) override;
   double Cost(const UnicycleState& robot, const Eigen::Vector2d& goal, const Control& u, bool* collides) const;
 
