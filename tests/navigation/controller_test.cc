@@ -197,6 +197,27 @@ TEST(SpanController, NonFiniteObservationsNeverThrow) {
   EXPECT_EQ(c.forecast().Mean(0, 1, 0), Eigen::Vector2d(2.0, 0.0));
 }
 
+TEST(Baselines, NonFiniteObservationsAreDroppedNotObstacles) {
+  Eigen::MatrixXd rows = Standing({{2.0, 0.0}, {5.0, 5.0}}, 5);
+  rows.row(1).setConstant(std::nan(""));
+  NavigationInput in;
+  in.robot = {0, 0, 0};
+  in.goal = {10, 0};
+  in.past_rows = &rows;
+  ReactiveController reactive(nullptr, Options());
+  EXPECT_TRUE(reactive.Compute(in).solved);
+  const GridMap map = Room(false);
+  const StaticCollisionField field(map, 0.4, 0.05);
+  ClRrtStarOptions o;
+  o.max_iterations = 300;
+  ClRrtStarController rrt(&field, Eigen::Vector4d(-0.5, 12.5, -0.5, 8.5), o, 2);
+  in.robot = {1, 1, 0};
+  in.goal = {9, 7};
+  const ControlOutcome out = rrt.Compute(in);
+  EXPECT_TRUE(out.solved);
+  for (Eigen::Index i = 0; i < rrt.path().cols(); ++i) EXPECT_TRUE(rrt.path().col(i).allFinite());
+}
+
 TEST(SpanController, BadOptionsAreClearErrors) {
   SpanControllerOptions o;
   o.epsilon = 1.2;

@@ -115,5 +115,42 @@ TEST(NavigationRun, BadScenesAndArtifactsAreClearErrors) {
   testing::ExpectErrorContains([&] { PrepareNavigation(bad, dir.path()); }, {"methods", "teleport"});
 }
 
+
+TEST(NavigationRun, SummaryMetricsFollowTheirDefinitions) {
+  auto episode = [](bool reached, double ttg, double doc, double clear, std::vector<double> ms) {
+    EpisodeResult r;
+    r.method = "span";
+    r.reached = reached;
+    r.ttg = ttg;
+    r.doc = doc;
+    r.min_clearance = clear;
+    r.cycle_ms = std::move(ms);
+    return r;
+  };
+  std::vector<EpisodeResult> results = {episode(true, 20, 0.0, 0.2, {1, 2, 3}), episode(false, 90, 0.5, -0.1, {4, 5}),
+                                        episode(true, 30, 0.2, 0.05, {6})};
+  results.push_back(results[0]);
+  results.back().method = "reactive";  // other methods are not mixed in
+  const MethodSummary m = Summarise("span", results);
+  EXPECT_EQ(m.episodes, 3);
+  EXPECT_DOUBLE_EQ(m.success_rate, 2.0 / 3);
+  EXPECT_DOUBLE_EQ(m.collision_free_rate, 1.0 / 3);
+  EXPECT_DOUBLE_EQ(m.ttg_mean, 25.0);  // reached episodes only
+  EXPECT_DOUBLE_EQ(m.doc_mean, 0.7 / 3);
+  EXPECT_DOUBLE_EQ(m.min_clearance, -0.1);
+  EXPECT_DOUBLE_EQ(m.min_clearance_mean, 0.15 / 3);
+  EXPECT_DOUBLE_EQ(m.cycle_ms_median, 3.5);  // of {1, ..., 6}
+  EXPECT_NEAR(m.cycle_ms_p99, 5.95, 1e-12);  // linear interpolation at 0.99 * 5
+  EXPECT_DOUBLE_EQ(m.cycle_ms_max, 6.0);
+  // None reached: TTG is null in the JSON, never NaN.
+  NavigationExperimentConfig c;
+  c.scenario.name = "a\"b";
+  const std::string json = SummaryJson(c, 1, {Summarise("span", {episode(false, 90, 0, 0.1, {1})})});
+  EXPECT_NE(json.find("\"ttg_mean\": null"), std::string::npos) << json;
+  EXPECT_EQ(json.find("nan"), std::string::npos);
+  EXPECT_EQ(json.find("inf"), std::string::npos);
+  EXPECT_NE(json.find("\"a\\\"b\""), std::string::npos) << json;
+}
+
 }  // namespace
 }  // namespace foresight
