@@ -65,7 +65,8 @@ struct DirectionalDataConfig {
     a->Visit("root", &root, Range::Any(), "directory for relative file names (empty: $FORESIGHT_DATA or ../shared/data)");
     a->Visit("file", &file, Range::Any(), "data file (grid_csv, edinburgh)");
     a->Visit("train_fraction", &train_fraction, Range::OpenClosed(0, 1),
-             "random fraction of each fold's training split that is kept (test folds stay whole)");
+"random fraction f of each fold's training split that is kept (test folds stay whole); the networks "
+             "then train epochs / f passes (the same number of steps), patience likewise");
     a->Visit("max_samples", &max_samples, Range::AtLeast(0), "random subsample of the data set (0: all)");
     a->Visit("edinburgh", &edinburgh, Range::Any(), "heading filter of tracked pedestrians (edinburgh)");
     a->Visit("crossing", &crossing, Range::Any(), "synthetic crossing whose flow flips over time (crossing)");

@@ -301,6 +301,12 @@ TrainingSummary TrainDirectionalNet(const DirectionalExperimentConfig& c, const 
   DirectionalTask task(net, DirectionalFeatures(features), train, val, PenaltyOf(c.network));
   TrainConfig tc = c.train;
   if (variant == DirectionalVariant::kSpatial && c.network.spatial_epochs > 0) tc.epochs = c.network.spatial_epochs;
+  if (c.data.train_fraction < 1.0) {
+    // Epochs count passes over a full training split: a fraction f trains epochs / f passes (the
+    // same number of optimiser steps), patience likewise.
+    tc.epochs = static_cast<int>(std::ceil(tc.epochs / c.data.train_fraction));
+    tc.patience = static_cast<int>(std::ceil(tc.patience / c.data.train_fraction));
+  }
   TrainingSummary s = Train(&task, tc, run, static_cast<std::uint64_t>(c.seed), can_resume, hooks);
   std::ofstream(dir + "/training_summary.json") << s.ToJson();
   if (s.reason == TerminationReason::kInterrupted) return s;
