@@ -54,6 +54,13 @@ double NloptCost(unsigned, const double* x, double*, void* data) {
   return p->cost({x[0], x[1]});
 }
 
+/// (Re)builds the goal-distance field when the goal changed (geodesic goal term with a static map).
+void UpdateGoalField(const SpanControllerOptions& o, const StaticCollisionField* field, const Eigen::Vector2d& goal,
+                     GoalDistanceField* goal_field) {
+  if (o.geodesic_goal && field && (goal_field->empty() || goal_field->goal() != goal))
+    *goal_field = GoalDistanceField(*field, goal, o.epsilon);
+}
+
 /// Runs COBYLA from each start; returns the best control and its cost. Never throws.
 std::pair<Control, double> MinimiseFromStarts(const SpanControllerOptions& o, const std::vector<Control>& starts,
                                               int max_starts, double lower_bound, Problem* problem) {
@@ -140,10 +147,7 @@ SpanController::SpanController(const SpanPredictor* predictor, const StaticColli
   }
 }
 
-void SpanController::Prepare(const Eigen::Vector2d& goal) {
-  if (options_.geodesic_goal && field_ && (goal_field_.empty() || goal_field_.goal() != goal))
-    goal_field_ = GoalDistanceField(*field_, goal, options_.epsilon);
-}
+void SpanController::Prepare(const Eigen::Vector2d& goal) { UpdateGoalField(options_, field_, goal, &goal_field_); }
 
 void SpanController::Forecast(const NavigationInput& input) {
   const int n = input.past_rows ? CleanObservations(*input.past_rows, &clean_rows_, &current_) : 0;
@@ -242,10 +246,7 @@ double ReactiveController::Cost(const UnicycleState& robot, const Eigen::Vector2
   return distance + heading_weight_ * std::abs(WrapToPi(bearing - s.heading)) + (hit ? options_.kappa : 0.0);
 }
 
-void ReactiveController::Prepare(const Eigen::Vector2d& goal) {
-  if (options_.geodesic_goal && field_ && (goal_field_.empty() || goal_field_.goal() != goal))
-    goal_field_ = GoalDistanceField(*field_, goal, options_.epsilon);
-}
+void ReactiveController::Prepare(const Eigen::Vector2d& goal) { UpdateGoalField(options_, field_, goal, &goal_field_); }
 
 ControlOutcome ReactiveController::Compute(const NavigationInput& input) {
   ControlOutcome out;
