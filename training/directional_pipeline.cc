@@ -16,6 +16,7 @@
 #include "datasets/data_root.h"
 #include "inference/engine/artifact.h"
 #include "models/directional/grid_map.h"
+#include "training/run_dir.h"
 #include "training/directional_plots.h"
 
 namespace foresight {
@@ -24,13 +25,6 @@ namespace fs = std::filesystem;
 namespace {
 
 using RowMatrixF = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-
-std::string ReadText(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 std::vector<Eigen::Index> RandomSubset(Eigen::Index n, double fraction, std::uint64_t seed) {
   std::vector<Eigen::Index> idx(static_cast<std::size_t>(n));
@@ -416,18 +410,7 @@ DirectionalRunResult RunDirectionalExperiment(const DirectionalExperimentConfig&
       FS_THROW_UNLESS(!fs::exists(fs::path(run_dir) / name), run_dir, ": already holds a run (", name,
                       "); continue it with --resume, or train into a new or empty --run-dir");
   }
-  fs::create_directories(run_dir);
-  const std::string config_path = run_dir + "/config.yaml";
-  const std::string resolved = config::ToYaml(c);
-  if (resume) {
-    FS_THROW_UNLESS(fs::exists(config_path), run_dir, ": no config.yaml to resume from");
-    FS_THROW_UNLESS(ReadText(config_path) == resolved, config_path,
-                    ": the resolved config differs from the one this run started with; "
-                    "resume with the same config and overrides");
-  } else {
-    std::ofstream(config_path) << resolved;
-  }
-  log::SetFile(run_dir + "/log.txt");
+  StartRunDirectory(run_dir, config::ToYaml(c), resume);
   log::Info(resume ? "resuming" : "training", " directional maps in ", run_dir, " (seed ", c.seed, ")");
 
   const DirectionalSamples data = LoadDirectionalSamples(c);

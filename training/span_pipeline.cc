@@ -11,6 +11,7 @@
 #include "inference/prediction/span_predictor.h"
 #include "models/span/span_data.h"
 #include "models/span/span_net.h"
+#include "training/run_dir.h"
 
 namespace foresight {
 namespace fs = std::filesystem;
@@ -97,13 +98,6 @@ class SpanTask : public TrainingTask {
   torch::Tensor x_train_, w_train_, x_val_, w_val_;
 };
 
-std::string ReadText(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 /// The file of `run_dir` that shows it holds a run a fresh start would mix with, or "".
 /// A metrics.csv without checkpoints (a run killed in epoch 1) holds nothing to resume: a fresh
 /// start replaces it.
@@ -122,18 +116,7 @@ TrainingSummary TrainSpan(const SpanExperimentConfig& c, const std::string& run_
   const std::string previous = resume ? "" : PreviousRunFile(run_dir);
   FS_THROW_UNLESS(previous.empty(), run_dir, ": already holds a run (", previous,
                   "); continue it with --resume, or train into a new or empty --run-dir");
-  fs::create_directories(run_dir);
-  const std::string config_path = run_dir + "/config.yaml";
-  const std::string resolved = config::ToYaml(c);
-  if (resume) {
-    FS_THROW_UNLESS(fs::exists(config_path), run_dir, ": no config.yaml to resume from");
-    FS_THROW_UNLESS(ReadText(config_path) == resolved, config_path,
-                    ": the resolved config differs from the one this run started with; "
-                    "resume with the same config and overrides");
-  } else {
-    std::ofstream(config_path) << resolved;
-  }
-  log::SetFile(run_dir + "/log.txt");
+  StartRunDirectory(run_dir, config::ToYaml(c), resume);
   log::Info(resume ? "resuming" : "training", " span_predictor in ", run_dir, " (seed ", c.seed, ")");
 
   const TrackSplit split = LoadPedestrianSplits(c.data, static_cast<std::uint64_t>(c.seed));
