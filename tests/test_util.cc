@@ -1,6 +1,7 @@
 #include "tests/test_util.h"
 
 #include <fstream>
+#include <iterator>
 
 #include "core/h5.h"
 #include "inference/engine/artifact.h"
@@ -9,6 +10,11 @@
 namespace foresight::testing {
 
 void WriteText(const std::string& path, const std::string& text) { std::ofstream(path) << text; }
+
+std::string ReadText(const std::string& path) {
+  std::ifstream in(path);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
 
 void Truncate(const std::string& path, std::size_t bytes) { std::filesystem::resize_file(path, bytes); }
 

@@ -50,6 +50,8 @@ class TempDir {
 
 /// Writes `text` to `path`.
 void WriteText(const std::string& path, const std::string& text);
+/// The whole text of `path` (an empty string when it cannot be read).
+std::string ReadText(const std::string& path);
 /// Keeps the first `bytes` bytes of `path`.
 void Truncate(const std::string& path, std::size_t bytes);
 

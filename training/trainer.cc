@@ -159,6 +159,18 @@ void ReadModel(const std::string& path, torch::serialize::InputArchive& archive,
   }
 }
 
+/// One scalar of the trainer state, read into a fresh tensor: `InputArchive::read` into a defined
+/// tensor calls `set_` and keeps that tensor's dtype, so reusing one tensor for an int64 and then a
+/// float64 entry reinterprets the float's bits as an integer (the resume defect of issue 18).
+torch::Tensor ReadStateScalar(const std::string& path, torch::serialize::InputArchive& archive,
+                              const std::string& key, torch::Dtype dtype) {
+  torch::Tensor t;
+  archive.read(key, t);
+  FS_THROW_UNLESS(t.defined() && t.numel() == 1 && t.scalar_type() == dtype, path, ": entry '", key,
+                  "' is not a scalar of the expected type");
+  return t;
+}
+
 State LoadCheckpoint(const std::string& path, torch::nn::Module* module, torch::optim::Optimizer* opt) {
   auto archive = OpenCheckpoint(path);
   ReadModel(path, archive, module);
@@ -167,15 +179,10 @@ State LoadCheckpoint(const std::string& path, torch::nn::Module* module, torch::
     torch::serialize::InputArchive opt_archive;
     archive.read("optimizer", opt_archive);
     opt->load(opt_archive);
-    torch::Tensor t;
-    archive.read("state/epoch", t);
-    s.epoch = static_cast<int>(t.item<int64_t>());
-    archive.read("state/best_epoch", t);
-    s.best_epoch = static_cast<int>(t.item<int64_t>());
-    archive.read("state/best_val", t);
-    s.best_val = t.item<double>();
-    archive.read("state/bad_epochs", t);
-    s.bad_epochs = static_cast<int>(t.item<int64_t>());
+    s.epoch = static_cast<int>(ReadStateScalar(path, archive, "state/epoch", torch::kInt64).item<int64_t>());
+    s.best_epoch = static_cast<int>(ReadStateScalar(path, archive, "state/best_epoch", torch::kInt64).item<int64_t>());
+    s.best_val = ReadStateScalar(path, archive, "state/best_val", torch::kFloat64).item<double>();
+    s.bad_epochs = static_cast<int>(ReadStateScalar(path, archive, "state/bad_epochs", torch::kInt64).item<int64_t>());
   } catch (const Error&) {
     throw;
   } catch (const std::exception& e) {

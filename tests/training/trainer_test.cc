@@ -7,8 +7,10 @@
 #include <fstream>
 #include <sstream>
 
+#include "core/h5.h"
 #include "models/span/span_net.h"
 #include "tests/test_util.h"
+#include "training/span_eval.h"
 #include "training/span_pipeline.h"
 
 namespace foresight {
@@ -80,6 +82,100 @@ TrainHooks StopAfter(int epochs) {
   TrainHooks hooks;
   hooks.continue_after_epoch = [epochs](int completed) { return completed < epochs; };
   return hooks;
+}
+
+/// A one-parameter task whose validation loss is negative (as a well-trained NLL is): minimises
+/// (p - 3)^2 with a validation loss of (p - 3)^2 - 10.
+class NegativeLossTask : public TrainingTask {
+ public:
+  NegativeLossTask() { p_ = module_.register_parameter("p", torch::zeros({1})); }
+  torch::nn::Module& module() override { return module_; }
+  std::int64_t num_train() const override { return 8; }
+  torch::Tensor BatchLoss(const torch::Tensor&) override { return (p_ - 3.0).pow(2).sum(); }
+  double ValidationLoss() override { return (p_ - 3.0).pow(2).sum().item<double>() - 10.0; }
+
+ private:
+  torch::nn::Module module_;
+  torch::Tensor p_;
+};
+
+// Issue 18, defect 1, at its root: a negative best validation loss read back as a reinterpreted
+// int64 (-8.5 became -4.6e18), so no epoch after a resume was ever "best" again.
+TEST(Trainer, ResumeKeepsANegativeBestValidationLoss) {
+  testing::TempDir dir;
+  TrainConfig c;
+  c.epochs = 6;
+  c.batch_size = 4;
+  c.learning_rate = 0.1;
+  c.patience = 0;
+  c.progress = ProgressStyle::kNone;
+  NegativeLossTask full_task;
+  const TrainingSummary full = Train(&full_task, c, RunPaths{dir.File("full")}, 1, false);
+  NegativeLossTask first, second;
+  Train(&first, c, RunPaths{dir.File("resumed")}, 1, false, StopAfter(2));
+  const TrainingSummary resumed = Train(&second, c, RunPaths{dir.File("resumed")}, 1, true);
+  ASSERT_LT(full.best_val_loss, 0.0);
+  EXPECT_EQ(full.best_epoch, 6);
+  EXPECT_EQ(resumed.best_epoch, full.best_epoch);
+  EXPECT_EQ(resumed.best_val_loss, full.best_val_loss);
+  NegativeLossTask a, b;
+  LoadCheckpointModel(dir.File("full/checkpoints/best.pt"), &a.module());
+  LoadCheckpointModel(dir.File("resumed/checkpoints/best.pt"), &b.module());
+  EXPECT_TRUE(torch::equal(a.module().parameters()[0], b.module().parameters()[0]));
+}
+
+/// Everything an artifact holds that a run determines (weights, normalisation, basis, config);
+/// HDF5 object timestamps aside, two equal digests mean the same exported model.
+std::string ArtifactDigest(const std::string& path) {
+  const h5::File f = h5::File::Open(path);
+  std::ostringstream os;
+  os.precision(17);
+  os << f.ReadString("/config") << "\n";
+  for (const std::string group : {"/weights", "/normalisation", "/model"}) {
+    std::vector<std::string> pending{group};
+    while (!pending.empty()) {
+      const std::string g = pending.back();
+      pending.pop_back();
+      for (const auto& name : f.List(g)) {
+        const std::string full = g + "/" + name;
+        try {
+          const auto a = f.ReadDouble(full);
+          os << full << ":";
+          for (double v : a.data) os << " " << v;
+          os << "\n";
+        } catch (const Error&) {
+          pending.push_back(full);  // a group
+        }
+      }
+    }
+  }
+  return os.str();
+}
+
+// Issue 18, defect 1: a resumed run read its best validation loss back as a reinterpreted int64,
+// so best.pt was never replaced after a resume and the export was an older model. The whole
+// pipeline (train, export, eval) of a resumed run must match the uninterrupted one exactly.
+TEST(Trainer, ResumedRunExportsAndEvaluatesTheSameModelAsAnUninterruptedOne) {
+  testing::TempDir dir;
+  SpanExperimentConfig c = TinyConfig();
+  c.train.epochs = 8;
+  c.train.patience = 3;
+  c.eval.plot_tracks = 0;
+  const auto full = TrainSpan(c, dir.File("full"), false);
+  TrainSpan(c, dir.File("resumed"), false, StopAfter(2));
+  const auto resumed = TrainSpan(c, dir.File("resumed"), true);
+  ASSERT_GT(full.best_epoch, 2) << "the test needs a best epoch after the interruption";
+  EXPECT_EQ(resumed.reason, full.reason);
+  EXPECT_EQ(resumed.epochs_completed, full.epochs_completed);
+  EXPECT_EQ(resumed.best_epoch, full.best_epoch);
+  EXPECT_EQ(resumed.best_val_loss, full.best_val_loss);
+
+  const std::string a = ExportSpan(dir.File("full"));
+  const std::string b = ExportSpan(dir.File("resumed"));
+  EXPECT_EQ(ArtifactDigest(a), ArtifactDigest(b));
+  EvaluateSpan(c, a, dir.File("full"));
+  EvaluateSpan(c, b, dir.File("resumed"));
+  EXPECT_EQ(testing::ReadText(dir.File("full/eval.json")), testing::ReadText(dir.File("resumed/eval.json")));
 }
 
 TEST(Trainer, MetricsRowPrecedesItsCheckpointAndResumeRewritesIt) {
