@@ -18,6 +18,7 @@
 #include "models/occupancy/bhm.h"
 #include "models/occupancy/fast_bhm.h"
 #include "models/occupancy/scan_training.h"
+#include "training/experiment.h"
 #include "training/occupancy_pipeline.h"
 #include "training/octomap_baseline.h"
 
@@ -53,8 +54,9 @@ double TimeMedian(int repeats, F&& f) {
 }
 
 void RunMapBench(const BenchMapArgs& a) {
-  FS_THROW_UNLESS(IsOccupancyConfig(a.config), a.config, ": not an occupancy config (model: occupancy.*)");
-  OccupancyExperimentConfig c = LoadOccupancyConfig(a.config, a.overrides);
+  FS_THROW_UNLESS(ModelTagOfFile(a.config).rfind("occupancy.", 0) == 0, a.config,
+                  ": not an occupancy config (model: occupancy.*)");
+  OccupancyExperimentConfig c = config::LoadExperimentConfig<OccupancyExperimentConfig>(a.config, a.overrides);
   const OccupancyData data = LoadOccupancyData(c);
   const HingeGrid grid(c.features);
 

@@ -3,34 +3,23 @@
 
 #include <CLI/CLI.hpp>
 
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "training/experiment.h"
+
 namespace foresight::app {
 
+/// train, export, eval, docs config, kinds: the same commands for every experiment kind.
+void AddExperimentCommands(CLI::App* app, std::shared_ptr<const ExperimentRegistry> registry);
 void AddDataCommands(CLI::App* app);
 void AddBenchCommands(CLI::App* app);
-void AddTrainCommands(CLI::App* app);  // train, export, eval, docs (needs LibTorch)
-void AddMapCommands(CLI::App* app);    // map fuse, map info
+void AddMapCommands(CLI::App* app);        // map fuse, map info
 void AddBenchMapCommand(CLI::App* bench);  // bench map (under `bench`)
-/// `train` for builds without LibTorch: occupancy configs only.
-void AddOccupancyOnlyTrainCommand(CLI::App* app);
-
-/// True when the YAML file's `model` is `directional` (continuous directional maps; needs LibTorch).
-bool IsDirectionalConfig(const std::string& path);
 /// `bench directional` (under `bench`; needs LibTorch for the comparison).
 void AddBenchDirectionalCommand(CLI::App* bench);
-/// True when the YAML file's `model` is occupancy.* (so `train` runs the occupancy pipeline).
-bool IsOccupancyConfig(const std::string& path);
-/// Evaluates run_dir/model.h5 (any occupancy map) on the config's test scans; prints JSON.
-void EvalOccupancy(const std::string& config_path, const std::vector<std::string>& overrides,
-                   const std::string& run_dir);
-/// Trains, exports and evaluates an occupancy map into run_dir (refuses a used run_dir).
-void TrainOccupancy(const std::string& config_path, const std::vector<std::string>& overrides,
-                    const std::string& run_dir, bool resume);
-
-/// `navigate CONFIG --out DIR [--episodes N]` (SPAN and baselines in a crowd scenario).
+/// `navigate CONFIG --run-dir DIR [--episodes N]` (SPAN and baselines in a crowd scenario).
 void AddNavigateCommand(CLI::App* app);
 
 }  // namespace foresight::app
-

@@ -4,20 +4,21 @@
 
 #include "apps/commands.h"
 #include "core/error.h"
+#include "training/kinds.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"foresight: learn, export and run robot perception and anticipation models"};
   app.require_subcommand(1);
-  foresight::app::AddDataCommands(&app);
-  foresight::app::AddBenchCommands(&app);
-  foresight::app::AddMapCommands(&app);
-  foresight::app::AddNavigateCommand(&app);
-#ifdef FORESIGHT_WITH_TORCH
-  foresight::app::AddTrainCommands(&app);
-#else
-  foresight::app::AddOccupancyOnlyTrainCommand(&app);
-#endif
   try {
+    foresight::app::AddExperimentCommands(
+        &app, std::make_shared<const foresight::ExperimentRegistry>(foresight::BuiltinKinds()));
+    foresight::app::AddDataCommands(&app);
+    foresight::app::AddBenchCommands(&app);
+#ifdef FORESIGHT_WITH_TORCH
+    foresight::app::AddBenchDirectionalCommand(app.get_subcommand("bench"));
+#endif
+    foresight::app::AddMapCommands(&app);
+    foresight::app::AddNavigateCommand(&app);
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);

@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -17,37 +18,6 @@
 
 namespace foresight::app {
 namespace fs = std::filesystem;
-
-bool IsOccupancyConfig(const std::string& path) {
-  if (path.empty() || path == "default") return false;
-  const YAML::Node root = config::LoadYamlFile(path);
-  if (!root.IsMap() || !root["model"] || !root["model"].IsScalar()) return false;
-  return root["model"].as<std::string>().rfind("occupancy.", 0) == 0;
-}
-
-void TrainOccupancy(const std::string& config_path, const std::vector<std::string>& overrides,
-                    const std::string& run_dir, bool resume) {
-  FS_THROW_UNLESS(!resume, "--resume: occupancy maps train in one pass (seconds); run again instead");
-  const OccupancyExperimentConfig c = LoadOccupancyConfig(config_path, overrides);
-  for (const char* f : {"model.h5", "eval.json"})
-    FS_THROW_UNLESS(!fs::exists(fs::path(run_dir) / f), run_dir, ": already holds ", f,
-                    " of an earlier run; use a new or empty --run-dir");
-  std::cout << RunOccupancyExperiment(c, config::ToYaml(c), run_dir);
-  std::cout << "wrote " << run_dir << "/model.h5, eval.json and plots/map.png\n";
-}
-
-void EvalOccupancy(const std::string& config_path, const std::vector<std::string>& overrides,
-                   const std::string& run_dir) {
-  const OccupancyExperimentConfig c = LoadOccupancyConfig(config_path, overrides);
-  const std::string artifact = run_dir + "/model.h5";
-  FS_THROW_UNLESS(fs::exists(artifact), artifact, ": not found (train the map first)");
-  const auto map = LoadOccupancyMap(artifact);
-  const OccupancyData data = LoadOccupancyData(c);
-  const BinaryMetrics m = EvaluateMap(*map, data.test);
-  std::cout << "{\"model_type\": \"" << map->model_type() << "\", \"test_points\": " << data.test.size()
-            << ", \"auc\": " << m.auc << ", \"precision\": " << m.precision << ", \"recall\": " << m.recall
-            << ", \"artifact_bytes\": " << fs::file_size(artifact) << "}\n";
-}
 
 namespace {
 struct FuseArgs {
@@ -72,6 +42,13 @@ void AddMapCommands(CLI::App* app) {
                    "local weight estimates with a variance at or above this are left out")
       ->check(CLI::PositiveNumber);
   fuse->callback([args] {
+    FS_THROW_UNLESS(std::isfinite(args->threshold) && args->threshold > 0, "--variance-threshold: ", args->threshold,
+                    " is not a finite positive number");
+    for (std::size_t i = 0; i < args->inputs.size(); ++i)
+      for (std::size_t j = 0; j < i; ++j)
+        FS_THROW_UNLESS(!fs::equivalent(args->inputs[i], args->inputs[j]), args->inputs[i],
+                        ": the same map is given twice (as input ", j + 1, " and ", i + 1,
+                        "); fusing a map with itself counts its evidence twice");
     std::vector<HingeMap> maps;
     for (const auto& p : args->inputs) maps.push_back(HingeMap::Load(p));
     std::vector<const HingeMap*> ptrs;
@@ -96,24 +73,6 @@ void AddMapCommands(CLI::App* app) {
     const Eigen::Vector4d e = m->Extent();
     std::cout << "{\"model_type\": \"" << m->model_type() << "\", \"extent\": [" << e[0] << ", " << e[1] << ", "
               << e[2] << ", " << e[3] << "], \"bytes\": " << fs::file_size(*path) << "}\n";
-  });
-}
-
-void AddOccupancyOnlyTrainCommand(CLI::App* app) {
-  struct Args {
-    std::string config, run_dir;
-    std::vector<std::string> overrides;
-  };
-  auto a = std::make_shared<Args>();
-  auto* train = app->add_subcommand("train", "train an occupancy map from a YAML config (this build has no LibTorch)");
-  train->add_option("config", a->config, "config file (model: occupancy.*)")->required();
-  train->add_option("overrides", a->overrides, "key.path=value overrides of the config");
-  train->add_option("--run-dir", a->run_dir, "run directory (default runs/<config name>)");
-  train->callback([a] {
-    FS_THROW_UNLESS(IsOccupancyConfig(a->config), a->config,
-                    ": this build has no LibTorch and trains occupancy maps (model: occupancy.*) only");
-    TrainOccupancy(a->config, a->overrides,
-                   a->run_dir.empty() ? "runs/" + fs::path(a->config).stem().string() : a->run_dir, false);
   });
 }
 

@@ -19,7 +19,7 @@ namespace fs = std::filesystem;
 
 namespace {
 struct NavigateArgs {
-  std::string config, out;
+  std::string config, run_dir;
   std::vector<std::string> overrides;
   int episodes = 0;
 };
@@ -45,18 +45,18 @@ void AddNavigateCommand(CLI::App* app) {
                   "navigation config (configs/navigation/*.yaml), or 'default' for the embedded configs/navigation/sim1.yaml")
       ->required();
   nav->add_option("overrides", args->overrides, "key.path=value overrides of the config");
-  nav->add_option("--out", args->out, "output directory (default runs/navigate_<config name>)");
+  nav->add_option("--run-dir", args->run_dir, "run directory (default runs/navigate_<config name>)");
   nav->add_option("--episodes", args->episodes, "episodes per method (default: the config's)")->check(CLI::Range(1, 100000));
   nav->callback([args] {
     const bool embedded = args->config == "default";
     const NavigationExperimentConfig c =
-        embedded ? NavigationConfigFromYaml(kEmbeddedNavigationConfig, "<embedded configs/navigation/sim1.yaml>", args->overrides)
-                 : LoadNavigationConfig(args->config, args->overrides);
-    const std::string out =
-        !args->out.empty() ? args->out : "runs/navigate_" + (embedded ? std::string("sim1") : fs::path(args->config).stem().string());
-    fs::create_directories(out);
-    std::ofstream(out + "/config.yaml") << config::ToYaml(c);
-    const bool needs_predictor = std::find(c.methods.begin(), c.methods.end(), "span") != c.methods.end();
+        embedded ? config::ExperimentConfigFromYaml<NavigationExperimentConfig>(kEmbeddedNavigationConfig, "<embedded configs/navigation/sim1.yaml>", args->overrides)
+                 : config::LoadExperimentConfig<NavigationExperimentConfig>(args->config, args->overrides);
+    const std::string out = !args->run_dir.empty()
+                                ? args->run_dir
+                                : "runs/navigate_" + (embedded ? std::string("sim1") : fs::path(args->config).stem().string());
+    StartRunDirectory(out, config::ToYaml(c), false, kNavigationRunRules);
+    const bool needs_predictor = c.Uses(NavigationMethod::kSpan);
     if (needs_predictor && !fs::exists(c.predictor.artifact)) {
 #ifdef FORESIGHT_WITH_TORCH
       EnsureNavigationPredictor(c, kEmbeddedNavigationPredictorConfig);

@@ -2,6 +2,8 @@
 
 #include <cstdlib>
 #include <fstream>
+#include <map>
+#include <filesystem>
 #include <iomanip>
 
 namespace foresight::config {
@@ -139,20 +141,55 @@ void ApplyOverride(YAML::Node root, const std::string& assignment) {
   SetPath(root, keys, 0, value, assignment);
 }
 
+namespace {
+/// yaml-cpp keeps both entries of a duplicated key and answers lookups with the first, so a
+/// repeated key would be silently ignored: refuse it, naming both lines.
+void RefuseDuplicateKeys(const YAML::Node& node, const std::string& source) {
+  if (node.IsSequence()) {
+    for (const auto& item : node) RefuseDuplicateKeys(item, source);
+    return;
+  }
+  if (!node.IsMap()) return;
+  std::map<std::string, int> seen;  // key -> 1-based line
+  for (const auto& item : node) {
+    if (item.first.IsScalar()) {
+      const std::string key = item.first.Scalar();
+      const int line = item.first.Mark().line + 1;
+      const auto [it, inserted] = seen.emplace(key, line);
+      FS_THROW_UNLESS(inserted, source, ":", line, ": key '", key, "' is repeated (first at line ", it->second,
+                      "); give each key once");
+    }
+    RefuseDuplicateKeys(item.second, source);
+  }
+}
+}  // namespace
+
 YAML::Node ParseYaml(const std::string& text, const std::string& source) {
+  YAML::Node node;
   try {
-    return YAML::Load(text);
+    node = YAML::Load(text);
   } catch (const YAML::Exception& e) {
     Fail(source, ":", e.mark.line + 1, ": invalid YAML: ", e.msg);
   }
+  RefuseDuplicateKeys(node, source);
+  return node;
 }
 
 YAML::Node LoadYamlFile(const std::string& path) {
+  // Configs are a few kilobytes; a huge file is a mistake (and would take gigabytes to parse).
+  constexpr std::uintmax_t kMaxConfigBytes = 1 << 20;
+  std::error_code ec;
+  const std::uintmax_t bytes = std::filesystem::file_size(path, ec);
+  FS_THROW_UNLESS(!ec || !std::filesystem::exists(path), path, ": cannot read config file (", ec.message(), ")");
+  FS_THROW_UNLESS(ec || bytes <= kMaxConfigBytes, path, ": config file has ", bytes, " bytes; at most ",
+                  kMaxConfigBytes, " are accepted");
   std::ifstream in(path);
   FS_THROW_UNLESS(in.good(), path, ": cannot open config file");
   std::stringstream ss;
   ss << in.rdbuf();
-  return ParseYaml(ss.str(), path);
+  const YAML::Node node = ParseYaml(ss.str(), path);
+  FS_THROW_UNLESS(node && !node.IsNull(), path, ": config file is empty; a config names at least its 'model'");
+  return node;
 }
 
 }  // namespace foresight::config

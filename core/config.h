@@ -341,6 +341,24 @@ T LoadFile(const std::string& path, const std::vector<std::string>& overrides = 
   return FromYaml<T>(LoadYamlFile(path), path, overrides);
 }
 
+/// Loads an experiment config: the strict read of `path` plus overrides, then `T::Validate(path)`,
+/// the one place where a config's rules across keys live. Every experiment kind loads this way.
+template <typename T>
+T LoadExperimentConfig(const std::string& path, const std::vector<std::string>& overrides = {}) {
+  T value = LoadFile<T>(path, overrides);
+  value.Validate(path);
+  return value;
+}
+
+/// The same from YAML text (an embedded default); `source` names it in errors.
+template <typename T>
+T ExperimentConfigFromYaml(const std::string& text, const std::string& source,
+                           const std::vector<std::string>& overrides = {}) {
+  T value = FromYaml<T>(ParseYaml(text, source), source, overrides);
+  value.Validate(source);
+  return value;
+}
+
 /// The fully resolved config as YAML text.
 template <typename T>
 std::string ToYaml(const T& value) {

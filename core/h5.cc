@@ -3,11 +3,13 @@
 #include <hdf5.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <mutex>
 
 #include "core/error.h"
+#include "core/file_io.h"
 
 namespace foresight::h5 {
 namespace {
@@ -56,9 +58,17 @@ std::string ObjectName(const std::string& object) { return object.empty() ? "/" 
 
 File File::Create(const std::string& path) {
   QuietHdf5();
-  hid_t id = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+  // The file is built in memory (HDF5's core driver without a backing store) and written by Close
+  // with checked POSIX calls: HDF5 then never meets a failing disk, whose errors it cannot always
+  // recover from (a failed close left a file that crashed the library's shutdown).
+  Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
+  FS_THROW_UNLESS(fapl.ok() && H5Pset_fapl_core(fapl.get(), 1 << 20, 0) >= 0, path,
+                  ": cannot set up an in-memory HDF5 file");
+  hid_t id = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get());
   FS_THROW_UNLESS(id >= 0, path, ": cannot create HDF5 file");
-  return File(id, path);
+  File f(id, path);
+  f.writable_ = true;
+  return f;
 }
 
 File File::Open(const std::string& path) {
@@ -73,20 +83,64 @@ File File::Open(const std::string& path) {
   return File(id, path);
 }
 
-File::File(File&& other) noexcept : id_(other.id_), path_(std::move(other.path_)) { other.id_ = -1; }
+File::File(File&& other) noexcept
+    : id_(other.id_), path_(std::move(other.path_)), writable_(other.writable_) {
+  other.id_ = -1;
+}
 
 File& File::operator=(File&& other) noexcept {
   if (this != &other) {
-    if (id_ >= 0) H5Fclose(id_);
+    CloseQuietly();
     id_ = other.id_;
     path_ = std::move(other.path_);
+    writable_ = other.writable_;
     other.id_ = -1;
   }
   return *this;
 }
 
-File::~File() {
-  if (id_ >= 0) H5Fclose(id_);
+File::~File() { CloseQuietly(); }
+
+void File::CloseQuietly() noexcept {
+  try {
+    Close();
+  } catch (...) {
+    // Unchecked, as a destructor must be: writers that need to know call Close().
+  }
+}
+
+
+void File::Close() {
+  if (id_ < 0) return;
+  const hid_t id = id_;
+  id_ = -1;
+  if (!writable_) {
+    H5Fclose(id);
+    return;
+  }
+  bool ok = H5Fflush(id, H5F_SCOPE_GLOBAL) >= 0;
+  const ssize_t size = ok ? H5Fget_file_image(id, nullptr, 0) : -1;
+  std::vector<char> image(size > 0 ? static_cast<std::size_t>(size) : 0);
+  ok = ok && size > 0 && H5Fget_file_image(id, image.data(), image.size()) == size;
+  ok = H5Fclose(id) >= 0 && ok;
+  FS_THROW_UNLESS(ok, path_, ": cannot serialise the HDF5 file");
+  WriteFileBytes(path_, image.data(), image.size());
+}
+
+void WriteAtomically(const std::string& path, const std::function<void(File*)>& write) {
+  const std::string tmp = path + ".tmp";
+  try {
+    File f = File::Create(tmp);
+    write(&f);
+    f.Close();
+  } catch (...) {
+    std::remove(tmp.c_str());
+    throw;
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    std::remove(tmp.c_str());
+    Fail(path, ": cannot move the written file into place");
+  }
 }
 
 bool File::Exists(const std::string& object) const {

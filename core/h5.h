@@ -5,6 +5,7 @@
 #include <Eigen/Core>
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -30,6 +31,10 @@ class File {
   File(const File&) = delete;
   File& operator=(const File&) = delete;
   ~File();
+  /// Closes the file. A created file lives in memory until then and is written here with checked
+  /// system calls: a failure (e.g. a full disk) is an Error naming it. The destructor closes
+  /// without checking: writers call Close (or use WriteAtomically).
+  void Close();
 
   const std::string& path() const { return path_; }
   bool Exists(const std::string& object) const;
@@ -76,9 +81,15 @@ class File {
 
  private:
   File(std::int64_t id, std::string path) : id_(id), path_(std::move(path)) {}
+  void CloseQuietly() noexcept;
   void EnsureParentGroups(const std::string& name);
   std::int64_t id_ = -1;
   std::string path_;
+  bool writable_ = false;  ///< created by Create: written to path_ on Close
 };
+
+/// Writes `path` completely or not at all: `write` fills `path`.tmp, which is closed (checked) and
+/// then renamed into place; on any failure the temporary file is removed and the Error propagates.
+void WriteAtomically(const std::string& path, const std::function<void(File*)>& write);
 
 }  // namespace foresight::h5

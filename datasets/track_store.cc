@@ -19,20 +19,16 @@ void WriteTrackStore(const std::string& path, const TrackSet& set) {
     }
     offsets.push_back(static_cast<std::int64_t>(time.size()));
   }
-  const std::string tmp = path + ".tmp";
-  {
-    h5::File f = h5::File::Create(tmp);
-    f.SetAttr("/", "kind", std::string(kTrackStoreKind));
-    f.SetAttr("/", "format_version", kTrackStoreVersion);
-    f.SetAttr("/", "source", set.source);
-    f.SetAttr("/", "seconds_per_step", set.seconds_per_step);
-    f.Write("/tracks/agent_id", ids.data(), {ids.size()});
-    f.Write("/tracks/offsets", offsets.data(), {offsets.size()});
-    f.Write("/tracks/time", time.data(), {time.size()});
-    f.Write("/tracks/xy", xy.data(), {time.size(), 2});
-  }
-  FS_THROW_UNLESS(std::rename(tmp.c_str(), path.c_str()) == 0, path, ": cannot move ", tmp,
-                  " into place");
+  h5::WriteAtomically(path, [&](h5::File* f) {
+    f->SetAttr("/", "kind", std::string(kTrackStoreKind));
+    f->SetAttr("/", "format_version", kTrackStoreVersion);
+    f->SetAttr("/", "source", set.source);
+    f->SetAttr("/", "seconds_per_step", set.seconds_per_step);
+    f->Write("/tracks/agent_id", ids.data(), {ids.size()});
+    f->Write("/tracks/offsets", offsets.data(), {offsets.size()});
+    f->Write("/tracks/time", time.data(), {time.size()});
+    f->Write("/tracks/xy", xy.data(), {time.size(), 2});
+  });
 }
 
 TrackSet ReadTrackStore(const std::string& path) {
@@ -45,6 +41,8 @@ TrackSet ReadTrackStore(const std::string& path) {
   TrackSet set;
   set.source = f.GetStringAttr("/", "source");
   set.seconds_per_step = f.GetDoubleAttr("/", "seconds_per_step");
+  FS_THROW_UNLESS(std::isfinite(set.seconds_per_step) && set.seconds_per_step > 0, path, ": attribute seconds_per_step is ",
+                  set.seconds_per_step, "; expected a positive number of seconds");
   const auto ids = f.ReadInt("/tracks/agent_id");
   const auto offsets = f.ReadInt("/tracks/offsets");
   const auto time = f.ReadDouble("/tracks/time");

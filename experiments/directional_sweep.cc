@@ -61,7 +61,7 @@ DirectionalRunResult Run(const Args& a, const std::string& config, std::vector<s
   overrides.push_back("train.progress=none");
   if (a.epochs > 0) overrides.push_back("train.epochs=" + std::to_string(a.epochs));
   for (const auto& e : a.extra) overrides.push_back(e);
-  const DirectionalExperimentConfig c = LoadDirectionalConfig(a.configs + "/" + config + ".yaml", overrides);
+  const DirectionalExperimentConfig c = config::LoadExperimentConfig<DirectionalExperimentConfig>(a.configs + "/" + config + ".yaml", overrides);
   const std::string dir = a.work + "/" + name;
   const bool resume = fs::exists(dir + "/config.yaml");
   std::cerr << "== " << name << (resume ? " (resuming)" : "") << "\n";

@@ -11,7 +11,7 @@ mkdir -p "$OUT" "$ROOT/runs"
 cd "$ROOT"
 for s in sim1 sim2 dataset; do
   rm -rf "runs/navigate_$s"
-  "$BIN" navigate "configs/navigation/$s.yaml" --out "runs/navigate_$s" "$@" > "runs/navigate_$s.out" 2>&1
+  "$BIN" navigate "configs/navigation/$s.yaml" --run-dir "runs/navigate_$s" "$@" > "runs/navigate_$s.out" 2>&1
 done
 python3 - "$OUT" <<'PY'
 import json, sys

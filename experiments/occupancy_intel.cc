@@ -136,7 +136,7 @@ int main(int argc, char** argv) try {
     else Fail("unknown option ", k, " (use --config FILE --out DIR)");
   }
   fs::create_directories(out);
-  const OccupancyExperimentConfig base = LoadOccupancyConfig(config_path, {});
+  const OccupancyExperimentConfig base = config::LoadExperimentConfig<OccupancyExperimentConfig>(config_path, {});
   std::ostringstream md;
   md << "# Occupancy maps on `" << base.data.file << "` (measured by `build/bin/occupancy_experiments --config "
      << config_path << "`)\n\n";

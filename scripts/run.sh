@@ -13,7 +13,7 @@ cd "$ROOT"
 # The navigation quickstart. The predictor (runs/navigation_predictor_sim1) is trained once and
 # reused by later runs; delete that directory to retrain it.
 rm -rf runs/navigate_quickstart
-./build/bin/foresight navigate default --out runs/navigate_quickstart --episodes 3
+./build/bin/foresight navigate default --run-dir runs/navigate_quickstart --episodes 3
 # Each run of the main job starts afresh (train refuses to start a new run in a directory that
 # holds one), unless it continues the last one with --resume.
 [[ " $* " == *" --resume "* ]] || rm -rf runs/quickstart

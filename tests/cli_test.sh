@@ -49,7 +49,13 @@ done
 check_json "$OCC/eval.json"
 AUC="$(json_number "$OCC/eval.json" auc)"
 awk -v a="$AUC" 'BEGIN { exit !(a > 0.9) }' || fail "occupancy test AUC '$AUC' is not above 0.9"
-expect_error "already holds model.h5" train configs/occupancy/synthetic.yaml --run-dir "$OCC"
+expect_error "already holds a run (model.h5)" train configs/occupancy/synthetic.yaml --run-dir "$OCC"
+# The same commands for every kind: export checks the map loads, eval recomputes the test AUC.
+"$BIN" export "$OCC" | grep -q "$OCC/model.h5" || fail "occupancy export"
+"$BIN" eval "$OCC" | grep -q "\"auc\": $AUC" || fail "occupancy eval"
+"$BIN" kinds | grep -q "^occupancy" || fail "kinds lists occupancy"
+expect_error "not a run directory" eval "$TMP"
+
 FUS="$TMP/fusion"
 "$BIN" train configs/occupancy/synthetic_fusion.yaml --run-dir "$FUS" >/dev/null 2>"$TMP/fus.log" || { cat "$TMP/fus.log"; fail "fusion train"; }
 for k in auc_single auc_fuse_once auc_repeated; do
@@ -59,6 +65,8 @@ check_json "$FUS/eval.json"
 "$BIN" map fuse "$FUS/single.h5" "$FUS/fuse_once.h5" -o "$TMP/fused.h5" | grep -q "fused 2 maps" || fail "map fuse"
 "$BIN" map fuse "$OCC/model.h5" "$FUS/single.h5" --base "$FUS/model.h5" -o "$TMP/fused_base.h5" >/dev/null || fail "map fuse --base"
 "$BIN" map info "$TMP/fused.h5" | grep -q '"model_type": "occupancy.fast_bhm"' || fail "map info of a fused map"
+expect_error "variance-threshold" map fuse "$FUS/single.h5" "$FUS/fuse_once.h5" -o "$TMP/nan.h5" --variance-threshold nan
+expect_error "given twice" map fuse "$FUS/single.h5" "$FUS/single.h5" -o "$TMP/twice.h5"
 "$BIN" train configs/occupancy/synthetic.yaml features.spacing=0.6 --run-dir "$TMP/occ_coarse" >/dev/null 2>&1 || fail "coarse train"
 expect_error "feature grid" map fuse "$OCC/model.h5" "$TMP/occ_coarse/model.h5" -o "$TMP/refused.h5"
 grep -q "occ_coarse/model.h5" "$TMP/err" || fail "refused fusion does not name the map"
@@ -70,19 +78,27 @@ expect_error "tracks.h5: not a foresight artifact" map info "$TMP/tracks.h5"
 # Navigation (torch-free with the reactive and CL-RRT* baselines; SPAN needs a predictor artifact).
 NAV="$TMP/nav"
 "$BIN" navigate configs/navigation/sim2.yaml "methods=[reactive, cl_rrt_star]" max_time=4 video.enabled=false \
-  cl_rrt_star.max_iterations=200 --episodes 1 --out "$NAV" >/dev/null 2>"$TMP/nav.log" || { cat "$TMP/nav.log"; fail "navigate"; }
-for f in summary.json episodes.csv paths.png map.h5 config.yaml; do
+  cl_rrt_star.max_iterations=200 --episodes 1 --run-dir "$NAV" >/dev/null 2>"$TMP/nav.log" || { cat "$TMP/nav.log"; fail "navigate"; }
+for f in summary.json episodes.csv paths.png map.h5 config.yaml log.txt; do
   [ -s "$NAV/$f" ] || fail "navigate output lacks $f"
 done
 check_json "$NAV/summary.json"
 for k in reactive cl_rrt_star success_rate collision_free_rate ttg_mean doc_mean min_clearance cycle_ms_median cycle_ms_p99; do
   grep -q "\"$k\"" "$NAV/summary.json" || fail "summary.json lacks $k"
 done
-expect_error "unknown method 'teleport'" navigate configs/navigation/sim2.yaml "methods=[teleport]" --out "$TMP/nav2"
-expect_error "robot_goal" navigate configs/navigation/sim2.yaml "methods=[reactive]" "scenario.robot_goal=[30, 0]" --out "$TMP/nav3"
-expect_error "unknown key 'span.kapa'" navigate configs/navigation/sim2.yaml span.kapa=3 --out "$TMP/nav4"
+expect_error "unknown method 'teleport'" navigate configs/navigation/sim2.yaml "methods=[teleport]" --run-dir "$TMP/nav2"
+expect_error "already holds a run (summary.json)" navigate configs/navigation/sim2.yaml --run-dir "$NAV"
+expect_error "'navigation' has no export step" export "$NAV"
+expect_error "'navigation' has no eval step" eval "$NAV"
+expect_error "robot_goal" navigate configs/navigation/sim2.yaml "methods=[reactive]" "scenario.robot_goal=[30, 0]" --run-dir "$TMP/nav3"
+expect_error "'max_time'" navigate configs/navigation/sim2.yaml max_time=3e8 --run-dir "$TMP/nav6"
+printf 'model: occupancy.fast_bhm\nseed: 1\nseed: 2\n' > "$TMP/twice.yaml"
+expect_error "key 'seed' is repeated" train "$TMP/twice.yaml" --run-dir "$TMP/r_twice"
+printf '# empty\n' > "$TMP/empty.yaml"
+expect_error "empty.yaml: config file is empty" train "$TMP/empty.yaml" --run-dir "$TMP/r_empty"
+expect_error "unknown key 'span.kapa'" navigate configs/navigation/sim2.yaml span.kapa=3 --run-dir "$TMP/nav4"
 expect_error "span_predictor" navigate configs/navigation/sim2.yaml "methods=[span]" predictor.artifact="$NAV/map.h5" \
-  --episodes 1 --out "$TMP/nav5"
+  --episodes 1 --run-dir "$TMP/nav5"
 
 if [ "${FORESIGHT_WITH_TORCH:-1}" = "1" ] || [ "${FORESIGHT_WITH_TORCH}" = "ON" ]; then
   printf 'model: span_predictor\ntrain: {epochs: 2, learning_rat: 0.1}\n' > "$TMP/typo.yaml"
@@ -90,8 +106,6 @@ if [ "${FORESIGHT_WITH_TORCH:-1}" = "1" ] || [ "${FORESIGHT_WITH_TORCH}" = "ON" 
   expect_error "'train.epochs'" train default train.epochs=zero --run-dir "$TMP/r0"
   expect_error "'train.epochs'" train default train.epochs=0 --run-dir "$TMP/r0"
   expect_error "cannot open config file" train "$TMP/missing.yaml"
-  # eval of an occupancy run recomputes the test AUC of its model.h5
-  "$BIN" eval configs/occupancy/synthetic.yaml --run-dir "$OCC" | grep -q "\"auc\": $AUC" || fail "occupancy eval"
   RUN="$TMP/run"
   TINY=(data.synthetic.num_tracks=120 network.hidden=[16,16] train.epochs=2 train.batch_size=64 train.progress=lines)
   "$BIN" train default "${TINY[@]}" --run-dir "$RUN" >/dev/null 2>"$TMP/train.log" || { cat "$TMP/train.log"; fail "train"; }
@@ -105,8 +119,8 @@ if [ "${FORESIGHT_WITH_TORCH:-1}" = "1" ] || [ "${FORESIGHT_WITH_TORCH}" = "ON" 
   "$BIN" train default "${TINY[@]}" train.epochs=3 --run-dir "$RUN" --resume >/dev/null 2>&1 && fail "resume with another config must fail"
   expect_error "--resume" train default "${TINY[@]}" --run-dir "$RUN"  # a fresh start does not mix runs
   "$BIN" export "$RUN" >/dev/null
-  "$BIN" eval default "${TINY[@]}" --run-dir "$RUN" | grep -q '"cv_nll"' || fail "eval"
-  expect_error "data.synthetic.num_tracks = 120, not 100" eval default "${TINY[@]}" data.synthetic.num_tracks=100 --run-dir "$RUN"
+  "$BIN" eval "$RUN" | grep -q '"cv_nll"' || fail "eval"
+  expect_error "data.synthetic.num_tracks = 120, not 100" eval "$RUN" data.synthetic.num_tracks=100
   # A loss that is non-finite in epoch 1: no checkpoint, and a summary that is still valid JSON.
   expect_error "no usable checkpoint" train default "${TINY[@]}" train.learning_rate=1e30 --run-dir "$TMP/nan_run"
   check_json "$TMP/nan_run/training_summary.json"
@@ -144,6 +158,8 @@ if [ "${FORESIGHT_WITH_TORCH:-1}" = "1" ] || [ "${FORESIGHT_WITH_TORCH}" = "ON" 
   done
   [ -s "$DIR_RUN/model.h5" ] && [ -s "$DIR_RUN/plots/trajectories.png" ] || fail "directional run dir"
   expect_error "already holds a run" train configs/directional/crossing.yaml --run-dir "$DIR_RUN"
+  "$BIN" export "$DIR_RUN" | grep -q "$DIR_RUN/model.h5" || fail "directional export"
+  "$BIN" eval "$DIR_RUN" | grep -q '"grid_mm": {"al": [0-9]' || fail "directional eval"
   expect_error "expected 'span_predictor'" bench engine --artifact "$DIR_RUN/model.h5"
   expect_error "expected 'directional_map'" bench directional --artifact "$RUN/model.h5"
   "$BIN" bench directional --artifact "$DIR_RUN/model.h5" --json --calls 200 --repeats 2 | grep -q engine_batch1024_us ||

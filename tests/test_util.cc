@@ -1,5 +1,7 @@
 #include "tests/test_util.h"
 
+#include <hdf5.h>
+
 #include <fstream>
 #include <iterator>
 
@@ -16,6 +18,32 @@ std::string ReadText(const std::string& path) {
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
+namespace {
+void OverwriteAttrRaw(const std::string& path, const std::string& object, const std::string& name, hid_t type,
+                      const void* value) {
+  const hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  ASSERT_GE(f, 0) << path;
+  const hid_t o = H5Oopen(f, object.c_str(), H5P_DEFAULT);
+  ASSERT_GE(o, 0) << object;
+  if (H5Aexists(o, name.c_str()) > 0) H5Adelete(o, name.c_str());
+  const hid_t space = H5Screate(H5S_SCALAR);
+  const hid_t a = H5Acreate2(o, name.c_str(), type, space, H5P_DEFAULT, H5P_DEFAULT);
+  EXPECT_GE(H5Awrite(a, type, value), 0);
+  H5Aclose(a);
+  H5Sclose(space);
+  H5Oclose(o);
+  EXPECT_GE(H5Fclose(f), 0);
+}
+}  // namespace
+
+void OverwriteAttr(const std::string& path, const std::string& object, const std::string& name, std::int64_t value) {
+  OverwriteAttrRaw(path, object, name, H5T_NATIVE_INT64, &value);
+}
+
+void OverwriteAttr(const std::string& path, const std::string& object, const std::string& name, double value) {
+  OverwriteAttrRaw(path, object, name, H5T_NATIVE_DOUBLE, &value);
+}
+
 void Truncate(const std::string& path, std::size_t bytes) { std::filesystem::resize_file(path, bytes); }
 
 std::string SharedDataDir() {
@@ -29,36 +57,35 @@ void WriteRandomSpanArtifact(const std::string& path, const RandomSpanSpec& s) {
   HeadLayout layout{s.basis, s.components, s.u_param};
   std::mt19937_64 rng(s.seed);
   std::normal_distribution<float> n01;
-  h5::File f = h5::File::Create(path);
-  Artifact::WriteHeader(&f, kSpanModelType, "model: span_predictor\n", 0);
-  f.SetAttr("/model", "observed", static_cast<std::int64_t>(s.observed));
-  f.SetAttr("/model", "predicted", static_cast<std::int64_t>(s.predicted));
-  f.SetAttr("/model", "seconds_per_step", s.seconds_per_step);
-  f.SetAttr("/model", "rotate_to_heading", static_cast<std::int64_t>(s.rotate));
-  f.SetAttr("/model", "residual_to_constant_velocity", static_cast<std::int64_t>(s.residual_cv));
-  f.SetAttr("/model", "basis_size", static_cast<std::int64_t>(s.basis));
-  f.SetAttr("/model", "components", static_cast<std::int64_t>(s.components));
-  f.SetAttr("/model", "u_param", std::string(UParamName(s.u_param)));
-  f.SetAttr("/model", "basis_gamma", 1.0);
-  f.WriteMatrix("/model/basis_centres", Eigen::VectorXd::LinSpaced(s.basis, 0.0, s.predicted * s.seconds_per_step));
-  f.WriteMatrix("/normalisation/input_mean", Eigen::VectorXd::Zero(2 * s.observed));
-  f.WriteMatrix("/normalisation/input_std", Eigen::VectorXd::Constant(2 * s.observed, 2.0));
+  SpanPredictorWeights w;
+  w.observed = s.observed;
+  w.predicted = s.predicted;
+  w.seconds_per_step = s.seconds_per_step;
+  w.rotate_to_heading = s.rotate;
+  w.residual_to_constant_velocity = s.residual_cv;
+  w.layout = layout;
+  w.basis_centres = Eigen::VectorXd::LinSpaced(s.basis, 0.0, s.predicted * s.seconds_per_step);
+  w.basis_gamma = 1.0;
+  w.input_mean = Eigen::VectorXd::Zero(2 * s.observed);
+  w.input_std = Eigen::VectorXd::Constant(2 * s.observed, 2.0);
   std::vector<int> widths{2 * s.observed};
   widths.insert(widths.end(), s.hidden.begin(), s.hidden.end());
   widths.push_back(layout.Total());
-  std::string names;
+  std::vector<DenseLayer> layers;
   for (std::size_t i = 0; i + 1 < widths.size(); ++i) {
     const std::string name = i + 2 == widths.size() ? "head" : "mlp." + std::to_string(2 * i);
-    names += (names.empty() ? "" : ",") + name;
-    Eigen::MatrixXf w(widths[i + 1], widths[i]);
-    for (Eigen::Index k = 0; k < w.size(); ++k) w.data()[k] = n01(rng) / std::sqrt(static_cast<float>(widths[i]));
-    if (name == "head") w *= 0.1f;
-    Eigen::VectorXf b(widths[i + 1]);
-    for (Eigen::Index k = 0; k < b.size(); ++k) b[k] = 0.1f * n01(rng);
-    f.WriteMatrix("/weights/" + name + "/weight", w);
-    f.WriteMatrix("/weights/" + name + "/bias", b);
+    w.layer_names.push_back(name);
+    DenseLayer l;
+    l.weight.resize(widths[i + 1], widths[i]);
+    for (Eigen::Index k = 0; k < l.weight.size(); ++k)
+      l.weight.data()[k] = n01(rng) / std::sqrt(static_cast<float>(widths[i]));
+    if (name == "head") l.weight *= 0.1f;
+    l.bias.resize(widths[i + 1]);
+    for (Eigen::Index k = 0; k < l.bias.size(); ++k) l.bias[k] = 0.1f * n01(rng);
+    layers.push_back(std::move(l));
   }
-  f.SetAttr("/model", "dense_layers", names);
+  w.mlp = Mlp(std::move(layers));
+  SpanPredictor::Save(path, w, "model: span_predictor\n", 0);
 }
 
 }  // namespace foresight::testing

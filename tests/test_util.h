@@ -3,6 +3,9 @@
 /// a random SPAN artifact writer (torch-free) and the path of ../shared/data.
 
 #include <gtest/gtest.h>
+#include <sys/resource.h>
+
+#include <csignal>
 
 #include <Eigen/Core>
 #include <cstdint>
@@ -48,10 +51,36 @@ class TempDir {
   std::filesystem::path path_;
 };
 
+/// While alive, files of this process cannot grow beyond `bytes` (writes fail with EFBIG, as on a
+/// full disk); SIGXFSZ is ignored so the failure reaches the writer.
+class ScopedFileSizeLimit {
+ public:
+  explicit ScopedFileSizeLimit(rlim_t bytes) {
+    getrlimit(RLIMIT_FSIZE, &saved_);
+    previous_ = std::signal(SIGXFSZ, SIG_IGN);
+    rlimit limit = saved_;
+    limit.rlim_cur = bytes;
+    setrlimit(RLIMIT_FSIZE, &limit);
+  }
+  ~ScopedFileSizeLimit() {
+    setrlimit(RLIMIT_FSIZE, &saved_);
+    std::signal(SIGXFSZ, previous_);
+  }
+  ScopedFileSizeLimit(const ScopedFileSizeLimit&) = delete;
+  ScopedFileSizeLimit& operator=(const ScopedFileSizeLimit&) = delete;
+
+ private:
+  rlimit saved_{};
+  void (*previous_)(int) = nullptr;
+};
+
 /// Writes `text` to `path`.
 void WriteText(const std::string& path, const std::string& text);
 /// The whole text of `path` (an empty string when it cannot be read).
 std::string ReadText(const std::string& path);
+/// Replaces attribute `name` of `object` in an existing HDF5 file (edited-artifact tests).
+void OverwriteAttr(const std::string& path, const std::string& object, const std::string& name, std::int64_t value);
+void OverwriteAttr(const std::string& path, const std::string& object, const std::string& name, double value);
 /// Keeps the first `bytes` bytes of `path`.
 void Truncate(const std::string& path, std::size_t bytes);
 

@@ -1,8 +1,8 @@
 #include "training/directional_config.h"
 
 namespace foresight {
-namespace {
-void Validate(const DirectionalExperimentConfig& c, const std::string& source) {
+void DirectionalExperimentConfig::Validate(const std::string& source) const {
+  const DirectionalExperimentConfig& c = *this;
   FS_THROW_UNLESS(c.model == "directional", source, ": key 'model': value '", c.model, "' is not 'directional'");
   FS_THROW_UNLESS(c.data.format == DirectionalSource::kCrossing || !c.data.file.empty(), source,
                   ": key 'data.file' must name a data file when data.format is grid_csv or edinburgh");
@@ -18,20 +18,6 @@ void Validate(const DirectionalExperimentConfig& c, const std::string& source) {
                   ": keys 'eval.spatiotemporal' and 'eval.spatial' are both false: no network to train");
   FS_THROW_UNLESS(c.eval.max_folds <= c.eval.folds, source, ": key 'eval.max_folds' (", c.eval.max_folds,
                   ") must be <= eval.folds (", c.eval.folds, ")");
-}
-}  // namespace
-
-DirectionalExperimentConfig LoadDirectionalConfig(const std::string& path, const std::vector<std::string>& overrides) {
-  auto c = config::LoadFile<DirectionalExperimentConfig>(path, overrides);
-  Validate(c, path);
-  return c;
-}
-
-DirectionalExperimentConfig DirectionalConfigFromYaml(const std::string& yaml_text, const std::string& source,
-                                                      const std::vector<std::string>& overrides) {
-  auto c = config::FromYaml<DirectionalExperimentConfig>(config::ParseYaml(yaml_text, source), source, overrides);
-  Validate(c, source);
-  return c;
 }
 
 }  // namespace foresight

@@ -152,11 +152,9 @@ struct DirectionalExperimentConfig {
     a->Visit("train", &train, config::Range::Any(), "trainer");
     a->Visit("eval", &eval, config::Range::Any(), "cross-validated evaluation and plots");
   }
+  /// Rules across keys; errors name `source` and the key.
+  void Validate(const std::string& source) const;
 };
 
-/// Loads and validates (errors name the file and key).
-DirectionalExperimentConfig LoadDirectionalConfig(const std::string& path, const std::vector<std::string>& overrides);
-DirectionalExperimentConfig DirectionalConfigFromYaml(const std::string& yaml_text, const std::string& source,
-                                                      const std::vector<std::string>& overrides = {});
 
 }  // namespace foresight

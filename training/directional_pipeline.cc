@@ -111,12 +111,6 @@ DirectionalNet MakeNet(const DirectionalExperimentConfig& c, const DirectionalFe
   return DirectionalNet(v, f.cells_x * f.cells_y, c.network.components, c.network.Hidden(), c.network.max_kappa);
 }
 
-void WriteParam(h5::File* f, const std::string& name, const torch::Tensor& value) {
-  const auto t = value.detach().contiguous().to(torch::kFloat32);
-  std::vector<std::size_t> shape(t.sizes().begin(), t.sizes().end());
-  f->Write(name, t.data_ptr<float>(), shape);
-}
-
 /// Splits `samples` into (train, val) with a seeded val_fraction (both non-empty).
 std::pair<DirectionalSamples, DirectionalSamples> SplitVal(const DirectionalSamples& s, double val_fraction,
                                                            std::uint64_t seed) {
@@ -224,35 +218,23 @@ DirectionalSamples LoadDirectionalSamples(const DirectionalExperimentConfig& c) 
 void WriteDirectionalArtifact(DirectionalNetImpl& net, const DirectionalFeatureConfig& fc,
                               const std::string& config_yaml, std::int64_t seed, const std::string& path) {
   FS_THROW_UNLESS(!fc.auto_extent && !fc.auto_time_range, "WriteDirectionalArtifact: unresolved feature extent");
-  const std::string tmp = path + ".tmp";
-  {
-    h5::File f = h5::File::Create(tmp);
-    Artifact::WriteHeader(&f, kDirectionalModelType, config_yaml, seed);
-    f.SetAttr("/model", "variant", std::string(VariantName(net.variant())));
-    f.SetAttr("/model", "components", static_cast<std::int64_t>(net.components()));
-    f.SetAttr("/model", "hidden", static_cast<std::int64_t>(net.hidden()));
-    f.SetAttr("/model", "log_kappa_min", kDirectionalLogKappaMin);
-    f.SetAttr("/model", "log_kappa_max", std::log(net.max_kappa()));
-    const std::string g = "/model/features";
-    f.SetAttr(g, "x_min", fc.x_min);
-    f.SetAttr(g, "x_max", fc.x_max);
-    f.SetAttr(g, "y_min", fc.y_min);
-    f.SetAttr(g, "y_max", fc.y_max);
-    f.SetAttr(g, "cells_x", static_cast<std::int64_t>(fc.cells_x));
-    f.SetAttr(g, "cells_y", static_cast<std::int64_t>(fc.cells_y));
-    f.SetAttr(g, "length_scale", fc.length_scale);
-    f.SetAttr(g, "t_min", fc.t_min);
-    f.SetAttr(g, "t_max", fc.t_max);
-    f.SetAttr(g, "time_points", static_cast<std::int64_t>(fc.time_points));
-    f.SetAttr(g, "time_length_scale", fc.time_length_scale);
-    f.SetAttr(g, "cutoff", fc.cutoff);
-    for (const auto& item : net.named_parameters()) {
-      const std::string& key = item.key();
-      const auto dot = key.rfind('.');
-      WriteParam(&f, "/weights/" + key.substr(0, dot) + "/" + key.substr(dot + 1), item.value());
-    }
-  }
-  FS_THROW_UNLESS(std::rename(tmp.c_str(), path.c_str()) == 0, path, ": cannot move the artifact into place");
+  const auto params = net.named_parameters();
+  auto matrix = [&](const std::string& name) {
+    const torch::Tensor t = params[name].detach().contiguous().to(torch::kFloat32);
+    return Eigen::MatrixXf(Eigen::Map<const Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
+        t.data_ptr<float>(), t.size(0), t.size(1)));
+  };
+  auto vector = [&](const std::string& name) {
+    const torch::Tensor t = params[name].detach().contiguous().to(torch::kFloat32);
+    return Eigen::VectorXf(Eigen::Map<const Eigen::VectorXf>(t.data_ptr<float>(), t.size(0)));
+  };
+  Lstm lstm;
+  if (net.variant() == DirectionalVariant::kSpatiotemporal)
+    lstm = Lstm(LstmWeights{matrix("lstm.weight_ih_l0"), matrix("lstm.weight_hh_l0"), vector("lstm.bias_ih_l0"),
+                            vector("lstm.bias_hh_l0")});
+  DirectionalHeads heads{matrix("alpha.weight"), matrix("mu.weight"), matrix("kappa.weight"),
+                         vector("alpha.bias"), vector("mu.bias"), vector("kappa.bias")};
+  DirectionalMap(net.variant(), fc, std::move(lstm), std::move(heads), net.max_kappa()).Save(path, config_yaml, seed);
 }
 
 LoadedDirectionalNet LoadDirectionalNetFromArtifact(const std::string& path) {
@@ -403,14 +385,49 @@ std::string DirectionalEvalReport::BriefReport() const {
   return os.str();
 }
 
+namespace {
+/// The run's artifacts: fold 0's networks (trained on fold 0's training split). model.h5 is the
+/// spatiotemporal one, or the spatial one when only that was trained.
+void PublishFoldZero(const DirectionalExperimentConfig& c, const std::string& run_dir) {
+  if (c.eval.spatiotemporal)
+    fs::copy_file(run_dir + "/folds/0/spatiotemporal/model.h5", run_dir + "/model.h5",
+                  fs::copy_options::overwrite_existing);
+  if (c.eval.spatial)
+    fs::copy_file(run_dir + "/folds/0/spatial/model.h5",
+                  run_dir + (c.eval.spatiotemporal ? "/model_spatial.h5" : "/model.h5"),
+                  fs::copy_options::overwrite_existing);
+}
+}  // namespace
+
+std::string ExportDirectionalRun(const std::string& run_dir) {
+  const auto c = config::LoadExperimentConfig<DirectionalExperimentConfig>(run_dir + "/config.yaml");
+  const DirectionalSamples data = LoadDirectionalSamples(c);
+  const DirectionalFeatureConfig f = ResolveExtent(c.features, data.x, data.y, data.t);
+  std::vector<DirectionalVariant> variants;
+  if (c.eval.spatiotemporal) variants.push_back(DirectionalVariant::kSpatiotemporal);
+  if (c.eval.spatial) variants.push_back(DirectionalVariant::kSpatial);
+  const int folds = c.eval.max_folds > 0 ? c.eval.max_folds : c.eval.folds;
+  for (int k = 0; k < folds; ++k) {
+    for (const DirectionalVariant v : variants) {
+      const std::string dir = run_dir + "/folds/" + std::to_string(k) + "/" + VariantName(v);
+      const RunPaths run{dir};
+      const std::string ckpt = fs::exists(run.BestCheckpoint()) ? run.BestCheckpoint() : run.Checkpoint();
+      FS_THROW_UNLESS(fs::exists(ckpt), dir, ": no checkpoint to export (fold ", k, " is not trained yet; ",
+                      "continue with train --resume)");
+      DirectionalNet best = MakeNet(c, f, v);
+      LoadCheckpointModel(ckpt, best.ptr().get());
+      WriteDirectionalArtifact(*best, f, config::ToYaml(c), c.seed, dir + "/model.h5");
+      (void)DirectionalMap::Load(dir + "/model.h5");
+    }
+  }
+  PublishFoldZero(c, run_dir);
+  log::Info("exported ", folds, " folds x ", variants.size(), " networks; ", run_dir, "/model.h5 is fold 0's");
+  return run_dir + "/model.h5";
+}
+
 DirectionalRunResult RunDirectionalExperiment(const DirectionalExperimentConfig& c, const std::string& run_dir,
                                               bool resume, const TrainHooks& hooks) {
-  if (!resume) {
-    for (const char* name : {"folds", "model.h5", "eval.json"})
-      FS_THROW_UNLESS(!fs::exists(fs::path(run_dir) / name), run_dir, ": already holds a run (", name,
-                      "); continue it with --resume, or train into a new or empty --run-dir");
-  }
-  StartRunDirectory(run_dir, config::ToYaml(c), resume);
+  StartRunDirectory(run_dir, config::ToYaml(c), resume, kDirectionalRunRules);
   log::Info(resume ? "resuming" : "training", " directional maps in ", run_dir, " (seed ", c.seed, ")");
 
   const DirectionalSamples data = LoadDirectionalSamples(c);
@@ -455,15 +472,7 @@ DirectionalRunResult RunDirectionalExperiment(const DirectionalExperimentConfig&
     }
     ++report.folds_evaluated;
   }
-  // The run's artifacts: fold 0's networks (trained on fold 0's training split). model.h5 is the
-  // spatiotemporal one, or the spatial one when only that was trained.
-  if (c.eval.spatiotemporal)
-    fs::copy_file(run_dir + "/folds/0/spatiotemporal/model.h5", run_dir + "/model.h5",
-                  fs::copy_options::overwrite_existing);
-  if (c.eval.spatial)
-    fs::copy_file(run_dir + "/folds/0/spatial/model.h5",
-                  run_dir + (c.eval.spatiotemporal ? "/model_spatial.h5" : "/model.h5"),
-                  fs::copy_options::overwrite_existing);
+  PublishFoldZero(c, run_dir);
   std::ofstream(run_dir + "/eval.json") << report.ToJson();
   std::ofstream(run_dir + "/eval.csv") << report.ToCsv();
   if (c.eval.plots) {

@@ -19,6 +19,7 @@
 #include "inference/directional/directional_map.h"
 #include "models/directional/directional_net.h"
 #include "training/directional_config.h"
+#include "training/run_dir.h"
 #include "training/trainer.h"
 
 namespace foresight {
@@ -73,10 +74,17 @@ struct DirectionalRunResult {
   bool interrupted = false;
 };
 
+/// What shows a directional run in a directory (resume continues unfinished fold networks).
+inline const RunDirectoryRules kDirectionalRunRules{{"folds", "model.h5", "eval.json"}, true};
+
 /// The whole experiment into `run_dir` (see above). A fresh start refuses a directory that holds
 /// an earlier run. Empty or non-finite data is an Error naming the source.
 DirectionalRunResult RunDirectionalExperiment(const DirectionalExperimentConfig& config, const std::string& run_dir,
                                               bool resume, const TrainHooks& hooks = {});
+
+/// Rewrites every fold network's model.h5 from its best checkpoint and the run's model.h5 (fold 0).
+/// A fold without a checkpoint is an Error naming it. @return the run's artifact path.
+std::string ExportDirectionalRun(const std::string& run_dir);
 
 /// Evaluates the methods on one split (used by the experiment binary with its own folds):
 /// returns {method, AL, MRE} for spatiotemporal, spatial (optional), grid_um, grid_mm (+ dense).

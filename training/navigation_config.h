@@ -109,6 +109,13 @@ struct ClRrtStarConfig {
   }
 };
 
+/// The controllers a navigation experiment compares. Configs name them (`methods: [span, ...]`);
+/// ParseNavigationMethod is the one place a name becomes a method.
+enum class NavigationMethod { kSpan, kReactive, kClRrtStar };
+const char* MethodName(NavigationMethod method);
+/// The method called `name`; an unknown name is an Error naming `where` and the known names.
+NavigationMethod ParseNavigationMethod(const std::string& name, const std::string& where);
+
 struct NavigationVideoConfig {
   bool enabled = true;
   std::string method = "span";  ///< whose episode is filmed
@@ -152,7 +159,8 @@ struct NavigationExperimentConfig {
     a->Visit("map", &map, config::Range::Any(), "static occupancy map");
     a->Visit("methods", &methods, config::Range::Any(), "controllers compared: span | reactive | cl_rrt_star");
     a->Visit("episodes", &episodes, config::Range::Closed(1, 100000), "episodes per method");
-    a->Visit("max_time", &max_time, config::Range::Positive(), "time limit of an episode (s)");
+    // At most a day: the cycle count max_time / dt must stay far inside an int.
+    a->Visit("max_time", &max_time, config::Range::OpenClosed(0, 86400), "time limit of an episode (s)");
     a->Visit("dt", &dt, config::Range::Closed(0.01, 1.0), "control period and simulation step (s)");
     a->Visit("goal_tolerance", &goal_tolerance, config::Range::Positive(), "goal reached within this distance (m)");
     a->Visit("sensing_range", &sensing_range, config::Range::Positive(), "observation range of pedestrians (m)");
@@ -163,12 +171,12 @@ struct NavigationExperimentConfig {
     a->Visit("cl_rrt_star", &cl_rrt_star, config::Range::Any(), "CL-RRT* baseline");
     a->Visit("video", &video, config::Range::Any(), "video of one episode");
   }
+  /// Scenario and method checks; errors name `path` and the key.
+  void Validate(const std::string& path) const;
+  /// `methods` as methods (Validate has checked the names).
+  std::vector<NavigationMethod> Methods() const;
+  bool Uses(NavigationMethod method) const;
 };
 
-/// Loads and validates a navigation config (strict YAML + scenario and method checks).
-NavigationExperimentConfig LoadNavigationConfig(const std::string& path, const std::vector<std::string>& overrides = {});
-/// The same from YAML text (`source` names it in errors), e.g. the embedded default.
-NavigationExperimentConfig NavigationConfigFromYaml(const std::string& yaml_text, const std::string& source,
-                                                    const std::vector<std::string>& overrides = {});
 
 }  // namespace foresight

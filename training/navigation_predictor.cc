@@ -49,8 +49,8 @@ std::string EnsureNavigationPredictor(const NavigationExperimentConfig& c, const
                                          "data.seconds_per_step=" + std::to_string(stored.seconds_per_step)};
   const SpanExperimentConfig span =
       p.train_config == "default"
-          ? SpanConfigFromYaml(embedded_default, "<embedded configs/navigation/predictor.yaml>", data)
-          : LoadSpanConfig(p.train_config, data);
+          ? config::ExperimentConfigFromYaml<SpanExperimentConfig>(embedded_default, "<embedded configs/navigation/predictor.yaml>", data)
+          : config::LoadExperimentConfig<SpanExperimentConfig>(p.train_config, data);
   const bool resume = fs::exists(run_dir + "/checkpoints/last.pt");
   std::cout << "training the SPAN predictor into " << run_dir << (resume ? " (resuming)" : "") << "\n";
   TrainingSummary s;

@@ -32,7 +32,7 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 bool UsesPredictor(const NavigationExperimentConfig& c) {
-  return std::find(c.methods.begin(), c.methods.end(), "span") != c.methods.end();
+  return c.Uses(NavigationMethod::kSpan);
 }
 
 /// Fast-BHM (or grid) map of the scenario's obstacles, saved as an artifact at `path`.
@@ -144,7 +144,7 @@ double Percentile(std::vector<double> v, double q) {
 }
 
 std::unique_ptr<nav::NavigationController> MakeController(const NavigationExperimentConfig& c,
-                                                          const NavigationResources& res, const std::string& method,
+                                                          const NavigationResources& res, NavigationMethod method,
                                                           std::uint64_t seed) {
   nav::ControlLimits limits{-c.v_max, c.v_max, c.omega_max};
   nav::SpanControllerOptions o = c.span.options;
@@ -152,17 +152,21 @@ std::unique_ptr<nav::NavigationController> MakeController(const NavigationExperi
   o.robot_radius = c.scenario.robot_radius;
   o.pedestrian_radius = c.scenario.pedestrian_radius;
   o.limits = limits;
-  if (method == "span") return std::make_unique<nav::SpanController>(res.predictor.get(), res.field.get(), o);
-  if (method == "reactive") return std::make_unique<nav::ReactiveController>(res.field.get(), o, c.reactive.heading_weight);
-  if (method == "cl_rrt_star") {
-    nav::ClRrtStarOptions r = c.cl_rrt_star.options;
-    r.robot_radius = o.robot_radius;
-    r.pedestrian_radius = o.pedestrian_radius;
-    r.epsilon = o.epsilon;
-    r.limits = limits;
-    return std::make_unique<nav::ClRrtStarController>(res.field.get(), res.raster.extent, r, seed);
+  switch (method) {
+    case NavigationMethod::kSpan:
+      return std::make_unique<nav::SpanController>(res.predictor.get(), res.field.get(), o);
+    case NavigationMethod::kReactive:
+      return std::make_unique<nav::ReactiveController>(res.field.get(), o, c.reactive.heading_weight);
+    case NavigationMethod::kClRrtStar: {
+      nav::ClRrtStarOptions r = c.cl_rrt_star.options;
+      r.robot_radius = o.robot_radius;
+      r.pedestrian_radius = o.pedestrian_radius;
+      r.epsilon = o.epsilon;
+      r.limits = limits;
+      return std::make_unique<nav::ClRrtStarController>(res.field.get(), res.raster.extent, r, seed);
+    }
   }
-  throw Error("methods: unknown method '" + method + "' (expected span, reactive or cl_rrt_star)");
+  Fail("navigation: method ", static_cast<int>(method), " has no controller");
 }
 
 std::string Json(double v) {
@@ -181,11 +185,7 @@ double NavigationResources::StaticDistance(double x, double y) const {
 }
 
 NavigationResources PrepareNavigation(const NavigationExperimentConfig& c, const std::string& out_dir) {
-  for (const std::string& m : c.methods)
-    FS_THROW_UNLESS(m == "span" || m == "reactive" || m == "cl_rrt_star", "methods: unknown method '", m,
-                    "' (expected span, reactive or cl_rrt_star)");
-  FS_THROW_UNLESS(!c.methods.empty(), "methods: empty list");
-  c.scenario.Validate("scenario");
+  c.Validate("navigation config");  // configs built in code get the same checks as loaded ones
   NavigationResources res;
   res.raster = ScenarioOccupancy(c.scenario, 0.05);
   res.static_distance = DistanceToObstacles(res.raster);
@@ -209,9 +209,9 @@ NavigationResources PrepareNavigation(const NavigationExperimentConfig& c, const
 }
 
 EpisodeResult RunEpisode(const NavigationExperimentConfig& c, const NavigationResources& res,
-                         const std::string& method, int episode, EpisodeRecorder* recorder) {
+                         NavigationMethod method, int episode, EpisodeRecorder* recorder) {
   EpisodeResult out;
-  out.method = method;
+  out.method = MethodName(method);
   out.episode = episode;
   out.seed = static_cast<std::uint64_t>(c.seed) + static_cast<std::uint64_t>(episode);
   std::unique_ptr<Crowd> crowd = MakeCrowd(c.scenario, out.seed);
@@ -279,12 +279,16 @@ EpisodeResult RunEpisode(const NavigationExperimentConfig& c, const NavigationRe
     nav::ControlOutcome u;
     try {
       u = controller->Compute(in);
-    } catch (const std::exception&) {  // controllers do not throw; count it if one ever does
-      u = nav::ControlOutcome{};
-      u.solved = false;
+    } catch (const std::exception& e) {  // controllers do not throw; count it if one ever does
+      u = nav::ControlOutcome::Stop(nav::ControlStatus::kError, e.what());
     }
     out.cycle_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-    out.solve_failures += u.solved ? 0 : 1;
+    if (!u.solved()) {
+      if (out.solve_failures == 0)
+        log::Info(out.method, " episode ", episode, ": first unsolved cycle at t = ", t, " s: ",
+                  nav::ToString(u.status), " (", u.message, ")");
+      ++out.solve_failures;
+    }
     const nav::Control cmd = limits.Clamp(u.command);
     const nav::UnicycleState next = nav::EulerStep(s, cmd, c.dt);
     RobotAgent robot;
@@ -306,11 +310,10 @@ EpisodeResult RunEpisode(const NavigationExperimentConfig& c, const NavigationRe
     if (clear < 0) out.doc += c.dt;
     min_clear = std::min(min_clear, clear);
     if (recorder) try {
-      const auto* span = dynamic_cast<const nav::SpanController*>(controller.get());
       Eigen::Matrix2Xd so_far(2, static_cast<Eigen::Index>(path.size()));
       for (std::size_t i = 0; i < path.size(); ++i) so_far.col(static_cast<Eigen::Index>(i)) = path[i];
-      recorder->Frame(t, s, goal, crowd->agents(), span ? &span->predictions() : nullptr,
-                      span ? span->forecast().pedestrians() : 0, so_far);
+      recorder->Frame(t, s, goal, crowd->agents(), controller->Predictions(), controller->PredictedPedestrians(),
+                      so_far);
     } catch (const std::exception& e) {  // a video problem must not lose the episode
       log::Warn("video: ", e.what(), "; no more frames");
       recorder = nullptr;
@@ -403,17 +406,17 @@ std::vector<MethodSummary> RunNavigation(const NavigationExperimentConfig& c, co
   std::vector<EpisodeResult> results;
   std::ofstream csv(out_dir + "/episodes.csv");
   csv << "method,episode,seed,reached,ttg,doc,doc_static,min_clearance,path_length,cycles,solve_failures,cycle_ms_median,cycle_ms_p99\n";
-  for (const std::string& method : c.methods) {
+  for (const NavigationMethod method : c.Methods()) {
     for (int e = 0; e < n; ++e) {
       std::unique_ptr<VideoRecorder> video;
-      if (c.video.enabled && method == c.video.method && e == c.video.episode)
+      if (c.video.enabled && MethodName(method) == c.video.method && e == c.video.episode)
         video = std::make_unique<VideoRecorder>(out_dir + "/episode.avi", res.raster, c.video, c.dt, c.seed);
       EpisodeResult r = RunEpisode(c, res, method, e, video.get());
       csv << r.method << ',' << r.episode << ',' << r.seed << ',' << r.reached << ',' << r.ttg << ',' << r.doc << ',' << r.doc_static << ','
           << r.min_clearance << ',' << r.path_length << ',' << r.cycles << ',' << r.solve_failures << ','
           << Percentile(r.cycle_ms, 0.5) << ',' << Percentile(r.cycle_ms, 0.99) << '\n';
       csv.flush();
-      log::Info(method, " episode ", e, ": ", r.reached ? "reached" : "not reached", " ttg ", r.ttg, " s, doc ", r.doc,
+      log::Info(r.method, " episode ", e, ": ", r.reached ? "reached" : "not reached", " ttg ", r.ttg, " s, doc ", r.doc,
                 " s, min clearance ", r.min_clearance, " m, cycle median ", Percentile(r.cycle_ms, 0.5), " ms");
       results.push_back(std::move(r));
     }

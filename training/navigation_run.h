@@ -15,6 +15,7 @@
 #include "inference/navigation/static_clearance.h"
 #include "inference/prediction/span_predictor.h"
 #include "training/navigation_config.h"
+#include "training/run_dir.h"
 
 namespace foresight {
 
@@ -61,7 +62,7 @@ class EpisodeRecorder {
 
 /// Runs one episode of `method` (span | reactive | cl_rrt_star). Never throws from the control loop.
 EpisodeResult RunEpisode(const NavigationExperimentConfig& config, const NavigationResources& resources,
-                         const std::string& method, int episode, EpisodeRecorder* recorder = nullptr);
+                         NavigationMethod method, int episode, EpisodeRecorder* recorder = nullptr);
 
 struct MethodSummary {
   std::string method;
@@ -75,6 +76,9 @@ struct MethodSummary {
   int solve_failures = 0;
 };
 MethodSummary Summarise(const std::string& method, const std::vector<EpisodeResult>& results);
+
+/// What shows a navigation run in a directory (episodes run in one pass: no resume).
+inline const RunDirectoryRules kNavigationRunRules{{"summary.json", "episodes.csv"}, false};
 
 /// Runs every method for `episodes` episodes (config.episodes when <= 0) into `out_dir`.
 /// @return the summaries, in config.methods order.

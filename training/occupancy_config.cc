@@ -3,8 +3,8 @@
 #include <algorithm>
 
 namespace foresight {
-namespace {
-void Validate(const OccupancyExperimentConfig& c, const std::string& source) {
+void OccupancyExperimentConfig::Validate(const std::string& source) const {
+  const OccupancyExperimentConfig& c = *this;
   static const std::vector<std::string> kModels{"occupancy.fast_bhm", "occupancy.bhm", "occupancy.hilbert",
                                                 "occupancy.grid", "occupancy.fusion"};
   FS_THROW_UNLESS(std::find(kModels.begin(), kModels.end(), c.model) != kModels.end(), source,
@@ -18,20 +18,6 @@ void Validate(const OccupancyExperimentConfig& c, const std::string& source) {
                   ": keys 'features.x_min/x_max/y_min/y_max' give an empty extent");
   FS_THROW_UNLESS(c.grid.x_max > c.grid.x_min && c.grid.y_max > c.grid.y_min, source,
                   ": keys 'grid.x_min/x_max/y_min/y_max' give an empty extent");
-}
-}  // namespace
-
-OccupancyExperimentConfig LoadOccupancyConfig(const std::string& path, const std::vector<std::string>& overrides) {
-  auto c = config::LoadFile<OccupancyExperimentConfig>(path, overrides);
-  Validate(c, path);
-  return c;
-}
-
-OccupancyExperimentConfig OccupancyConfigFromYaml(const std::string& yaml_text, const std::string& source,
-                                                  const std::vector<std::string>& overrides) {
-  auto c = config::FromYaml<OccupancyExperimentConfig>(config::ParseYaml(yaml_text, source), source, overrides);
-  Validate(c, source);
-  return c;
 }
 
 }  // namespace foresight

@@ -111,10 +111,9 @@ struct OccupancyExperimentConfig {
                  "floating-point type of the stored weights");
     a->Visit("eval", &eval, config::Range::Any(), "evaluation outputs");
   }
+  /// Rules across keys; errors name `source` and the key.
+  void Validate(const std::string& source) const;
 };
 
-OccupancyExperimentConfig LoadOccupancyConfig(const std::string& path, const std::vector<std::string>& overrides);
-OccupancyExperimentConfig OccupancyConfigFromYaml(const std::string& yaml_text, const std::string& source,
-                                                  const std::vector<std::string>& overrides = {});
 
 }  // namespace foresight

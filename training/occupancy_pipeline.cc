@@ -210,53 +210,67 @@ FusionResult RunFusion(const OccupancyExperimentConfig& c, const OccupancyData& 
   return r;
 }
 
-std::string RunOccupancyExperiment(const OccupancyExperimentConfig& c, const std::string& config_yaml,
-                                   const std::string& run_dir) {
-  fs::create_directories(run_dir + "/plots");
-  std::ofstream(run_dir + "/config.yaml") << config_yaml;
+void TrainOccupancyRun(const OccupancyExperimentConfig& c, const std::string& run_dir) {
+  StartRunDirectory(run_dir, config::ToYaml(c), false, kOccupancyRunRules);
   const OccupancyData data = LoadOccupancyData(c);
   const std::string artifact = run_dir + "/model.h5";
+  const auto start = std::chrono::steady_clock::now();
+  if (c.model == "occupancy.fusion") {
+    const FusionResult r = RunFusion(c, data);
+    SaveOccupancyMap(*r.single, run_dir + "/single.h5", c);
+    SaveOccupancyMap(*r.fuse_once, run_dir + "/fuse_once.h5", c);
+    SaveOccupancyMap(*r.repeated, artifact, c);
+    std::ofstream out(run_dir + "/training_summary.json");
+    out << "{\"seconds\": " << Json(Seconds(start)) << ", \"robots\": " << r.robot_scans.size()
+        << ", \"robot_scans\": [";
+    for (std::size_t i = 0; i < r.robot_scans.size(); ++i) out << (i ? ", " : "") << r.robot_scans[i];
+    out << "], \"merges\": " << c.fusion.merges << "}\n";
+  } else {
+    double secs = 0;
+    const std::unique_ptr<OccupancyMap> map = TrainOccupancyMap(c.model, c, data, &secs);
+    SaveOccupancyMap(*map, artifact, c);
+    std::ofstream(run_dir + "/training_summary.json") << "{\"seconds\": " << Json(secs) << "}\n";
+    log::Info(c.model, ": trained in ", secs, " s");
+  }
+}
+
+std::string EvaluateOccupancyRun(const OccupancyExperimentConfig& c, const std::string& run_dir) {
+  const std::string artifact = run_dir + "/model.h5";
+  FS_THROW_UNLESS(fs::exists(artifact), artifact, ": not found (train the map first)");
+  const OccupancyData data = LoadOccupancyData(c);
+  fs::create_directories(run_dir + "/plots");
   std::ostringstream json;
   json << "{\n  \"model\": \"" << c.model << "\",\n  \"train_scans\": " << data.train_scans.size()
        << ",\n  \"test_scans\": " << data.test_scans.size() << ",\n  \"train_points\": " << data.train.size()
        << ",\n  \"test_points\": " << data.test.size() << ",\n";
   if (c.model == "occupancy.fusion") {
-    const auto start = std::chrono::steady_clock::now();
-    const FusionResult r = RunFusion(c, data);
-    const double secs = Seconds(start);
-    SaveOccupancyMap(*r.repeated, artifact, c);
-    SaveOccupancyMap(*r.fuse_once, run_dir + "/fuse_once.h5", c);
-    SaveOccupancyMap(*r.single, run_dir + "/single.h5", c);
-    const BinaryMetrics single = EvaluateMap(*r.single, data.test);
-    const BinaryMetrics once = EvaluateMap(*r.fuse_once, data.test);
-    const BinaryMetrics repeated = EvaluateMap(*r.repeated, data.test);
-    json << "  \"robots\": " << r.robot_scans.size() << ",\n  \"robot_scans\": [";
-    for (std::size_t i = 0; i < r.robot_scans.size(); ++i) json << (i ? ", " : "") << r.robot_scans[i];
-    json << "],\n  \"merges\": " << c.fusion.merges << ",\n  \"auc_single\": " << Json(single.auc)
+    // Evaluates what ships: the maps as loaded from their artifacts.
+    const auto single_map = LoadOccupancyMap(run_dir + "/single.h5");
+    const auto once_map = LoadOccupancyMap(run_dir + "/fuse_once.h5");
+    const auto repeated_map = LoadOccupancyMap(artifact);
+    const BinaryMetrics single = EvaluateMap(*single_map, data.test);
+    const BinaryMetrics once = EvaluateMap(*once_map, data.test);
+    const BinaryMetrics repeated = EvaluateMap(*repeated_map, data.test);
+    json << "  \"merges\": " << c.fusion.merges << ",\n  \"auc_single\": " << Json(single.auc)
          << ",\n  \"auc_fuse_once\": " << Json(once.auc) << ",\n  \"auc_repeated\": " << Json(repeated.auc)
          << ",\n  \"single\": " << MetricsJson(single) << ",\n  \"fuse_once\": " << MetricsJson(once)
          << ",\n  \"repeated\": " << MetricsJson(repeated) << ",\n  \"auc\": " << Json(repeated.auc)
          << ",\n  \"precision\": " << Json(repeated.precision) << ",\n  \"recall\": " << Json(repeated.recall)
-         << ",\n  \"artifact_bytes\": " << fs::file_size(artifact) << ",\n  \"seconds\": " << Json(secs) << "\n}\n";
-    WriteMapPanels({{"single map", r.single.get()}, {"fused once", r.fuse_once.get()},
-                    {"repeatedly fused", r.repeated.get()}},
+         << ",\n  \"artifact_bytes\": " << fs::file_size(artifact) << "\n}\n";
+    WriteMapPanels({{"single map", single_map.get()}, {"fused once", once_map.get()},
+                    {"repeatedly fused", repeated_map.get()}},
                    c.eval.plot_resolution, run_dir + "/plots/map.png");
     log::Info("fusion AUC: single ", single.auc, ", fuse once ", once.auc, ", repeated ", repeated.auc);
   } else {
-    double secs = 0;
-    const std::unique_ptr<OccupancyMap> map = TrainOccupancyMap(c.model, c, data, &secs);
-    SaveOccupancyMap(*map, artifact, c);
     const std::unique_ptr<OccupancyMap> loaded = LoadOccupancyMap(artifact);  // evaluate what ships
     const BinaryMetrics m = EvaluateMap(*loaded, data.test);
     json << "  \"auc\": " << Json(m.auc) << ",\n  \"precision\": " << Json(m.precision)
-         << ",\n  \"recall\": " << Json(m.recall) << ",\n  \"artifact_bytes\": " << fs::file_size(artifact)
-         << ",\n  \"train_seconds\": " << Json(secs);
+         << ",\n  \"recall\": " << Json(m.recall) << ",\n  \"artifact_bytes\": " << fs::file_size(artifact);
     if (data.val.size() > 0) json << ",\n  \"val\": " << MetricsJson(EvaluateMap(*loaded, data.val));
     json << "\n}\n";
     WriteRoc(*loaded, data.test, c.eval.roc_points, run_dir + "/roc.csv");
     WriteMapPanels({{c.model, loaded.get()}}, c.eval.plot_resolution, run_dir + "/plots/map.png");
-    log::Info(c.model, ": AUC ", m.auc, ", precision ", m.precision, ", recall ", m.recall, " (trained in ",
-              secs, " s)");
+    log::Info(c.model, ": AUC ", m.auc, ", precision ", m.precision, ", recall ", m.recall);
   }
   std::ofstream(run_dir + "/eval.json") << json.str();
   return json.str();

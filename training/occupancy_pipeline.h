@@ -13,6 +13,7 @@
 #include "datasets/occupancy_points.h"
 #include "inference/mapping/occupancy_map.h"
 #include "training/occupancy_config.h"
+#include "training/run_dir.h"
 
 namespace foresight {
 
@@ -47,9 +48,15 @@ struct FusionResult {
 };
 FusionResult RunFusion(const OccupancyExperimentConfig& config, const OccupancyData& data);
 
-/// The whole run: train, export RUN_DIR/model.h5, evaluate into RUN_DIR/eval.json, roc.csv and
-/// plots/map.png. Returns the eval.json text.
-std::string RunOccupancyExperiment(const OccupancyExperimentConfig& config, const std::string& config_yaml,
-                                   const std::string& run_dir);
+/// What shows an occupancy run in a directory (maps train in one pass: no resume).
+inline const RunDirectoryRules kOccupancyRunRules{{"model.h5", "eval.json"}, false};
+
+/// Trains the map (or the fusion experiment) into RUN_DIR: model.h5 (the fused map for
+/// occupancy.fusion, with single.h5 and fuse_once.h5), training_summary.json (seconds).
+void TrainOccupancyRun(const OccupancyExperimentConfig& config, const std::string& run_dir);
+
+/// Evaluates the run's maps as loaded from their artifacts on the held-out scans: writes
+/// eval.json, roc.csv (single maps) and plots/map.png. @return the eval.json text.
+std::string EvaluateOccupancyRun(const OccupancyExperimentConfig& config, const std::string& run_dir);
 
 }  // namespace foresight

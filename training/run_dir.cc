@@ -8,6 +8,7 @@
 #include "core/log.h"
 
 namespace foresight {
+namespace fs = std::filesystem;
 
 std::string ReadText(const std::string& path) {
   std::ifstream in(path);
@@ -16,16 +17,28 @@ std::string ReadText(const std::string& path) {
   return ss.str();
 }
 
-void StartRunDirectory(const std::string& run_dir, const std::string& resolved_yaml, bool resume) {
-  std::filesystem::create_directories(run_dir);
+void StartRunDirectory(const std::string& run_dir, const std::string& resolved_yaml, bool resume,
+                       const RunDirectoryRules& rules) {
+  FS_THROW_UNLESS(!resume || rules.resumable, "--resume: this kind runs in one pass and cannot be continued; "
+                  "run it again into a new or empty --run-dir");
   const std::string config_path = run_dir + "/config.yaml";
   if (resume) {
-    FS_THROW_UNLESS(std::filesystem::exists(config_path), run_dir, ": no config.yaml to resume from");
+    FS_THROW_UNLESS(fs::exists(config_path), run_dir, ": no config.yaml to resume from");
     FS_THROW_UNLESS(ReadText(config_path) == resolved_yaml, config_path,
                     ": the resolved config differs from the one this run started with; "
                     "resume with the same config and overrides");
   } else {
-    std::ofstream(config_path) << resolved_yaml;
+    for (const std::string& marker : rules.markers) {
+      const fs::path p = fs::path(run_dir) / marker;
+      const bool present = fs::is_directory(p) ? !fs::is_empty(p) : fs::exists(p);
+      FS_THROW_UNLESS(!present, run_dir, ": already holds a run (", marker, "); ",
+                      rules.resumable ? "continue it with --resume, or " : "", "use a new or empty --run-dir");
+    }
+    fs::create_directories(run_dir);
+    std::ofstream out(config_path);
+    out << resolved_yaml;
+    out.close();
+    FS_THROW_UNLESS(out.good(), config_path, ": cannot write the resolved config");
   }
   log::SetFile(run_dir + "/log.txt");
 }

@@ -1,8 +1,9 @@
 #include "training/span_config.h"
 
 namespace foresight {
-namespace {
-void Validate(const SpanExperimentConfig& c, const std::string& source) {
+
+void SpanExperimentConfig::Validate(const std::string& source) const {
+  const SpanExperimentConfig& c = *this;
   FS_THROW_UNLESS(c.model == "span_predictor", source, ": key 'model': value '", c.model,
                   "' is not 'span_predictor'");
   FS_THROW_UNLESS(c.data.synthetic.speed_max >= c.data.synthetic.speed_min, source,
@@ -15,20 +16,6 @@ void Validate(const SpanExperimentConfig& c, const std::string& source) {
                       c.data.format != TrackFormat::kSynthetic,
                   source, ": key 'data.synthetic.min_steps' must be >= windows.observed + windows.predicted");
   FS_THROW_UNLESS(!c.network.hidden.empty(), source, ": key 'network.hidden' must list at least one layer");
-}
-}  // namespace
-
-SpanExperimentConfig LoadSpanConfig(const std::string& path, const std::vector<std::string>& overrides) {
-  auto c = config::LoadFile<SpanExperimentConfig>(path, overrides);
-  Validate(c, path);
-  return c;
-}
-
-SpanExperimentConfig SpanConfigFromYaml(const std::string& yaml_text, const std::string& source,
-                                        const std::vector<std::string>& overrides) {
-  auto c = config::FromYaml<SpanExperimentConfig>(config::ParseYaml(yaml_text, source), source, overrides);
-  Validate(c, source);
-  return c;
 }
 
 }  // namespace foresight

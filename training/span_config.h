@@ -50,11 +50,9 @@ struct SpanExperimentConfig {
     a->Visit("train", &train, config::Range::Any(), "trainer");
     a->Visit("eval", &eval, config::Range::Any(), "evaluation");
   }
+  /// Rules across keys; errors name `source` and the key.
+  void Validate(const std::string& source) const;
 };
 
-/// Loads and validates (errors name the file and key).
-SpanExperimentConfig LoadSpanConfig(const std::string& path, const std::vector<std::string>& overrides);
-SpanExperimentConfig SpanConfigFromYaml(const std::string& yaml_text, const std::string& source,
-                                        const std::vector<std::string>& overrides = {});
 
 }  // namespace foresight

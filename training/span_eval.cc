@@ -101,7 +101,7 @@ std::string FirstDifference(const YAML::Node& trained, const YAML::Node& given, 
 /// (data.root, where the files are, may differ).
 void CheckSameDataAsTraining(const SpanExperimentConfig& config, const std::string& artifact) {
   const SpanExperimentConfig trained =
-      SpanConfigFromYaml(Artifact::Open(artifact, kSpanModelType).config_yaml(), artifact + ":/config");
+      config::ExperimentConfigFromYaml<SpanExperimentConfig>(Artifact::Open(artifact, kSpanModelType).config_yaml(), artifact + ":/config");
   const auto tree = [](SpanExperimentConfig c) {
     c.data.root.clear();
     return config::ParseYaml(config::ToYaml(c), "resolved config");

@@ -55,9 +55,10 @@ Normalisation FitNormalisation(const Eigen::MatrixXd& x) {
 }
 
 void WriteNormalisation(const std::string& path, const Normalisation& n) {
-  h5::File f = h5::File::Create(path);
-  f.WriteMatrix("/input_mean", n.mean);
-  f.WriteMatrix("/input_std", n.std);
+  h5::WriteAtomically(path, [&](h5::File* f) {
+    f->WriteMatrix("/input_mean", n.mean);
+    f->WriteMatrix("/input_std", n.std);
+  });
 }
 
 Normalisation ReadNormalisation(const std::string& path) {
@@ -98,25 +99,11 @@ class SpanTask : public TrainingTask {
   torch::Tensor x_train_, w_train_, x_val_, w_val_;
 };
 
-/// The file of `run_dir` that shows it holds a run a fresh start would mix with, or "".
-/// A metrics.csv without checkpoints (a run killed in epoch 1) holds nothing to resume: a fresh
-/// start replaces it.
-std::string PreviousRunFile(const std::string& run_dir) {
-  const std::string checkpoints = run_dir + "/checkpoints";
-  if (fs::is_directory(checkpoints) && !fs::is_empty(checkpoints)) return "checkpoints/";
-  for (const char* name : {"model.h5", "eval.json"})
-    if (fs::exists(run_dir + "/" + name)) return name;
-  return "";
-}
-
 }  // namespace
 
 TrainingSummary TrainSpan(const SpanExperimentConfig& c, const std::string& run_dir, bool resume,
                           const TrainHooks& hooks) {
-  const std::string previous = resume ? "" : PreviousRunFile(run_dir);
-  FS_THROW_UNLESS(previous.empty(), run_dir, ": already holds a run (", previous,
-                  "); continue it with --resume, or train into a new or empty --run-dir");
-  StartRunDirectory(run_dir, config::ToYaml(c), resume);
+  StartRunDirectory(run_dir, config::ToYaml(c), resume, kSpanRunRules);
   log::Info(resume ? "resuming" : "training", " span_predictor in ", run_dir, " (seed ", c.seed, ")");
 
   const TrackSplit split = LoadPedestrianSplits(c.data, static_cast<std::uint64_t>(c.seed));
@@ -151,6 +138,24 @@ TrainingSummary TrainSpan(const SpanExperimentConfig& c, const std::string& run_
   return Train(&task, c.train, RunPaths{run_dir}, static_cast<std::uint64_t>(c.seed), resume, hooks);
 }
 
+namespace {
+/// The engine's dense layers from the network's `names[i].weight` / `.bias` parameters (float).
+Mlp ToEngineMlp(torch::nn::Module& net, const std::vector<std::string>& names) {
+  const auto params = net.named_parameters();
+  std::vector<DenseLayer> layers;
+  for (const std::string& name : names) {
+    const torch::Tensor w = params[name + ".weight"].detach().contiguous().to(torch::kFloat32);
+    const torch::Tensor b = params[name + ".bias"].detach().contiguous().to(torch::kFloat32);
+    DenseLayer l;
+    l.weight = Eigen::Map<const Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
+        w.data_ptr<float>(), w.size(0), w.size(1));
+    l.bias = Eigen::Map<const Eigen::VectorXf>(b.data_ptr<float>(), b.size(0));
+    layers.push_back(std::move(l));
+  }
+  return Mlp(std::move(layers));
+}
+}  // namespace
+
 void WriteSpanArtifact(const SpanExperimentConfig& c, const std::string& checkpoint,
                        const std::string& normalisation_file, const std::string& artifact_path) {
   const HeadLayout layout = LayoutOf(c);
@@ -159,42 +164,26 @@ void WriteSpanArtifact(const SpanExperimentConfig& c, const std::string& checkpo
   const Normalisation norm = ReadNormalisation(normalisation_file);
   const double dt = SecondsPerStep(c.data);
   const TimeBasis basis = MakeFutureBasis(c.basis, c.windows.predicted, dt);
-  const std::string tmp = artifact_path + ".tmp";
-  {
-    h5::File f = h5::File::Create(tmp);
-    Artifact::WriteHeader(&f, kSpanModelType, config::ToYaml(c), c.seed);
-    f.SetAttr("/model", "observed", static_cast<std::int64_t>(c.windows.observed));
-    f.SetAttr("/model", "predicted", static_cast<std::int64_t>(c.windows.predicted));
-    f.SetAttr("/model", "seconds_per_step", dt);
-    f.SetAttr("/model", "rotate_to_heading", static_cast<std::int64_t>(c.network.rotate_to_heading));
-    f.SetAttr("/model", "residual_to_constant_velocity",
-              static_cast<std::int64_t>(c.network.residual_to_constant_velocity));
-    f.SetAttr("/model", "basis_size", static_cast<std::int64_t>(layout.basis));
-    f.SetAttr("/model", "components", static_cast<std::int64_t>(layout.components));
-    f.SetAttr("/model", "u_param", std::string(UParamName(layout.u_param)));
-    f.SetAttr("/model", "basis_gamma", basis.gamma());
-    f.WriteMatrix("/model/basis_centres", basis.centres());
-    f.WriteMatrix("/normalisation/input_mean", norm.mean);
-    f.WriteMatrix("/normalisation/input_std", norm.std);
-    std::string names;
-    for (const auto& name : net->DenseLayerNames()) names += (names.empty() ? "" : ",") + name;
-    f.SetAttr("/model", "dense_layers", names);
-    for (const auto& item : net->named_parameters()) {
-      const auto t = item.value().detach().contiguous().to(torch::kFloat32);
-      std::vector<std::size_t> shape(t.sizes().begin(), t.sizes().end());
-      f.Write("/weights/" + item.key().substr(0, item.key().rfind('.')) + "/" +
-                  item.key().substr(item.key().rfind('.') + 1),
-              t.data_ptr<float>(), shape);
-    }
-  }
-  FS_THROW_UNLESS(std::rename(tmp.c_str(), artifact_path.c_str()) == 0, artifact_path,
-                  ": cannot move the artifact into place");
+  SpanPredictorWeights w;
+  w.observed = c.windows.observed;
+  w.predicted = c.windows.predicted;
+  w.seconds_per_step = dt;
+  w.rotate_to_heading = c.network.rotate_to_heading;
+  w.residual_to_constant_velocity = c.network.residual_to_constant_velocity;
+  w.layout = layout;
+  w.basis_centres = basis.centres();
+  w.basis_gamma = basis.gamma();
+  w.input_mean = norm.mean;
+  w.input_std = norm.std;
+  w.layer_names = net->DenseLayerNames();
+  w.mlp = ToEngineMlp(*net, w.layer_names);
+  SpanPredictor::Save(artifact_path, w, config::ToYaml(c), c.seed);
 }
 
 std::string ExportSpan(const std::string& run_dir) {
   const std::string config_path = run_dir + "/config.yaml";
   FS_THROW_UNLESS(fs::exists(config_path), run_dir, ": not a run directory (no config.yaml)");
-  const SpanExperimentConfig c = LoadSpanConfig(config_path, {});
+  const SpanExperimentConfig c = config::LoadExperimentConfig<SpanExperimentConfig>(config_path, {});
   RunPaths run{run_dir};
   const std::string ckpt = fs::exists(run.BestCheckpoint()) ? run.BestCheckpoint() : run.Checkpoint();
   FS_THROW_UNLESS(fs::exists(ckpt), run_dir, ": no checkpoint to export (train first)");

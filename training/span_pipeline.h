@@ -6,10 +6,15 @@
 
 #include <string>
 
+#include "training/run_dir.h"
 #include "training/span_config.h"
 #include "training/trainer.h"
 
 namespace foresight {
+
+/// What shows a SPAN run in a directory: a metrics.csv without checkpoints (a run killed in
+/// epoch 1) holds nothing to resume, so a fresh start replaces it.
+inline const RunDirectoryRules kSpanRunRules{{"checkpoints/", "model.h5", "eval.json"}, true};
 
 /// Trains (or resumes) into `run_dir`; writes the resolved config and the normalisation first.
 /// A fresh start (not `resume`) refuses a directory that already holds checkpoints, metrics.csv,

@@ -9,7 +9,7 @@ namespace foresight {
 LoadedSpanNet LoadSpanNetFromArtifact(const std::string& artifact) {
   const Artifact art = Artifact::Open(artifact, kSpanModelType);
   LoadedSpanNet out;
-  out.config = SpanConfigFromYaml(art.config_yaml(), artifact + ":/config");
+  out.config = config::ExperimentConfigFromYaml<SpanExperimentConfig>(art.config_yaml(), artifact + ":/config");
   out.layout.basis = out.config.basis.num_centres;
   out.layout.components = out.config.network.components;
   out.layout.u_param = out.config.network.u_param;

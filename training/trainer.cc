@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/file_io.h"
 #include "core/log.h"
 #include "core/parse.h"
 #include "training/progress.h"
@@ -130,11 +131,15 @@ void SaveCheckpoint(const std::string& path, torch::nn::Module& module, torch::o
   archive.write("state/best_epoch", torch::tensor(static_cast<int64_t>(s.best_epoch)));
   archive.write("state/best_val", torch::tensor(s.best_val, torch::kFloat64));
   archive.write("state/bad_epochs", torch::tensor(static_cast<int64_t>(s.bad_epochs)));
-  const std::string tmp = path + ".tmp";
-  archive.save_to(tmp);
-  Sync(tmp, true);  // the data is on disk before the rename makes it the checkpoint
-  FS_THROW_UNLESS(std::rename(tmp.c_str(), path.c_str()) == 0, path, ": cannot move checkpoint into place");
-  Sync(fs::path(path).parent_path().string(), false);
+  // Serialised in memory, then written with checked calls: LibTorch's file writer aborts the
+  // process when the disk fills (its destructor throws), and a full disk must only stop the run.
+  std::ostringstream bytes;
+  archive.save_to(bytes);
+  try {
+    WriteFileAtomically(path, bytes.str());
+  } catch (const Error& e) {
+    Fail(e.what(), "; the previous checkpoint is kept");
+  }
 }
 
 torch::serialize::InputArchive OpenCheckpoint(const std::string& path) {

@@ -49,18 +49,18 @@ DirectionalMap DirectionalMap::Load(const std::string& path) {
   m.variant_ = variant == "spatial" ? DirectionalVariant::kSpatial : DirectionalVariant::kSpatiotemporal;
   DirectionalFeatureConfig fc;
   const std::string g = "/model/features";
-  fc.x_min = f.GetDoubleAttr(g, "x_min");
-  fc.x_max = f.GetDoubleAttr(g, "x_max");
-  fc.y_min = f.GetDoubleAttr(g, "y_min");
-  fc.y_max = f.GetDoubleAttr(g, "y_max");
-  fc.cells_x = static_cast<int>(f.GetIntAttr(g, "cells_x"));
-  fc.cells_y = static_cast<int>(f.GetIntAttr(g, "cells_y"));
-  fc.length_scale = f.GetDoubleAttr(g, "length_scale");
-  fc.t_min = f.GetDoubleAttr(g, "t_min");
-  fc.t_max = f.GetDoubleAttr(g, "t_max");
-  fc.time_points = static_cast<int>(f.GetIntAttr(g, "time_points"));
-  fc.time_length_scale = f.GetDoubleAttr(g, "time_length_scale");
-  fc.cutoff = f.GetDoubleAttr(g, "cutoff");
+  fc.x_min = art.DoubleAttr(g, "x_min", -1e12, 1e12);
+  fc.x_max = art.DoubleAttr(g, "x_max", -1e12, 1e12);
+  fc.y_min = art.DoubleAttr(g, "y_min", -1e12, 1e12);
+  fc.y_max = art.DoubleAttr(g, "y_max", -1e12, 1e12);
+  fc.cells_x = art.IntAttr(g, "cells_x", 1, 10000000);
+  fc.cells_y = art.IntAttr(g, "cells_y", 1, 10000000);
+  fc.length_scale = art.DoubleAttr(g, "length_scale", -1e12, 1e12);
+  fc.t_min = art.DoubleAttr(g, "t_min", -1e12, 1e12);
+  fc.t_max = art.DoubleAttr(g, "t_max", -1e12, 1e12);
+  fc.time_points = art.IntAttr(g, "time_points", 1, 10000000);
+  fc.time_length_scale = art.DoubleAttr(g, "time_length_scale", -1e12, 1e12);
+  fc.cutoff = art.DoubleAttr(g, "cutoff", -1e12, 1e12);
   FS_THROW_UNLESS(fc.cells_x >= 1 && fc.cells_y >= 1 && fc.time_points >= 1 &&
                       static_cast<double>(fc.cells_x) * fc.cells_y <= 1e7,
                   path, ": implausible inducing grid ", fc.cells_x, " x ", fc.cells_y, " x ", fc.time_points);
@@ -69,8 +69,8 @@ DirectionalMap DirectionalMap::Load(const std::string& path) {
   } catch (const Error& e) {
     Fail(path, ": ", e.what());
   }
-  m.log_kappa_max_ = f.GetDoubleAttr("/model", "log_kappa_max");
-  const auto R = f.GetIntAttr("/model", "components");
+  m.log_kappa_max_ = art.DoubleAttr("/model", "log_kappa_max", -1e3, 1e3);
+  const auto R = art.IntAttr("/model", "components", 1, 1000);
   FS_THROW_UNLESS(R >= 1 && R <= 1000, path, ": implausible number of components ", R);
   auto read_head = [&](const std::string& name, Eigen::MatrixXf* w, Eigen::VectorXf* b) {
     *w = f.ReadMatrixF("/weights/" + name + "/weight", R, -1);
@@ -86,6 +86,45 @@ DirectionalMap DirectionalMap::Load(const std::string& path) {
     Fail(path, ": ", e.what());
   }
   return m;
+}
+
+void DirectionalMap::Save(const std::string& path, const std::string& config_yaml, std::int64_t seed) const {
+  h5::WriteAtomically(path, [&](h5::File* f) {
+    Artifact::WriteHeader(f, kDirectionalModelType, config_yaml, seed);
+    const bool temporal = variant_ == DirectionalVariant::kSpatiotemporal;
+    f->SetAttr("/model", "variant", std::string(VariantName(variant_)));
+    f->SetAttr("/model", "components", static_cast<std::int64_t>(components()));
+    f->SetAttr("/model", "hidden", static_cast<std::int64_t>(temporal ? lstm_.hidden_size() : 0));
+    f->SetAttr("/model", "log_kappa_min", kDirectionalLogKappaMin);
+    f->SetAttr("/model", "log_kappa_max", log_kappa_max_);
+    const DirectionalFeatureConfig& c = features_.config();
+    const std::string g = "/model/features";
+    f->SetAttr(g, "x_min", c.x_min);
+    f->SetAttr(g, "x_max", c.x_max);
+    f->SetAttr(g, "y_min", c.y_min);
+    f->SetAttr(g, "y_max", c.y_max);
+    f->SetAttr(g, "cells_x", static_cast<std::int64_t>(c.cells_x));
+    f->SetAttr(g, "cells_y", static_cast<std::int64_t>(c.cells_y));
+    f->SetAttr(g, "length_scale", c.length_scale);
+    f->SetAttr(g, "t_min", c.t_min);
+    f->SetAttr(g, "t_max", c.t_max);
+    f->SetAttr(g, "time_points", static_cast<std::int64_t>(c.time_points));
+    f->SetAttr(g, "time_length_scale", c.time_length_scale);
+    f->SetAttr(g, "cutoff", c.cutoff);
+    if (temporal) {
+      const LstmWeights& w = lstm_.weights();
+      f->WriteMatrix("/weights/lstm/weight_ih_l0", w.weight_ih);
+      f->WriteMatrix("/weights/lstm/weight_hh_l0", w.weight_hh);
+      f->WriteMatrix("/weights/lstm/bias_ih_l0", w.bias_ih);
+      f->WriteMatrix("/weights/lstm/bias_hh_l0", w.bias_hh);
+    }
+    f->WriteMatrix("/weights/alpha/weight", heads_.alpha_w);
+    f->WriteMatrix("/weights/alpha/bias", heads_.alpha_b);
+    f->WriteMatrix("/weights/mu/weight", heads_.mu_w);
+    f->WriteMatrix("/weights/mu/bias", heads_.mu_b);
+    f->WriteMatrix("/weights/kappa/weight", heads_.kappa_w);
+    f->WriteMatrix("/weights/kappa/bias", heads_.kappa_b);
+  });
 }
 
 DirectionalMap::Workspace DirectionalMap::MakeWorkspace() const {

@@ -54,7 +54,10 @@ class DirectionalMap {
   /// Opens and checks an artifact; a missing file, another model type or inconsistent tensors are
   /// Errors naming the file.
   static DirectionalMap Load(const std::string& path);
-  /// Builds a map from parts (tests). `lstm` is ignored for the spatial variant.
+  /// Writes an artifact that Load reads (to path.tmp, then renamed into place); the engine owns
+  /// the schema both ways (docs/artifact_schema.md).
+  void Save(const std::string& path, const std::string& config_yaml, std::int64_t seed) const;
+  /// Builds a map from parts (exporters, tests). `lstm` is ignored for the spatial variant.
   DirectionalMap(DirectionalVariant variant, const DirectionalFeatureConfig& features, Lstm lstm,
                  DirectionalHeads heads, double max_kappa = kDirectionalDefaultMaxKappa);
 

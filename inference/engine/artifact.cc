@@ -1,5 +1,7 @@
 #include "inference/engine/artifact.h"
 
+#include <cmath>
+
 #include "core/error.h"
 
 namespace foresight {
@@ -19,6 +21,20 @@ Artifact Artifact::Open(const std::string& path, const std::string& expected_mod
   a.seed_ = f.GetIntAttr("/", "seed");
   a.config_yaml_ = f.ReadString("/config");
   return a;
+}
+
+int Artifact::IntAttr(const std::string& object, const std::string& name, int lo, int hi) const {
+  const std::int64_t v = file_.GetIntAttr(object, name);
+  FS_THROW_UNLESS(v >= lo && v <= hi, file_.path(), ": attribute ", object, "/", name, " is ", v, "; expected ", lo,
+                  " to ", hi);
+  return static_cast<int>(v);
+}
+
+double Artifact::DoubleAttr(const std::string& object, const std::string& name, double lo, double hi) const {
+  const double v = file_.GetDoubleAttr(object, name);
+  FS_THROW_UNLESS(std::isfinite(v) && v >= lo && v <= hi, file_.path(), ": attribute ", object, "/", name, " is ", v,
+                  "; expected a finite number from ", lo, " to ", hi);
+  return v;
 }
 
 void Artifact::WriteHeader(h5::File* f, const std::string& model_type, const std::string& config_yaml,

@@ -26,6 +26,12 @@ class Artifact {
   const std::string& config_yaml() const { return config_yaml_; }
   std::int64_t seed() const { return seed_; }
 
+  /// An integer attribute of `object` in [lo, hi] (an Error naming the file, the attribute and the
+  /// value otherwise: a loader never narrows an out-of-range int64 silently).
+  int IntAttr(const std::string& object, const std::string& name, int lo, int hi) const;
+  /// A finite floating-point attribute in [lo, hi] (likewise).
+  double DoubleAttr(const std::string& object, const std::string& name, double lo, double hi) const;
+
   /// Writes the common header of a new artifact.
   static void WriteHeader(h5::File* file, const std::string& model_type, const std::string& config_yaml,
                           std::int64_t seed);

@@ -34,6 +34,15 @@ Mlp Mlp::Load(const h5::File& file, const std::string& prefix, const std::vector
   }
 }
 
+void Mlp::Save(h5::File* file, const std::string& prefix, const std::vector<std::string>& names) const {
+  FS_THROW_UNLESS(names.size() == layers_.size(), file->path(), ": ", names.size(), " layer names for ",
+                  layers_.size(), " layers");
+  for (std::size_t i = 0; i < layers_.size(); ++i) {
+    file->WriteMatrix(prefix + names[i] + "/weight", layers_[i].weight);
+    file->WriteMatrix(prefix + names[i] + "/bias", layers_[i].bias);
+  }
+}
+
 Mlp::Workspace Mlp::MakeWorkspace() const {
   return {Eigen::VectorXf::Zero(max_width_), Eigen::VectorXf::Zero(max_width_)};
 }

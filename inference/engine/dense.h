@@ -26,6 +26,8 @@ class Mlp {
   /// Reads `<prefix><name>/weight` and `<prefix><name>/bias` for each name, checking shapes chain.
   static Mlp Load(const h5::File& file, const std::string& prefix,
                   const std::vector<std::string>& names);
+  /// Writes what Load reads: `<prefix><names[i]>/weight` [out x in] and `/bias` [out] (float).
+  void Save(h5::File* file, const std::string& prefix, const std::vector<std::string>& names) const;
 
   int input_size() const { return static_cast<int>(layers_.front().weight.cols()); }
   int output_size() const { return static_cast<int>(layers_.back().weight.rows()); }

@@ -65,38 +65,38 @@ Eigen::Vector4d GridMap::Extent() const {
 }
 
 void GridMap::Save(const std::string& path, const std::string& config_yaml, std::int64_t seed) const {
-  h5::File f = h5::File::Create(path);
-  Artifact::WriteHeader(&f, kGridMapType, config_yaml, seed);
-  f.SetAttr("/model", "x_min", geometry_.x_min);
-  f.SetAttr("/model", "y_min", geometry_.y_min);
-  f.SetAttr("/model", "resolution", geometry_.resolution);
-  f.SetAttr("/model", "nx", static_cast<std::int64_t>(geometry_.nx));
-  f.SetAttr("/model", "ny", static_cast<std::int64_t>(geometry_.ny));
-  const std::vector<std::size_t> shape{static_cast<std::size_t>(geometry_.ny),
-                                       static_cast<std::size_t>(geometry_.nx)};
-  // Row-major [ny x nx]: row iy holds cells (0..nx-1, iy).
-  if (cell_type_ == CellType::kUint8) {
-    f.SetAttr("/model", "cell_type", std::string("uint8"));
-    std::vector<std::uint8_t> bytes(cells_.size());
-    for (int iy = 0; iy < geometry_.ny; ++iy)
-      for (int ix = 0; ix < geometry_.nx; ++ix) bytes[iy * geometry_.nx + ix] = EncodeCell(cells_(iy, ix));
-    f.Write("/cells", bytes.data(), shape);
-  } else {
-    f.SetAttr("/model", "cell_type", std::string("float32"));
-    f.WriteMatrix("/cells", cells_);
-  }
+  h5::WriteAtomically(path, [&](h5::File* f) {
+    Artifact::WriteHeader(f, kGridMapType, config_yaml, seed);
+    f->SetAttr("/model", "x_min", geometry_.x_min);
+    f->SetAttr("/model", "y_min", geometry_.y_min);
+    f->SetAttr("/model", "resolution", geometry_.resolution);
+    f->SetAttr("/model", "nx", static_cast<std::int64_t>(geometry_.nx));
+    f->SetAttr("/model", "ny", static_cast<std::int64_t>(geometry_.ny));
+    const std::vector<std::size_t> shape{static_cast<std::size_t>(geometry_.ny),
+                                         static_cast<std::size_t>(geometry_.nx)};
+    // Row-major [ny x nx]: row iy holds cells (0..nx-1, iy).
+    if (cell_type_ == CellType::kUint8) {
+      f->SetAttr("/model", "cell_type", std::string("uint8"));
+      std::vector<std::uint8_t> bytes(cells_.size());
+      for (int iy = 0; iy < geometry_.ny; ++iy)
+        for (int ix = 0; ix < geometry_.nx; ++ix) bytes[iy * geometry_.nx + ix] = EncodeCell(cells_(iy, ix));
+      f->Write("/cells", bytes.data(), shape);
+    } else {
+      f->SetAttr("/model", "cell_type", std::string("float32"));
+      f->WriteMatrix("/cells", cells_);
+    }
+  });
 }
 
 GridMap GridMap::Load(const std::string& path) {
   Artifact a = Artifact::Open(path, kGridMapType);
   const h5::File& f = a.file();
   GridGeometry g;
-  g.x_min = f.GetDoubleAttr("/model", "x_min");
-  g.y_min = f.GetDoubleAttr("/model", "y_min");
-  g.resolution = f.GetDoubleAttr("/model", "resolution");
-  const auto nx = f.GetIntAttr("/model", "nx"), ny = f.GetIntAttr("/model", "ny");
-  FS_THROW_UNLESS(nx > 0 && ny > 0 && nx * ny <= (std::int64_t{1} << 30), path, ": grid of ", nx,
-                  " x ", ny, " cells is invalid");
+  g.x_min = a.DoubleAttr("/model", "x_min", -1e9, 1e9);
+  g.y_min = a.DoubleAttr("/model", "y_min", -1e9, 1e9);
+  g.resolution = a.DoubleAttr("/model", "resolution", 1e-9, 1e9);
+  const std::int64_t nx = a.IntAttr("/model", "nx", 1, 1 << 20), ny = a.IntAttr("/model", "ny", 1, 1 << 20);
+  FS_THROW_UNLESS(nx * ny <= (std::int64_t{1} << 30), path, ": grid of ", nx, " x ", ny, " cells is too large");
   g.nx = static_cast<int>(nx);
   g.ny = static_cast<int>(ny);
   const std::string type = f.GetStringAttr("/model", "cell_type");

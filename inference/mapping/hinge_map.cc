@@ -189,27 +189,28 @@ Eigen::Vector4d HingeMap::Extent() const {
 
 void HingeMap::Save(const std::string& path, const std::string& config_yaml, std::int64_t seed,
                     StoredPrecision precision) const {
-  h5::File f = h5::File::Create(path);
-  Artifact::WriteHeader(&f, model_type(), config_yaml, seed);
-  const auto& c = grid_.config();
-  f.SetAttr("/model", "x_min", c.x_min);
-  f.SetAttr("/model", "x_max", c.x_max);
-  f.SetAttr("/model", "y_min", c.y_min);
-  f.SetAttr("/model", "y_max", c.y_max);
-  f.SetAttr("/model", "spacing", c.spacing);
-  f.SetAttr("/model", "gamma", c.gamma);
-  f.SetAttr("/model", "cutoff_radius", c.cutoff_radius);
-  f.SetAttr("/model", "prior_mean", prior_mean_);
-  f.SetAttr("/model", "prior_variance", prior_variance_);
-  WriteVector(&f, "/weights/mean", weights_.mean, precision);
-  if (kind_ == HingeMapKind::kFastBhm) WriteVector(&f, "/weights/variance", weights_.variance, precision);
-  if (kind_ == HingeMapKind::kBhm) {
-    if (precision == StoredPrecision::kFloat64) {
-      f.WriteMatrix("/weights/covariance", weights_.covariance);
-    } else {
-      f.WriteMatrix("/weights/covariance", weights_.covariance.cast<float>());
+  h5::WriteAtomically(path, [&](h5::File* f) {
+    Artifact::WriteHeader(f, model_type(), config_yaml, seed);
+    const auto& c = grid_.config();
+    f->SetAttr("/model", "x_min", c.x_min);
+    f->SetAttr("/model", "x_max", c.x_max);
+    f->SetAttr("/model", "y_min", c.y_min);
+    f->SetAttr("/model", "y_max", c.y_max);
+    f->SetAttr("/model", "spacing", c.spacing);
+    f->SetAttr("/model", "gamma", c.gamma);
+    f->SetAttr("/model", "cutoff_radius", c.cutoff_radius);
+    f->SetAttr("/model", "prior_mean", prior_mean_);
+    f->SetAttr("/model", "prior_variance", prior_variance_);
+    WriteVector(f, "/weights/mean", weights_.mean, precision);
+    if (kind_ == HingeMapKind::kFastBhm) WriteVector(f, "/weights/variance", weights_.variance, precision);
+    if (kind_ == HingeMapKind::kBhm) {
+      if (precision == StoredPrecision::kFloat64) {
+        f->WriteMatrix("/weights/covariance", weights_.covariance);
+      } else {
+        f->WriteMatrix("/weights/covariance", weights_.covariance.cast<float>());
+      }
     }
-  }
+  });
 }
 
 HingeMap HingeMap::Load(const std::string& path, const std::string& expected_type) {
@@ -227,13 +228,13 @@ HingeMap HingeMap::Load(const std::string& path, const std::string& expected_typ
   }
   const h5::File& f = a.file();
   HingeGridConfig c;
-  c.x_min = f.GetDoubleAttr("/model", "x_min");
-  c.x_max = f.GetDoubleAttr("/model", "x_max");
-  c.y_min = f.GetDoubleAttr("/model", "y_min");
-  c.y_max = f.GetDoubleAttr("/model", "y_max");
-  c.spacing = f.GetDoubleAttr("/model", "spacing");
-  c.gamma = f.GetDoubleAttr("/model", "gamma");
-  c.cutoff_radius = f.GetDoubleAttr("/model", "cutoff_radius");
+  c.x_min = a.DoubleAttr("/model", "x_min", -1e9, 1e9);
+  c.x_max = a.DoubleAttr("/model", "x_max", -1e9, 1e9);
+  c.y_min = a.DoubleAttr("/model", "y_min", -1e9, 1e9);
+  c.y_max = a.DoubleAttr("/model", "y_max", -1e9, 1e9);
+  c.spacing = a.DoubleAttr("/model", "spacing", 1e-12, 1e12);
+  c.gamma = a.DoubleAttr("/model", "gamma", 1e-12, 1e12);
+  c.cutoff_radius = a.DoubleAttr("/model", "cutoff_radius", 1e-12, 1e12);
   try {
     HingeGrid grid(c);
     const long t = grid.size();
@@ -241,8 +242,8 @@ HingeMap HingeMap::Load(const std::string& path, const std::string& expected_typ
     w.mean = ReadVector(f, "/weights/mean", t);
     if (kind == HingeMapKind::kFastBhm) w.variance = ReadVector(f, "/weights/variance", t);
     if (kind == HingeMapKind::kBhm) w.covariance = f.ReadMatrixD("/weights/covariance", t, t);
-    return HingeMap(kind, std::move(grid), std::move(w), f.GetDoubleAttr("/model", "prior_mean"),
-                    f.GetDoubleAttr("/model", "prior_variance"));
+    return HingeMap(kind, std::move(grid), std::move(w), a.DoubleAttr("/model", "prior_mean", -1e12, 1e12),
+                    a.DoubleAttr("/model", "prior_variance", 1e-300, 1e300));
   } catch (const Error& e) {
     const std::string what = e.what();
     if (what.rfind(path, 0) == 0) throw;

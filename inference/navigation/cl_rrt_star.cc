@@ -162,17 +162,17 @@ ControlOutcome ClRrtStarController::Compute(const NavigationInput& input) {
                                   (path_.col(path_.cols() - 1) - input.goal).norm() >= o.min_progress;
     if (!(exact || (approximate && progress))) {
       path_.resize(2, 0);
-      out.solved = false;
+      out.status = ControlStatus::kNoPath;
+      out.message = "no plan reaches the goal or makes progress";
       out.command = {0, 0};
       return out;
     }
     const og::PathGeometric& g = ss.getSolutionPath();
     out.cost = g.length();
     out.command = PurePursuit(input.robot, path_, o.lookahead, o.limits);
-  } catch (const std::exception&) {
+  } catch (const std::exception& e) {
     path_.resize(2, 0);
-    out = ControlOutcome{};
-    out.solved = false;
+    out = ControlOutcome::Stop(ControlStatus::kError, e.what());
   }
   return out;
 }

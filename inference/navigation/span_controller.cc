@@ -198,7 +198,8 @@ ControlOutcome SpanController::Compute(const NavigationInput& input) {
                                                  options_.initialisations, lower, &problem);
     out.evaluations = problem.evaluations;
     if (!std::isfinite(cost)) {
-      out.solved = false;
+      out.status = ControlStatus::kNoFinitePlan;
+      out.message = "no start of the optimiser reached a finite cost";
       out.command = {0, 0};
       has_previous_ = false;
       return out;
@@ -207,9 +208,8 @@ ControlOutcome SpanController::Compute(const NavigationInput& input) {
     out.cost = Cost(input.robot, input.goal, best, &out.tau);
     previous_ = best;
     has_previous_ = true;
-  } catch (const std::exception&) {
-    out = ControlOutcome{};
-    out.solved = false;  // e.g. malformed observations: stop and let the harness count it
+  } catch (const std::exception& e) {
+    out = ControlOutcome::Stop(ControlStatus::kError, e.what());  // e.g. malformed observations
     has_previous_ = false;
   }
   return out;
@@ -263,16 +263,16 @@ ControlOutcome ReactiveController::Compute(const NavigationInput& input) {
     bool hit = true;
     if (std::isfinite(cost)) Cost(input.robot, input.goal, best, &hit);
     if (hit) {
-      out.solved = false;
+      out.status = ControlStatus::kNoFinitePlan;
+      out.message = "every candidate control collides";
       out.command = {0, 0};
       return out;
     }
     out.command = best;
     out.cost = cost;
     out.tau = kInf;
-  } catch (const std::exception&) {
-    out = ControlOutcome{};
-    out.solved = false;
+  } catch (const std::exception& e) {
+    out = ControlOutcome::Stop(ControlStatus::kError, e.what());
   }
   return out;
 }

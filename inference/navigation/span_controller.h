@@ -56,6 +56,8 @@ class SpanController final : public NavigationController {
   const CrowdForecast& forecast() const { return forecast_; }
   /// Predictions of the last cycle (first forecast().pedestrians() entries are valid).
   const std::vector<TrajectoryDistribution>& predictions() const { return predictions_; }
+  const std::vector<TrajectoryDistribution>* Predictions() const override { return &predictions_; }
+  int PredictedPedestrians() const override { return forecast_.pedestrians(); }
   const SpanControllerOptions& options() const { return options_; }
   int steps() const { return steps_; }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "core/ego_frame.h"
 #include "core/error.h"
@@ -107,13 +108,13 @@ SpanPredictor SpanPredictor::Load(const std::string& path) {
   const Artifact art = Artifact::Open(path, kSpanModelType);
   const h5::File& f = art.file();
   SpanPredictor p;
-  p.observed_ = static_cast<int>(f.GetIntAttr("/model", "observed"));
-  p.seconds_per_step_ = f.GetDoubleAttr("/model", "seconds_per_step");
+  p.observed_ = art.IntAttr("/model", "observed", 2, 100000);
+  p.seconds_per_step_ = art.DoubleAttr("/model", "seconds_per_step", 1e-6, 3600);
   p.rotate_ = f.GetIntAttr("/model", "rotate_to_heading") != 0;
   p.residual_cv_ = f.HasAttr("/model", "residual_to_constant_velocity") &&
                    f.GetIntAttr("/model", "residual_to_constant_velocity") != 0;
-  p.layout_.basis = static_cast<int>(f.GetIntAttr("/model", "basis_size"));
-  p.layout_.components = static_cast<int>(f.GetIntAttr("/model", "components"));
+  p.layout_.basis = art.IntAttr("/model", "basis_size", 1, 10000);
+  p.layout_.components = art.IntAttr("/model", "components", 1, 64);
   const std::string u_param = f.GetStringAttr("/model", "u_param");
   FS_THROW_UNLESS(u_param == "cholesky" || u_param == "diagonal", path, ": unknown u_param '",
                   u_param, "'");
@@ -123,7 +124,13 @@ SpanPredictor SpanPredictor::Load(const std::string& path) {
                   path, ": implausible model attributes (observed ", p.observed_, ", basis ",
                   p.layout_.basis, ", components ", p.layout_.components, ")");
   const Eigen::MatrixXd centres = f.ReadMatrixD("/model/basis_centres", p.layout_.basis, 1);
-  p.basis_ = TimeBasis(centres.col(0), f.GetDoubleAttr("/model", "basis_gamma"));
+  FS_THROW_UNLESS(centres.allFinite(), path, ": /model/basis_centres has non-finite entries");
+  const double gamma = art.DoubleAttr("/model", "basis_gamma", 1e-12, 1e12);
+  try {
+    p.basis_ = TimeBasis(centres.col(0), gamma);
+  } catch (const Error& e) {
+    Fail(path, ": ", e.what());
+  }
   const int in = 2 * p.observed_;
   p.input_mean_ = f.ReadMatrixD("/normalisation/input_mean", in, 1).col(0);
   p.input_std_ = f.ReadMatrixD("/normalisation/input_std", in, 1).col(0);
@@ -148,6 +155,29 @@ SpanPredictor SpanPredictor::Load(const std::string& path) {
   for (const auto& l : p.mlp_.layers())
     FS_THROW_UNLESS(l.weight.allFinite() && l.bias.allFinite(), path, ": non-finite weights");
   return p;
+}
+
+void SpanPredictor::Save(const std::string& path, const SpanPredictorWeights& w, const std::string& config_yaml,
+                         std::int64_t seed) {
+  h5::WriteAtomically(path, [&](h5::File* f) {
+    Artifact::WriteHeader(f, kSpanModelType, config_yaml, seed);
+    f->SetAttr("/model", "observed", static_cast<std::int64_t>(w.observed));
+    f->SetAttr("/model", "predicted", static_cast<std::int64_t>(w.predicted));
+    f->SetAttr("/model", "seconds_per_step", w.seconds_per_step);
+    f->SetAttr("/model", "rotate_to_heading", static_cast<std::int64_t>(w.rotate_to_heading));
+    f->SetAttr("/model", "residual_to_constant_velocity", static_cast<std::int64_t>(w.residual_to_constant_velocity));
+    f->SetAttr("/model", "basis_size", static_cast<std::int64_t>(w.layout.basis));
+    f->SetAttr("/model", "components", static_cast<std::int64_t>(w.layout.components));
+    f->SetAttr("/model", "u_param", std::string(UParamName(w.layout.u_param)));
+    f->SetAttr("/model", "basis_gamma", w.basis_gamma);
+    f->WriteMatrix("/model/basis_centres", w.basis_centres);
+    f->WriteMatrix("/normalisation/input_mean", w.input_mean);
+    f->WriteMatrix("/normalisation/input_std", w.input_std);
+    std::string names;
+    for (const auto& name : w.layer_names) names += (names.empty() ? "" : ",") + name;
+    f->SetAttr("/model", "dense_layers", names);
+    w.mlp.Save(f, "/weights/", w.layer_names);
+  });
 }
 
 SpanPredictor::Workspace SpanPredictor::MakeWorkspace() const {

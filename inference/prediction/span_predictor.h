@@ -63,6 +63,20 @@ class TrajectoryDistribution {
   mutable Eigen::MatrixXd z_, w_;
 };
 
+/// Everything a span_predictor artifact holds besides its header: the engine's schema, written by
+/// SpanPredictor::Save and read by SpanPredictor::Load (docs/artifact_schema.md).
+struct SpanPredictorWeights {
+  int observed = 0, predicted = 0;  ///< points observed / predicted per window
+  double seconds_per_step = 0;      ///< s between points
+  bool rotate_to_heading = true, residual_to_constant_velocity = false;
+  HeadLayout layout;
+  Eigen::VectorXd basis_centres;    ///< [basis] s
+  double basis_gamma = 0;
+  Eigen::VectorXd input_mean, input_std;  ///< [2 observed]
+  std::vector<std::string> layer_names;   ///< module paths of the dense layers ("mlp.0", ..., "head")
+  Mlp mlp;
+};
+
 class SpanPredictor {
  public:
   struct Workspace {
@@ -74,6 +88,9 @@ class SpanPredictor {
 
   /// Loads an artifact written by `foresight export` (model_type "span_predictor").
   static SpanPredictor Load(const std::string& path);
+  /// Writes an artifact that Load reads (to path.tmp, then renamed into place).
+  static void Save(const std::string& path, const SpanPredictorWeights& weights, const std::string& config_yaml,
+                   std::int64_t seed);
 
   int observed() const { return observed_; }
   double seconds_per_step() const { return seconds_per_step_; }

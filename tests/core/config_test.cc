@@ -100,6 +100,26 @@ TEST(Config, ReferenceListsEveryKeyWithDefault) {
   EXPECT_NE(table.find("`0.5`"), std::string::npos);
 }
 
+// Issue 18, defect 5: yaml-cpp answers a repeated key with its first value; refuse it instead.
+TEST(Config, RepeatedKeysAreRefusedWithBothLines) {
+  testing::ExpectErrorContains([] { Parse("count: 2\nname: a\ncount: 5\n"); },
+                               {"test.yaml:3", "key 'count' is repeated", "first at line 1"});
+  testing::ExpectErrorContains([] { Parse("inner:\n  rate: 0.1\n  rate: 0.2\n"); },
+                               {"test.yaml:3", "'rate'", "line 2"});
+  testing::ExpectErrorContains([] { Parse("inner: {widths: [1], widths: [2]}\n"); }, {"'widths' is repeated"});
+}
+
+// Issue 18, defect 6 and 7: an empty config file does not silently train defaults, and a huge one
+// is refused before it is parsed.
+TEST(Config, EmptyAndHugeConfigFilesAreRefused) {
+  testing::TempDir dir;
+  testing::WriteText(dir.File("empty.yaml"), "# nothing but a comment\n");
+  testing::ExpectErrorContains([&] { config::LoadYamlFile(dir.File("empty.yaml")); }, {"empty.yaml", "empty"});
+  testing::WriteText(dir.File("huge.yaml"), "widths: [" + std::string(2 << 20, '1') + "]\n");
+  testing::ExpectErrorContains([&] { config::LoadYamlFile(dir.File("huge.yaml")); }, {"huge.yaml", "bytes; at most"});
+  testing::ExpectErrorContains([&] { config::LoadYamlFile(dir.File("none.yaml")); }, {"none.yaml", "cannot open"});
+}
+
 TEST(Config, InvalidYamlNamesTheFile) {
   testing::ExpectErrorContains([] { config::ParseYaml("a: [1, 2", "bad.yaml"); }, {"bad.yaml", "invalid YAML"});
   testing::ExpectErrorContains([] { config::LoadYamlFile("/nonexistent/x.yaml"); }, {"/nonexistent/x.yaml"});

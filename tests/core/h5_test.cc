@@ -3,10 +3,33 @@
 #include <gtest/gtest.h>
 #include <hdf5.h>
 
+#include <filesystem>
+
 #include "tests/test_util.h"
 
 namespace foresight {
 namespace {
+
+// Issue 18, defect 2: a write that fails (full disk) is an Error naming the file, and nothing
+// half-written is left where the file is expected (nor its temporary).
+TEST(H5, WriteAtomicallyLeavesNothingWhenTheDiskIsFull) {
+  testing::TempDir dir;
+  const std::string path = dir.File("big.h5");
+  const Eigen::MatrixXd big = Eigen::MatrixXd::Ones(200, 200);  // 320 kB
+  {
+    const testing::ScopedFileSizeLimit limit(64 * 1024);
+    testing::ExpectErrorContains([&] { h5::WriteAtomically(path, [&](h5::File* f) { f->WriteMatrix("/m", big); }); },
+                                 {"big.h5"});
+  }
+  EXPECT_FALSE(std::filesystem::exists(path));
+  EXPECT_FALSE(std::filesystem::exists(path + ".tmp"));
+  // A writer that fails for its own reasons leaves nothing either; a complete write lands.
+  EXPECT_THROW(h5::WriteAtomically(path, [](h5::File*) { throw Error("stop"); }), Error);
+  EXPECT_FALSE(std::filesystem::exists(path + ".tmp"));
+  h5::WriteAtomically(path, [&](h5::File* f) { f->WriteMatrix("/m", big); });
+  EXPECT_TRUE(h5::File::Open(path).ReadMatrixD("/m", 200, 200).isApprox(big));
+  EXPECT_FALSE(std::filesystem::exists(path + ".tmp"));
+}
 
 TEST(H5, RoundTripsArraysAttributesAndStrings) {
   testing::TempDir dir;

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "core/h5.h"
 #include "datasets/synthetic_pedestrians.h"
 #include "datasets/windows.h"
@@ -54,6 +56,19 @@ void WriteStoreWithOffsets(const std::string& path, const std::vector<std::int64
   f.Write("/tracks/offsets", offsets.data(), {offsets.size()});
   f.Write("/tracks/time", time.data(), {time.size()});
   f.Write("/tracks/xy", xy.data(), {time.size(), 2});
+}
+
+// Issue 18, defect 6: a store with a negative or NaN time step is refused, naming the file.
+TEST(TrackStore, RejectsANonPositiveTimeStep) {
+  testing::TempDir dir;
+  SyntheticPedestrianConfig cfg;
+  cfg.num_tracks = 3;
+  TrackSet set = GenerateSyntheticPedestrians(cfg);
+  for (const double step : {-1.0, 0.0, std::nan("")}) {
+    set.seconds_per_step = step;
+    WriteTrackStore(dir.File("bad.h5"), set);
+    testing::ExpectErrorContains([&] { ReadTrackStore(dir.File("bad.h5")); }, {"bad.h5", "seconds_per_step"});
+  }
 }
 
 TEST(TrackStore, RejectsOffsetsOutsideThePoints) {

@@ -174,7 +174,7 @@ TEST(DirectionalArtifact, RoundTripAndWrongKinds) {
   for (const DirectionalVariant v : {DirectionalVariant::kSpatiotemporal, DirectionalVariant::kSpatial}) {
     const DirectionalMap m = testing::RandomDirectionalMap(v, SmallFeatureConfig(), 8, 3, 2, 2.0f, 50.0);
     const std::string path = dir.File(std::string(VariantName(v)) + ".h5");
-    testing::WriteDirectionalArtifact(m, path);
+    m.Save(path, "model: directional\n", 0);
     const DirectionalMap loaded = DirectionalMap::Load(path);
     EXPECT_EQ(loaded.variant(), v);
     EXPECT_EQ(loaded.components(), 3);

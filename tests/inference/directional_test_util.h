@@ -47,41 +47,4 @@ inline DirectionalMap RandomDirectionalMap(DirectionalVariant v, const Direction
   return DirectionalMap(v, f, std::move(lstm), std::move(h), max_kappa);
 }
 
-/// Writes `map` as a directional_map artifact (the schema of docs/artifact_schema.md).
-inline void WriteDirectionalArtifact(const DirectionalMap& map, const std::string& path) {
-  h5::File f = h5::File::Create(path);
-  Artifact::WriteHeader(&f, kDirectionalModelType, "model: directional\n", 0);
-  const DirectionalFeatureConfig& c = map.features().config();
-  f.SetAttr("/model", "variant", std::string(VariantName(map.variant())));
-  f.SetAttr("/model", "components", static_cast<std::int64_t>(map.components()));
-  f.SetAttr("/model", "log_kappa_max", std::log(map.max_kappa()));
-  const std::string g = "/model/features";
-  f.SetAttr(g, "x_min", c.x_min);
-  f.SetAttr(g, "x_max", c.x_max);
-  f.SetAttr(g, "y_min", c.y_min);
-  f.SetAttr(g, "y_max", c.y_max);
-  f.SetAttr(g, "cells_x", static_cast<std::int64_t>(c.cells_x));
-  f.SetAttr(g, "cells_y", static_cast<std::int64_t>(c.cells_y));
-  f.SetAttr(g, "length_scale", c.length_scale);
-  f.SetAttr(g, "t_min", c.t_min);
-  f.SetAttr(g, "t_max", c.t_max);
-  f.SetAttr(g, "time_points", static_cast<std::int64_t>(c.time_points));
-  f.SetAttr(g, "time_length_scale", c.time_length_scale);
-  f.SetAttr(g, "cutoff", c.cutoff);
-  if (map.variant() == DirectionalVariant::kSpatiotemporal) {
-    const LstmWeights& w = map.lstm().weights();
-    f.WriteMatrix("/weights/lstm/weight_ih_l0", w.weight_ih);
-    f.WriteMatrix("/weights/lstm/weight_hh_l0", w.weight_hh);
-    f.WriteMatrix("/weights/lstm/bias_ih_l0", Eigen::MatrixXf(w.bias_ih));
-    f.WriteMatrix("/weights/lstm/bias_hh_l0", Eigen::MatrixXf(w.bias_hh));
-  }
-  const DirectionalHeads& h = map.heads();
-  f.WriteMatrix("/weights/alpha/weight", h.alpha_w);
-  f.WriteMatrix("/weights/alpha/bias", Eigen::MatrixXf(h.alpha_b));
-  f.WriteMatrix("/weights/mu/weight", h.mu_w);
-  f.WriteMatrix("/weights/mu/bias", Eigen::MatrixXf(h.mu_b));
-  f.WriteMatrix("/weights/kappa/weight", h.kappa_w);
-  f.WriteMatrix("/weights/kappa/bias", Eigen::MatrixXf(h.kappa_b));
-}
-
 }  // namespace foresight::testing

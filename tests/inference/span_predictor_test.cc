@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cmath>
 #include <new>
 
 #include "core/h5.h"
@@ -230,6 +231,28 @@ TEST(SpanEngineErrors, TruncatedForeignAndWrongTypeArtifacts) {
     f.SetAttr("/", "format_version", std::int64_t{99});
   }
   testing::ExpectErrorContains([&] { SpanPredictor::Load(dir.File("future.h5")); }, {"format_version 99"});
+}
+
+// Issue 18, defect 7: edited attributes are refused with the file, the attribute and the value,
+// never narrowed or accepted as NaN.
+TEST(SpanEngineErrors, EditedAttributesAreRefusedWithFileAndValue) {
+  testing::TempDir dir;
+  const std::string good = dir.File("model.h5");
+  testing::WriteRandomSpanArtifact(good, {});
+  auto edited = [&](const std::string& name, auto value) {
+    const std::string path = dir.File(name + ".h5");
+    std::filesystem::copy_file(good, path, std::filesystem::copy_options::overwrite_existing);
+    testing::OverwriteAttr(path, "/model", name, value);
+    return path;
+  };
+  const std::string wide = edited("observed", (std::int64_t{1} << 32) + 8);
+  testing::ExpectErrorContains([&] { SpanPredictor::Load(wide); }, {wide, "/model/observed", "4294967304"});
+  const std::string step = edited("seconds_per_step", std::nan(""));
+  testing::ExpectErrorContains([&] { SpanPredictor::Load(step); }, {step, "seconds_per_step", "nan"});
+  const std::string gamma = edited("basis_gamma", -1.0);
+  testing::ExpectErrorContains([&] { SpanPredictor::Load(gamma); }, {gamma, "basis_gamma", "-1"});
+  const std::string many = edited("components", std::int64_t{1} << 40);
+  testing::ExpectErrorContains([&] { SpanPredictor::Load(many); }, {many, "components"});
 }
 
 }  // namespace

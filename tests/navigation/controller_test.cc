@@ -74,7 +74,7 @@ TEST(GoalDistanceField, IsEuclideanInOpenSpaceAndGoesAroundWalls) {
   const Eigen::Vector2d goal(9, 2);
   const GoalDistanceField free_space(open_field, goal, 0.25), around(walled_field, goal, 0.25);
   // Away from walls: the straight-line distance up to the 8-connected grid error (<= 8 %).
-  for (const Eigen::Vector2d x : {Eigen::Vector2d(3, 2), Eigen::Vector2d(5, 4), Eigen::Vector2d(7, 3.5)}) {
+  for (const Eigen::Vector2d& x : {Eigen::Vector2d(3, 2), Eigen::Vector2d(5, 4), Eigen::Vector2d(7, 3.5)}) {
     const double euclid = (x - goal).norm();
     EXPECT_GE(free_space.Distance(x), euclid - 0.05);
     EXPECT_LE(free_space.Distance(x), 1.09 * euclid + 0.05);
@@ -101,7 +101,7 @@ TEST(SpanController, FreeSpaceDrivesStraightAtTheGoal) {
   in.robot = {0, 0, 0};
   in.goal = {10, 0};
   const ControlOutcome out = c.Compute(in);
-  EXPECT_TRUE(out.solved);
+  EXPECT_TRUE(out.solved());
   EXPECT_NEAR(out.command.v, 1.0, 1e-3);
   EXPECT_NEAR(out.command.omega, 0.0, 2e-2);
   EXPECT_EQ(out.tau, kInf);
@@ -139,7 +139,7 @@ TEST(SpanController, CobylaFindsAsGoodAControlAsAGridSearch) {
   for (int i = 0; i <= 40; ++i)
     for (int j = 0; j <= 40; ++j)
       grid_best = std::min(grid_best, c.Cost(in.robot, in.goal, {-1.0 + 0.05 * i, -1.0 + 0.05 * j}, nullptr));
-  EXPECT_TRUE(out.solved);
+  EXPECT_TRUE(out.solved());
   EXPECT_LE(out.cost, grid_best + 0.05) << "COBYLA " << out.cost << " vs grid " << grid_best;
 }
 
@@ -192,7 +192,7 @@ TEST(SpanController, NonFiniteObservationsNeverThrow) {
   in.goal = {10, 0};
   in.past_rows = &rows;
   const ControlOutcome out = c.Compute(in);
-  EXPECT_TRUE(out.solved);
+  EXPECT_TRUE(out.solved());
   EXPECT_EQ(c.forecast().pedestrians(), 1);  // the all-NaN row is dropped, the other stands at its last finite point
   EXPECT_EQ(c.forecast().Mean(0, 1, 0), Eigen::Vector2d(2.0, 0.0));
 }
@@ -205,7 +205,7 @@ TEST(Baselines, NonFiniteObservationsAreDroppedNotObstacles) {
   in.goal = {10, 0};
   in.past_rows = &rows;
   ReactiveController reactive(nullptr, Options());
-  EXPECT_TRUE(reactive.Compute(in).solved);
+  EXPECT_TRUE(reactive.Compute(in).solved());
   const GridMap map = Room(false);
   const StaticCollisionField field(map, 0.4, 0.05);
   ClRrtStarOptions o;
@@ -214,7 +214,7 @@ TEST(Baselines, NonFiniteObservationsAreDroppedNotObstacles) {
   in.robot = {1, 1, 0};
   in.goal = {9, 7};
   const ControlOutcome out = rrt.Compute(in);
-  EXPECT_TRUE(out.solved);
+  EXPECT_TRUE(out.solved());
   for (Eigen::Index i = 0; i < rrt.path().cols(); ++i) EXPECT_TRUE(rrt.path().col(i).allFinite());
 }
 
@@ -235,11 +235,13 @@ TEST(ReactiveController, StopsWhenBoxedInAndMovesWhenFree) {
   in.goal = {10, 0};
   in.past_rows = &boxed;
   ControlOutcome out = c.Compute(in);
-  EXPECT_FALSE(out.solved);
+  EXPECT_FALSE(out.solved());
+  EXPECT_EQ(out.status, ControlStatus::kNoFinitePlan);
+  EXPECT_EQ(out.message, "every candidate control collides");
   EXPECT_EQ(out.command.v, 0.0);
   in.past_rows = nullptr;
   out = c.Compute(in);
-  EXPECT_TRUE(out.solved);
+  EXPECT_TRUE(out.solved());
   EXPECT_GT(out.command.v, 0.9);
 }
 
@@ -284,14 +286,16 @@ TEST(ClRrtStar, PlansThroughTheGapAndStaysPutWhenBlocked) {
   in.robot = {2, 2, 0};
   in.goal = {5.0, 2.0};
   ControlOutcome out = c.Compute(in);
-  EXPECT_TRUE(out.solved);
+  EXPECT_TRUE(out.solved());
   EXPECT_GT(out.command.v, 0.0);
   ASSERT_GT(c.path().cols(), 0);
   EXPECT_LT((c.path().col(c.path().cols() - 1) - in.goal).norm(), 1.0);
   o.min_progress = 1e9;
   ClRrtStarController strict(&field, Eigen::Vector4d(-0.5, 12.5, -0.5, 8.5), o, 1);
   out = strict.Compute(in);
-  EXPECT_FALSE(out.solved);
+  EXPECT_FALSE(out.solved());
+  EXPECT_EQ(out.status, ControlStatus::kNoPath);
+  EXPECT_FALSE(out.message.empty());
   EXPECT_EQ(out.command.v, 0.0);
   EXPECT_EQ(out.command.omega, 0.0);
 }

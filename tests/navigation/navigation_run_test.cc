@@ -67,7 +67,8 @@ TEST(NavigationRun, EpisodesAreDeterministicForReplayFreeMethods) {
   NavigationExperimentConfig c = SmallConfig(dir);
   c.methods = {"reactive"};
   const NavigationResources res = PrepareNavigation(c, dir.path());
-  const EpisodeResult a = RunEpisode(c, res, "reactive", 0), b = RunEpisode(c, res, "reactive", 0);
+  const EpisodeResult a = RunEpisode(c, res, NavigationMethod::kReactive, 0),
+                      b = RunEpisode(c, res, NavigationMethod::kReactive, 0);
   EXPECT_EQ(a.path, b.path);
   EXPECT_EQ(a.doc, b.doc);
 }

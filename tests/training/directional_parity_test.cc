@@ -288,11 +288,11 @@ TEST(DirectionalPipeline, BadInput) {
   testing::ExpectErrorContains([&] { RunDirectionalExperiment(c, dir.File("run"), false); }, {"empty.csv"});
   // Config errors name the key.
   testing::ExpectErrorContains(
-      [&] { DirectionalConfigFromYaml("model: directional\ndata: {format: grid_csv}\n", "x.yaml"); },
+      [&] { config::ExperimentConfigFromYaml<DirectionalExperimentConfig>("model: directional\ndata: {format: grid_csv}\n", "x.yaml"); },
       {"x.yaml", "data.file"});
-  testing::ExpectErrorContains([&] { DirectionalConfigFromYaml("model: directional\nfeatures: {cells: 3}\n", "x.yaml"); },
+  testing::ExpectErrorContains([&] { config::ExperimentConfigFromYaml<DirectionalExperimentConfig>("model: directional\nfeatures: {cells: 3}\n", "x.yaml"); },
                                {"x.yaml", "features.cells"});
-  testing::ExpectErrorContains([&] { DirectionalConfigFromYaml("model: span_predictor\n", "x.yaml"); },
+  testing::ExpectErrorContains([&] { config::ExperimentConfigFromYaml<DirectionalExperimentConfig>("model: span_predictor\n", "x.yaml"); },
                                {"'model'", "directional"});
   // Artifacts of the other kind, both ways.
   const std::string span = dir.File("span.h5");
@@ -311,7 +311,7 @@ TEST(DirectionalConfigs, ShippedConfigsLoad) {
   const char* src = std::getenv("FORESIGHT_SOURCE_DIR");
   ASSERT_NE(src, nullptr);
   for (const char* name : {"p1", "p2", "crossing", "edinburgh"})
-    EXPECT_NO_THROW(LoadDirectionalConfig(std::string(src) + "/configs/directional/" + name + ".yaml", {})) << name;
+    EXPECT_NO_THROW(config::LoadExperimentConfig<DirectionalExperimentConfig>(std::string(src) + "/configs/directional/" + name + ".yaml", {})) << name;
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <csignal>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <sstream>
 
 #include "core/h5.h"
@@ -195,6 +196,26 @@ TEST(Trainer, MetricsRowPrecedesItsCheckpointAndResumeRewritesIt) {
   const auto resumed = TrainSpan(c, run, true);  // from the checkpoint of epoch 2
   EXPECT_EQ(resumed.epochs_completed, 4);
   EXPECT_EQ(LossColumns(dir.File("full") + "/metrics.csv"), LossColumns(run + "/metrics.csv"));
+}
+
+// Issue 18, defect 4: a full disk during a checkpoint save stops the run with one line and keeps
+// the last good checkpoint (LibTorch's file writer used to abort the process).
+TEST(Trainer, FullDiskDuringACheckpointKeepsThePreviousOne) {
+  testing::TempDir dir;
+  const SpanExperimentConfig c = TinyConfig();
+  std::unique_ptr<testing::ScopedFileSizeLimit> limit;
+  TrainHooks hooks;
+  hooks.continue_after_epoch = [&](int completed) {
+    if (completed == 2) limit = std::make_unique<testing::ScopedFileSizeLimit>(4096);
+    return true;
+  };
+  testing::ExpectErrorContains([&] { TrainSpan(c, dir.path(), false, hooks); },
+                               {"checkpoints/", "cannot write", "the previous checkpoint is kept"});
+  limit.reset();
+  EXPECT_FALSE(std::filesystem::exists(dir.File("checkpoints/last.pt.tmp")));
+  EXPECT_FALSE(std::filesystem::exists(dir.File("checkpoints/best.pt.tmp")));
+  const auto resumed = TrainSpan(c, dir.path(), true);  // from the checkpoint of epoch 2
+  EXPECT_EQ(resumed.epochs_completed, 4);
 }
 
 TEST(Trainer, ResumeRestartsAMissingMetricsFileWithItsHeader) {

@@ -1,0 +1,25 @@
+#include "training/kinds.h"
+
+#ifdef FORESIGHT_WITH_TORCH
+#include "embedded_config.h"
+#endif
+
+namespace foresight {
+
+ExperimentRegistry BuiltinKinds() {
+  ExperimentRegistry r;
+#ifdef FORESIGHT_WITH_TORCH
+  r.Add(SpanKind(kEmbeddedDefaultConfig));
+#endif
+  r.Add(OccupancyKind());
+#ifdef FORESIGHT_WITH_TORCH
+  r.Add(DirectionalKind());
+#endif
+  r.Add(NavigationKind());
+#ifdef FORESIGHT_WITH_TORCH
+  r.SetDefault("span_predictor");
+#endif
+  return r;
+}
+
+}  // namespace foresight
