@@ -28,7 +28,9 @@ double Median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
-double Us(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double, std::micro>(b - a).count(); }
+double Us(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double, std::micro>(b - a).count();
+}
 
 struct BenchDirectionalArgs {
   std::string artifact;
@@ -43,7 +45,8 @@ void RunDirectionalBench(const BenchDirectionalArgs& a) {
   const DirectionalFeatureConfig& fc = map.features().config();
   const int n = 1024;
   std::mt19937_64 rng(1);
-  std::uniform_real_distribution<double> ux(fc.x_min, fc.x_max), uy(fc.y_min, fc.y_max), ut(fc.t_min, fc.t_max);
+  std::uniform_real_distribution<double> ux(fc.x_min, fc.x_max), uy(fc.y_min, fc.y_max),
+      ut(fc.t_min, fc.t_max);
   Eigen::VectorXd x(n), y(n), t(n);
   for (int i = 0; i < n; ++i) x[i] = ux(rng), y[i] = uy(rng), t[i] = ut(rng);
 
@@ -79,7 +82,8 @@ void RunDirectionalBench(const BenchDirectionalArgs& a) {
     const auto ts = torch::from_blob(s.data(), {s.rows(), s.cols()}, torch::kFloat32);
     const auto tt = torch::from_blob(tm.data(), {tm.rows(), tm.cols()}, torch::kFloat32);
     const auto t1 = Clock::now();
-    const auto p = DecodeDirectionalHead(net.net->forward(ts, tt), net.net->components(), net.net->max_kappa());
+    const auto p = DecodeDirectionalHead(net.net->forward(ts, tt), net.net->components(),
+                                         net.net->max_kappa());
     (void)p.kappa.sum().item<float>();
     const auto t2 = Clock::now();
     if (forward_only) forward_only->push_back(Us(t1, t2));
@@ -90,15 +94,17 @@ void RunDirectionalBench(const BenchDirectionalArgs& a) {
   std::vector<float> value;
   auto torch_sparse = [&](int begin, int len) {
     const auto t0 = Clock::now();
-    feats.SpatialSparseBatch(x.segment(begin, len), y.segment(begin, len), &index, &value, &offsets);
+    feats.SpatialSparseBatch(x.segment(begin, len), y.segment(begin, len), &index, &value,
+                             &offsets);
     RowMatrixF tm(len, feats.time_size());
     feats.TemporalBatch(t.segment(begin, len), tm);
     const auto nnz = static_cast<std::int64_t>(index.size());
     const auto p = DecodeDirectionalHead(
-        net.net->forward_sparse(torch::from_blob(index.data(), {nnz}, torch::kInt64),
-                                torch::from_blob(value.data(), {nnz}, torch::kFloat32),
-                                torch::from_blob(offsets.data(), {len + 1}, torch::kInt64),
-                                torch::from_blob(tm.data(), {tm.rows(), tm.cols()}, torch::kFloat32)),
+        net.net->forward_sparse(
+            torch::from_blob(index.data(), {nnz}, torch::kInt64),
+            torch::from_blob(value.data(), {nnz}, torch::kFloat32),
+            torch::from_blob(offsets.data(), {len + 1}, torch::kInt64),
+            torch::from_blob(tm.data(), {tm.rows(), tm.cols()}, torch::kFloat32)),
         net.net->components(), net.net->max_kappa());
     (void)p.kappa.sum().item<float>();
     return Us(t0, Clock::now());
@@ -120,36 +126,48 @@ void RunDirectionalBench(const BenchDirectionalArgs& a) {
   torch_sparse(0, n);
   for (int r = 0; r < a.repeats; ++r) sb.push_back(torch_sparse(0, n));
 
-  const double engine1 = Median(e1), engine_b = Median(eb), torch1 = Median(l1), torch_b = Median(lb);
+  const double engine1 = Median(e1), engine_b = Median(eb), torch1 = Median(l1),
+               torch_b = Median(lb);
   if (a.json) {
-    std::cout << "{\"artifact\": \"" << a.artifact << "\", \"variant\": \"" << VariantName(map.variant())
-              << "\", \"inducing_points\": " << feats.spatial_size() << ", \"time_points\": " << feats.time_size()
-              << ", \"threads\": 1, \"engine_batch1_us\": " << engine1 << ", \"libtorch_batch1_us\": " << torch1
-              << ", \"libtorch_batch1_forward_us\": " << Median(l1f) << ", \"engine_batch1024_us\": " << engine_b
-              << ", \"libtorch_batch1024_us\": " << torch_b << ", \"libtorch_batch1024_forward_us\": " << Median(lbf)
-              << ", \"libtorch_sparse_batch1_us\": " << Median(s1) << ", \"libtorch_sparse_batch1024_us\": " << Median(sb)
-              << "}\n";
+    std::cout << "{\"artifact\": \"" << a.artifact << "\", \"variant\": \""
+              << VariantName(map.variant()) << "\", \"inducing_points\": " << feats.spatial_size()
+              << ", \"time_points\": " << feats.time_size()
+              << ", \"threads\": 1, \"engine_batch1_us\": " << engine1
+              << ", \"libtorch_batch1_us\": " << torch1
+              << ", \"libtorch_batch1_forward_us\": " << Median(l1f)
+              << ", \"engine_batch1024_us\": " << engine_b
+              << ", \"libtorch_batch1024_us\": " << torch_b
+              << ", \"libtorch_batch1024_forward_us\": " << Median(lbf)
+              << ", \"libtorch_sparse_batch1_us\": " << Median(s1)
+              << ", \"libtorch_sparse_batch1024_us\": " << Median(sb) << "}\n";
     return;
   }
   std::printf("directional map %s: %d x %d inducing points x %d times, R = %d, 1 thread\n",
               VariantName(map.variant()), fc.cells_x, fc.cells_y, fc.time_points, map.components());
   std::printf("batch 1    engine (median of %d):   %10.2f us\n", a.calls, engine1);
-  std::printf("batch 1    libtorch (features+net):  %10.2f us   (net only %.2f us)   ratio %.1f x\n", torch1,
-              Median(l1f), torch1 / engine1);
-  std::printf("batch 1024 engine (median of %d):     %10.1f us   (%.2f us/query)\n", a.repeats, engine_b, engine_b / n);
-  std::printf("batch 1024 libtorch (features+net):  %10.1f us   (net only %.1f us)   ratio %.2f x\n", torch_b,
-              Median(lbf), torch_b / engine_b);
-  std::printf("libtorch, sparse features (embedding bag, the training path): batch 1 %.2f us (ratio %.1f x), "
-              "batch 1024 %.1f us (ratio %.2f x)\n",
-              Median(s1), Median(s1) / engine1, Median(sb), Median(sb) / engine_b);
+  std::printf(
+      "batch 1    libtorch (features+net):  %10.2f us   (net only %.2f us)   ratio %.1f x\n",
+      torch1, Median(l1f), torch1 / engine1);
+  std::printf("batch 1024 engine (median of %d):     %10.1f us   (%.2f us/query)\n", a.repeats,
+              engine_b, engine_b / n);
+  std::printf(
+      "batch 1024 libtorch (features+net):  %10.1f us   (net only %.1f us)   ratio %.2f x\n",
+      torch_b, Median(lbf), torch_b / engine_b);
+  std::printf(
+      "libtorch, sparse features (embedding bag, the training path): batch 1 %.2f us (ratio %.1f "
+      "x), "
+      "batch 1024 %.1f us (ratio %.2f x)\n",
+      Median(s1), Median(s1) / engine1, Median(sb), Median(sb) / engine_b);
 }
 
 }  // namespace
 
 void AddBenchDirectionalCommand(CLI::App* bench) {
   auto a = std::make_shared<BenchDirectionalArgs>();
-  auto* cmd = bench->add_subcommand("directional", "directional map: engine vs LibTorch query latency (batch 1, 1024)");
-  cmd->add_option("--artifact", a->artifact, "exported directional model .h5 (RUN_DIR/model.h5)")->required();
+  auto* cmd = bench->add_subcommand(
+      "directional", "directional map: engine vs LibTorch query latency (batch 1, 1024)");
+  cmd->add_option("--artifact", a->artifact, "exported directional model .h5 (RUN_DIR/model.h5)")
+      ->required();
   cmd->add_option("--calls", a->calls, "timed single queries")->check(CLI::Range(100, 10000000));
   cmd->add_option("--repeats", a->repeats, "timed batches of 1024")->check(CLI::Range(1, 10000));
   cmd->add_flag("--json", a->json, "print one JSON object");

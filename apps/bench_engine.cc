@@ -92,7 +92,8 @@ void RunEngineBench(const BenchArgs& a) {
       const auto t0 = Clock::now();
       const auto params = DecodeHead(loaded.net->forward(xi), loaded.layout);
       const auto t1 = Clock::now();
-      if (i >= 200) torch_times.push_back(std::chrono::duration<double, std::micro>(t1 - t0).count());
+      if (i >= 200)
+        torch_times.push_back(std::chrono::duration<double, std::micro>(t1 - t0).count());
       (void)params;
     }
     libtorch_us = Median(torch_times);
@@ -109,7 +110,8 @@ void RunEngineBench(const BenchArgs& a) {
     double elapsed = 0;
     while (elapsed < 1.5 || steps < 10) {
       opt.zero_grad();
-      const auto loss = MixtureNll(DecodeHead(loaded.net->forward(x), loaded.layout), w, loaded.layout).mean();
+      const auto loss =
+          MixtureNll(DecodeHead(loaded.net->forward(x), loaded.layout), w, loaded.layout).mean();
       loss.backward();
       opt.step();
       ++steps;
@@ -121,22 +123,27 @@ void RunEngineBench(const BenchArgs& a) {
   const double ratio = libtorch_us / engine_us;
   auto num = [](double v) {
     std::ostringstream os;
-    if (std::isfinite(v)) os << v;
-    else os << "null";
+    if (std::isfinite(v))
+      os << v;
+    else
+      os << "null";
     return os.str();
   };
   if (a.json) {
-    std::cout << "{\"artifact\": \"" << a.artifact << "\", \"batch\": 1, \"threads\": 1, \"calls\": " << a.calls
+    std::cout << "{\"artifact\": \"" << a.artifact
+              << "\", \"batch\": 1, \"threads\": 1, \"calls\": " << a.calls
               << ", \"engine_us\": " << num(engine_us) << ", \"libtorch_us\": " << num(libtorch_us)
-              << ", \"ratio\": " << num(ratio) << ", \"engine_batch1024_us_per_window\": "
-              << num(engine_batch1024_us / 1024.0) << ", \"train_windows_per_s\": " << num(train_windows_per_s)
-              << "}\n";
+              << ", \"ratio\": " << num(ratio)
+              << ", \"engine_batch1024_us_per_window\": " << num(engine_batch1024_us / 1024.0)
+              << ", \"train_windows_per_s\": " << num(train_windows_per_s) << "}\n";
   } else {
     std::printf("engine   (Eigen, batch 1, median of %d calls): %8.2f us\n", a.calls, engine_us);
     std::printf("libtorch (same network + head, batch 1):        %8.2f us\n", libtorch_us);
     std::printf("ratio libtorch / engine:                        %8.1f x\n", ratio);
-    std::printf("engine batch 1024 (per window):                 %8.2f us\n", engine_batch1024_us / 1024.0);
-    std::printf("training throughput (batch 256, 1 thread):      %8.0f windows/s\n", train_windows_per_s);
+    std::printf("engine batch 1024 (per window):                 %8.2f us\n",
+                engine_batch1024_us / 1024.0);
+    std::printf("training throughput (batch 256, 1 thread):      %8.0f windows/s\n",
+                train_windows_per_s);
   }
 }
 
@@ -146,7 +153,8 @@ void AddBenchCommands(CLI::App* app) {
   auto* bench = app->add_subcommand("bench", "benchmarks that print figures");
   bench->require_subcommand(1);
   auto args = std::make_shared<BenchArgs>();
-  auto* engine = bench->add_subcommand("engine", "engine vs LibTorch latency of an exported predictor");
+  auto* engine =
+      bench->add_subcommand("engine", "engine vs LibTorch latency of an exported predictor");
   engine->add_option("--artifact", args->artifact, "exported model .h5")->required();
   engine->add_flag("--json", args->json, "print one JSON object");
   engine->add_option("--calls", args->calls, "timed calls")->check(CLI::Range(100, 10000000));

@@ -3,7 +3,6 @@
 // coarser grid against Fast-BHM on that same grid and data, engine query throughput (probability,
 // gradient and variance), and OctoMap (insertion time, serialized size, memory, AUC).
 
-
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
@@ -56,7 +55,8 @@ double TimeMedian(int repeats, F&& f) {
 void RunMapBench(const BenchMapArgs& a) {
   FS_THROW_UNLESS(ModelTagOfFile(a.config).rfind("occupancy.", 0) == 0, a.config,
                   ": not an occupancy config (model: occupancy.*)");
-  OccupancyExperimentConfig c = config::LoadExperimentConfig<OccupancyExperimentConfig>(a.config, a.overrides);
+  OccupancyExperimentConfig c =
+      config::LoadExperimentConfig<OccupancyExperimentConfig>(a.config, a.overrides);
   const OccupancyData data = LoadOccupancyData(c);
   const HingeGrid grid(c.features);
 
@@ -101,14 +101,17 @@ void RunMapBench(const BenchMapArgs& a) {
   });
   const double query_pps = static_cast<double>(n) * passes / query_s;
 
-  const OctomapFigures octo = RunOctomapBaseline(data, c.data.points.max_range, a.octomap_resolution, a.repeats);
+  const OctomapFigures octo =
+      RunOctomapBaseline(data, c.data.points.max_range, a.octomap_resolution, a.repeats);
 
   std::ostringstream j;
   j << "{\"train_points\": " << data.train.size() << ", \"fast_bhm_train_s\": " << fast_s
     << ", \"fast_bhm_auc\": " << fast_auc << ", \"fast_bhm_bytes\": " << fast_bytes
-    << ", \"bhm_train_s\": " << bhm_s << ", \"bhm_grid\": \"" << bhm_grid.Describe() << "\", \"bhm_scans\": " << scans
-    << ", \"fast_bhm_same_grid_s\": " << fast_same_s << ", \"bhm_over_fast_bhm\": " << bhm_s / fast_same_s
-    << ", \"query_points_per_s\": " << query_pps << ", \"octomap_resolution\": " << a.octomap_resolution
+    << ", \"bhm_train_s\": " << bhm_s << ", \"bhm_grid\": \"" << bhm_grid.Describe()
+    << "\", \"bhm_scans\": " << scans << ", \"fast_bhm_same_grid_s\": " << fast_same_s
+    << ", \"bhm_over_fast_bhm\": " << bhm_s / fast_same_s
+    << ", \"query_points_per_s\": " << query_pps
+    << ", \"octomap_resolution\": " << a.octomap_resolution
     << ", \"octomap_train_s\": " << octo.insert_s << ", \"octomap_auc\": " << octo.auc
     << ", \"octomap_bytes\": " << octo.bytes << ", \"octomap_memory_bytes\": " << octo.memory
     << ", \"repeats\": " << a.repeats << ", \"checksum\": " << (sink != 0 ? 1 : 0) << "}";
@@ -116,28 +119,34 @@ void RunMapBench(const BenchMapArgs& a) {
     std::cout << j.str() << "\n";
     return;
   }
-  std::cout << "Fast-BHM: trains " << data.train.size() << " points in " << fast_s << " s (AUC " << fast_auc << ", "
-            << fast_bytes << " bytes)\n"
-            << "full BHM: " << bhm_s << " s vs Fast-BHM " << fast_same_s << " s on " << scans << " scans, grid "
-            << bhm_grid.Describe() << " (ratio " << bhm_s / fast_same_s << ")\n"
+  std::cout << "Fast-BHM: trains " << data.train.size() << " points in " << fast_s << " s (AUC "
+            << fast_auc << ", " << fast_bytes << " bytes)\n"
+            << "full BHM: " << bhm_s << " s vs Fast-BHM " << fast_same_s << " s on " << scans
+            << " scans, grid " << bhm_grid.Describe() << " (ratio " << bhm_s / fast_same_s << ")\n"
             << "query (p, gradient, variance): " << query_pps / 1e6 << " M points/s on one thread\n"
-            << "OctoMap " << a.octomap_resolution << " m: inserts in " << octo.insert_s << " s, " << octo.bytes
-            << " bytes serialized, " << octo.memory << " bytes in memory, AUC " << octo.auc << "\n";
+            << "OctoMap " << a.octomap_resolution << " m: inserts in " << octo.insert_s << " s, "
+            << octo.bytes << " bytes serialized, " << octo.memory << " bytes in memory, AUC "
+            << octo.auc << "\n";
 }
 
 }  // namespace
 
 void AddBenchMapCommand(CLI::App* bench) {
   auto a = std::make_shared<BenchMapArgs>();
-  auto* cmd = bench->add_subcommand("map", "occupancy maps: Fast-BHM vs full BHM vs OctoMap, query throughput");
-  cmd->add_option("--config", a->config, "occupancy config (e.g. configs/occupancy/intel.yaml)")->required();
+  auto* cmd = bench->add_subcommand(
+      "map", "occupancy maps: Fast-BHM vs full BHM vs OctoMap, query throughput");
+  cmd->add_option("--config", a->config, "occupancy config (e.g. configs/occupancy/intel.yaml)")
+      ->required();
   cmd->add_option("overrides", a->overrides, "key.path=value overrides of the config");
   cmd->add_flag("--json", a->json, "print one JSON object");
-  cmd->add_option("--repeats", a->repeats, "timed repetitions (median reported)")->check(CLI::Range(1, 100));
+  cmd->add_option("--repeats", a->repeats, "timed repetitions (median reported)")
+      ->check(CLI::Range(1, 100));
   cmd->add_option("--bhm-spacing", a->bhm_spacing, "feature spacing of the full-BHM comparison (m)")
       ->check(CLI::PositiveNumber);
-  cmd->add_option("--bhm-scans", a->bhm_scans, "training scans of the full-BHM comparison")->check(CLI::Range(1, 100000));
-  cmd->add_option("--octomap-resolution", a->octomap_resolution, "OctoMap voxel size (m)")->check(CLI::PositiveNumber);
+  cmd->add_option("--bhm-scans", a->bhm_scans, "training scans of the full-BHM comparison")
+      ->check(CLI::Range(1, 100000));
+  cmd->add_option("--octomap-resolution", a->octomap_resolution, "OctoMap voxel size (m)")
+      ->check(CLI::PositiveNumber);
   cmd->callback([a] { RunMapBench(*a); });
 }
 

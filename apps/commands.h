@@ -2,7 +2,6 @@
 /// Sub-command registration of the `foresight` CLI (each file adds its own sub-commands).
 
 #include <CLI/CLI.hpp>
-
 #include <memory>
 #include <string>
 #include <vector>

@@ -12,7 +12,8 @@
 namespace foresight::app {
 
 void AddDataCommands(CLI::App* app) {
-  auto* data = app->add_subcommand("data", "convert real datasets and generate synthetic ones (HDF5 track store)");
+  auto* data = app->add_subcommand(
+      "data", "convert real datasets and generate synthetic ones (HDF5 track store)");
   data->require_subcommand(1);
 
   struct ConvertArgs {
@@ -24,8 +25,10 @@ void AddDataCommands(CLI::App* app) {
   auto* convert = data->add_subcommand("convert", "convert text tracks to one HDF5 track store");
   convert->add_option("inputs", convert_args->inputs, "input files")->required();
   convert->add_option("-o,--output", convert_args->output, "output .h5")->required();
-  convert->add_option("--format", convert_args->format, "input format")->check(CLI::IsMember({"eth_ucy"}));
-  convert->add_option("--seconds-per-step", convert_args->seconds_per_step, "seconds per frame step")
+  convert->add_option("--format", convert_args->format, "input format")
+      ->check(CLI::IsMember({"eth_ucy"}));
+  convert
+      ->add_option("--seconds-per-step", convert_args->seconds_per_step, "seconds per frame step")
       ->check(CLI::PositiveNumber);
   convert->callback([convert_args] {
     TrackSet all;
@@ -36,7 +39,8 @@ void AddDataCommands(CLI::App* app) {
       for (auto& t : part.tracks) all.tracks.push_back(std::move(t));
     }
     WriteTrackStore(convert_args->output, all);
-    std::cout << convert_args->output << ": " << all.tracks.size() << " tracks, " << all.NumPoints() << " points\n";
+    std::cout << convert_args->output << ": " << all.tracks.size() << " tracks, " << all.NumPoints()
+              << " points\n";
   });
 
   struct GenerateArgs {
@@ -45,16 +49,19 @@ void AddDataCommands(CLI::App* app) {
   };
   auto gen_args = std::make_shared<GenerateArgs>();
   auto* gen = data->add_subcommand("generate", "generate synthetic pedestrian tracks");
-  gen->add_option("overrides", gen_args->overrides, "generator settings key=value (see docs/config_reference.md, data.synthetic)");
+  gen->add_option("overrides", gen_args->overrides,
+                  "generator settings key=value (see docs/config_reference.md, data.synthetic)");
   gen->add_option("-o,--output", gen_args->output, "output .h5")->required();
   gen->add_option("--config", gen_args->config, "YAML file of generator settings");
   gen->callback([gen_args] {
-    const auto cfg = gen_args->config.empty()
-                         ? config::FromYaml<SyntheticPedestrianConfig>(YAML::Node(), "<defaults>", gen_args->overrides)
-                         : config::LoadFile<SyntheticPedestrianConfig>(gen_args->config, gen_args->overrides);
+    const auto cfg = gen_args->config.empty() ? config::FromYaml<SyntheticPedestrianConfig>(
+                                                    YAML::Node(), "<defaults>", gen_args->overrides)
+                                              : config::LoadFile<SyntheticPedestrianConfig>(
+                                                    gen_args->config, gen_args->overrides);
     const TrackSet set = GenerateSyntheticPedestrians(cfg);
     WriteTrackStore(gen_args->output, set);
-    std::cout << gen_args->output << ": " << set.tracks.size() << " tracks, " << set.NumPoints() << " points\n";
+    std::cout << gen_args->output << ": " << set.tracks.size() << " tracks, " << set.NumPoints()
+              << " points\n";
   });
 
   auto info_path = std::make_shared<std::string>();

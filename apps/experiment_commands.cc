@@ -31,11 +31,14 @@ struct EvalArgs {
 void AddExperimentCommands(CLI::App* app, std::shared_ptr<const ExperimentRegistry> registry) {
   auto req = std::make_shared<TrainRequest>();
   auto no_eval = std::make_shared<bool>(false);
-  auto* train = app->add_subcommand("train", "train a model from a YAML config, export it and evaluate it");
-  train->add_option("config", req->config, "config file, or 'default' for the embedded quickstart")->required();
+  auto* train =
+      app->add_subcommand("train", "train a model from a YAML config, export it and evaluate it");
+  train->add_option("config", req->config, "config file, or 'default' for the embedded quickstart")
+      ->required();
   train->add_option("overrides", req->overrides, "key.path=value overrides of the config");
   train->add_option("--run-dir", req->run_dir, "run directory (default runs/<config name>)");
-  train->add_flag("--resume", req->resume, "continue the killed run in --run-dir from its last checkpoint");
+  train->add_flag("--resume", req->resume,
+                  "continue the killed run in --run-dir from its last checkpoint");
   train->add_flag("--no-eval", *no_eval, "stop after export");
   train->callback([registry, req, no_eval] {
     TrainRequest r = *req;
@@ -47,8 +50,11 @@ void AddExperimentCommands(CLI::App* app, std::shared_ptr<const ExperimentRegist
   });
 
   auto export_dir = std::make_shared<std::string>();
-  auto* exp = app->add_subcommand("export", "write RUN_DIR's artifact (model.h5) from its best checkpoint");
-  exp->add_option("run_dir", *export_dir, "run directory")->required()->check(CLI::ExistingDirectory);
+  auto* exp =
+      app->add_subcommand("export", "write RUN_DIR's artifact (model.h5) from its best checkpoint");
+  exp->add_option("run_dir", *export_dir, "run directory")
+      ->required()
+      ->check(CLI::ExistingDirectory);
   exp->callback([registry, export_dir] {
     const ExperimentKind& kind = registry->ForRun(*export_dir);
     if (!kind.export_run) kind.NoSuchStep("export");
@@ -56,9 +62,13 @@ void AddExperimentCommands(CLI::App* app, std::shared_ptr<const ExperimentRegist
   });
 
   auto eargs = std::make_shared<EvalArgs>();
-  auto* eval = app->add_subcommand("eval", "evaluate RUN_DIR's artifact with the run's config; writes RUN_DIR/eval.json");
-  eval->add_option("run_dir", eargs->run_dir, "run directory")->required()->check(CLI::ExistingDirectory);
-  eval->add_option("overrides", eargs->overrides, "key.path=value overrides of the run's config (e.g. data.root=...)");
+  auto* eval = app->add_subcommand(
+      "eval", "evaluate RUN_DIR's artifact with the run's config; writes RUN_DIR/eval.json");
+  eval->add_option("run_dir", eargs->run_dir, "run directory")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  eval->add_option("overrides", eargs->overrides,
+                   "key.path=value overrides of the run's config (e.g. data.root=...)");
   eval->callback([registry, eargs] {
     const ExperimentKind& kind = registry->ForRun(eargs->run_dir);
     if (!kind.evaluate) kind.NoSuchStep("eval");
@@ -68,7 +78,8 @@ void AddExperimentCommands(CLI::App* app, std::shared_ptr<const ExperimentRegist
   auto docs_out = std::make_shared<std::string>();
   auto* docs = app->add_subcommand("docs", "generate reference documentation");
   docs->require_subcommand(1);
-  auto* cfg = docs->add_subcommand("config", "print the config reference (every key of every kind) as Markdown");
+  auto* cfg = docs->add_subcommand(
+      "config", "print the config reference (every key of every kind) as Markdown");
   cfg->add_option("-o,--output", *docs_out, "write to this file instead of stdout");
   cfg->callback([registry, docs_out] {
     const std::string text = registry->ReferenceMarkdown();
@@ -82,12 +93,13 @@ void AddExperimentCommands(CLI::App* app, std::shared_ptr<const ExperimentRegist
     FS_THROW_UNLESS(out.good(), *docs_out, ": cannot write the config reference");
   });
 
-  auto* kinds = app->add_subcommand("kinds", "list the experiment kinds of this build and their steps");
+  auto* kinds =
+      app->add_subcommand("kinds", "list the experiment kinds of this build and their steps");
   kinds->callback([registry] {
     for (const ExperimentKind& k : registry->kinds())
-      std::cout << k.tag << (k.tag_is_prefix ? "*" : "") << "\t" << k.summary << "\tsteps:" << (k.train ? " train" : "")
-                << (k.export_run ? " export" : "") << (k.evaluate ? " eval" : "") << (k.resumable ? " (resumable)" : "")
-                << "\n";
+      std::cout << k.tag << (k.tag_is_prefix ? "*" : "") << "\t" << k.summary
+                << "\tsteps:" << (k.train ? " train" : "") << (k.export_run ? " export" : "")
+                << (k.evaluate ? " eval" : "") << (k.resumable ? " (resumable)" : "") << "\n";
   });
 }
 

@@ -32,18 +32,22 @@ void AddMapCommands(CLI::App* app) {
   map->require_subcommand(1);
 
   auto args = std::make_shared<FuseArgs>();
-  auto* fuse = map->add_subcommand("fuse", "fuse Fast-BHM artifacts of a shared feature grid into one");
-  fuse->add_option("maps", args->inputs, "Fast-BHM artifacts (model.h5 of each robot)")->required()->check(CLI::ExistingFile);
+  auto* fuse =
+      map->add_subcommand("fuse", "fuse Fast-BHM artifacts of a shared feature grid into one");
+  fuse->add_option("maps", args->inputs, "Fast-BHM artifacts (model.h5 of each robot)")
+      ->required()
+      ->check(CLI::ExistingFile);
   fuse->add_option("-o,--output", args->output, "fused artifact to write")->required();
-  fuse->add_option("--base", args->base,
-                   "last global map the inputs were copied from (repeated fusion: merge their increments)")
+  fuse->add_option(
+          "--base", args->base,
+          "last global map the inputs were copied from (repeated fusion: merge their increments)")
       ->check(CLI::ExistingFile);
   fuse->add_option("--variance-threshold", args->threshold,
                    "local weight estimates with a variance at or above this are left out")
       ->check(CLI::PositiveNumber);
   fuse->callback([args] {
-    FS_THROW_UNLESS(std::isfinite(args->threshold) && args->threshold > 0, "--variance-threshold: ", args->threshold,
-                    " is not a finite positive number");
+    FS_THROW_UNLESS(std::isfinite(args->threshold) && args->threshold > 0,
+                    "--variance-threshold: ", args->threshold, " is not a finite positive number");
     for (std::size_t i = 0; i < args->inputs.size(); ++i)
       for (std::size_t j = 0; j < i; ++j)
         FS_THROW_UNLESS(!fs::equivalent(args->inputs[i], args->inputs[j]), args->inputs[i],
@@ -61,18 +65,20 @@ void AddMapCommands(CLI::App* app) {
     // The fused map carries the first input's config (same grid and prior by construction).
     const Artifact first = Artifact::Open(args->inputs[0], "");
     fused.Save(args->output, first.config_yaml(), first.seed());
-    std::cout << "fused " << maps.size() << " maps" << (base ? " (increments over --base)" : "") << " into "
-              << args->output << " (" << fs::file_size(args->output) << " bytes)\n";
+    std::cout << "fused " << maps.size() << " maps" << (base ? " (increments over --base)" : "")
+              << " into " << args->output << " (" << fs::file_size(args->output) << " bytes)\n";
   });
 
   auto path = std::make_shared<std::string>();
-  auto* info = map->add_subcommand("info", "print an occupancy-map artifact's type, extent and size");
+  auto* info =
+      map->add_subcommand("info", "print an occupancy-map artifact's type, extent and size");
   info->add_option("artifact", *path, "map artifact")->required()->check(CLI::ExistingFile);
   info->callback([path] {
     const auto m = LoadOccupancyMap(*path);
     const Eigen::Vector4d e = m->Extent();
-    std::cout << "{\"model_type\": \"" << m->model_type() << "\", \"extent\": [" << e[0] << ", " << e[1] << ", "
-              << e[2] << ", " << e[3] << "], \"bytes\": " << fs::file_size(*path) << "}\n";
+    std::cout << "{\"model_type\": \"" << m->model_type() << "\", \"extent\": [" << e[0] << ", "
+              << e[1] << ", " << e[2] << ", " << e[3] << "], \"bytes\": " << fs::file_size(*path)
+              << "}\n";
   });
 }
 

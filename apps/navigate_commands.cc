@@ -25,14 +25,17 @@ struct NavigateArgs {
 };
 
 void PrintTable(const std::vector<MethodSummary>& rows) {
-  std::cout << std::left << std::setw(12) << "method" << std::right << std::setw(9) << "success" << std::setw(9)
-            << "no-coll" << std::setw(9) << "TTG s" << std::setw(9) << "DOC s" << std::setw(10) << "min gap"
-            << std::setw(11) << "cycle med" << std::setw(11) << "cycle p99" << std::setw(9) << "failed" << "\n";
+  std::cout << std::left << std::setw(12) << "method" << std::right << std::setw(9) << "success"
+            << std::setw(9) << "no-coll" << std::setw(9) << "TTG s" << std::setw(9) << "DOC s"
+            << std::setw(10) << "min gap" << std::setw(11) << "cycle med" << std::setw(11)
+            << "cycle p99" << std::setw(9) << "failed"
+            << "\n";
   std::cout << std::fixed << std::setprecision(2);
   for (const MethodSummary& m : rows)
-    std::cout << std::left << std::setw(12) << m.method << std::right << std::setw(9) << m.success_rate << std::setw(9)
-              << m.collision_free_rate << std::setw(9) << m.ttg_mean << std::setw(9) << m.doc_mean << std::setw(10)
-              << m.min_clearance << std::setw(8) << m.cycle_ms_median << " ms" << std::setw(8) << m.cycle_ms_p99
+    std::cout << std::left << std::setw(12) << m.method << std::right << std::setw(9)
+              << m.success_rate << std::setw(9) << m.collision_free_rate << std::setw(9)
+              << m.ttg_mean << std::setw(9) << m.doc_mean << std::setw(10) << m.min_clearance
+              << std::setw(8) << m.cycle_ms_median << " ms" << std::setw(8) << m.cycle_ms_p99
               << " ms" << std::setw(9) << m.solve_failures << "\n";
   std::cout << std::defaultfloat;
 }
@@ -40,21 +43,30 @@ void PrintTable(const std::vector<MethodSummary>& rows) {
 
 void AddNavigateCommand(CLI::App* app) {
   auto args = std::make_shared<NavigateArgs>();
-  auto* nav = app->add_subcommand("navigate", "run SPAN and the reactive and CL-RRT* baselines through a crowd scenario");
+  auto* nav = app->add_subcommand(
+      "navigate", "run SPAN and the reactive and CL-RRT* baselines through a crowd scenario");
   nav->add_option("config", args->config,
-                  "navigation config (configs/navigation/*.yaml), or 'default' for the embedded configs/navigation/sim1.yaml")
+                  "navigation config (configs/navigation/*.yaml), or 'default' for the embedded "
+                  "configs/navigation/sim1.yaml")
       ->required();
   nav->add_option("overrides", args->overrides, "key.path=value overrides of the config");
-  nav->add_option("--run-dir", args->run_dir, "run directory (default runs/navigate_<config name>)");
-  nav->add_option("--episodes", args->episodes, "episodes per method (default: the config's)")->check(CLI::Range(1, 100000));
+  nav->add_option("--run-dir", args->run_dir,
+                  "run directory (default runs/navigate_<config name>)");
+  nav->add_option("--episodes", args->episodes, "episodes per method (default: the config's)")
+      ->check(CLI::Range(1, 100000));
   nav->callback([args] {
     const bool embedded = args->config == "default";
     const NavigationExperimentConfig c =
-        embedded ? config::ExperimentConfigFromYaml<NavigationExperimentConfig>(kEmbeddedNavigationConfig, "<embedded configs/navigation/sim1.yaml>", args->overrides)
-                 : config::LoadExperimentConfig<NavigationExperimentConfig>(args->config, args->overrides);
-    const std::string out = !args->run_dir.empty()
-                                ? args->run_dir
-                                : "runs/navigate_" + (embedded ? std::string("sim1") : fs::path(args->config).stem().string());
+        embedded ? config::ExperimentConfigFromYaml<NavigationExperimentConfig>(
+                       kEmbeddedNavigationConfig, "<embedded configs/navigation/sim1.yaml>",
+                       args->overrides)
+                 : config::LoadExperimentConfig<NavigationExperimentConfig>(args->config,
+                                                                            args->overrides);
+    const std::string out =
+        !args->run_dir.empty()
+            ? args->run_dir
+            : "runs/navigate_" +
+                  (embedded ? std::string("sim1") : fs::path(args->config).stem().string());
     StartRunDirectory(out, config::ToYaml(c), false, kNavigationRunRules);
     const bool needs_predictor = c.Uses(NavigationMethod::kSpan);
     if (needs_predictor && !fs::exists(c.predictor.artifact)) {
@@ -62,12 +74,13 @@ void AddNavigateCommand(CLI::App* app) {
       EnsureNavigationPredictor(c, kEmbeddedNavigationPredictorConfig);
 #else
       Fail("predictor.artifact: ", c.predictor.artifact,
-           " not found; this build has no LibTorch to train it (train it with a LibTorch build first)");
+           " not found; this build has no LibTorch to train it (train it with a LibTorch build "
+           "first)");
 #endif
     }
     const int episodes = args->episodes > 0 ? args->episodes : c.episodes;
-    std::cout << "navigating " << c.scenario.name << ": " << episodes << " episodes x " << c.methods.size()
-              << " methods -> " << out << "\n";
+    std::cout << "navigating " << c.scenario.name << ": " << episodes << " episodes x "
+              << c.methods.size() << " methods -> " << out << "\n";
     const std::vector<MethodSummary> rows = RunNavigation(c, out, episodes);
     PrintTable(rows);
     std::cout << "wrote " << out << "/summary.json, episodes.csv, paths.png"

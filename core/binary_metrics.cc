@@ -17,14 +17,15 @@ std::vector<std::size_t> SortedByScoreDescending(const std::vector<double>& scor
     FS_THROW_UNLESS(!std::isnan(scores[i]), "binary metrics: score ", i, " is NaN");
   std::vector<std::size_t> order(scores.size());
   std::iota(order.begin(), order.end(), std::size_t{0});
-  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return scores[a] > scores[b]; });
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t a, std::size_t b) { return scores[a] > scores[b]; });
   return order;
 }
 
 }  // namespace
 
-BinaryMetrics EvaluateBinary(const std::vector<double>& scores, const std::vector<std::uint8_t>& labels,
-                             double threshold) {
+BinaryMetrics EvaluateBinary(const std::vector<double>& scores,
+                             const std::vector<std::uint8_t>& labels, double threshold) {
   const std::vector<std::size_t> order = SortedByScoreDescending(scores, labels);
   BinaryMetrics m;
   for (const auto l : labels) (l ? m.positives : m.negatives) += 1;
@@ -58,8 +59,10 @@ BinaryMetrics EvaluateBinary(const std::vector<double>& scores, const std::vecto
 }
 
 std::vector<std::pair<double, double>> RocCurve(const std::vector<double>& scores,
-                                                const std::vector<std::uint8_t>& labels, int max_points) {
-  FS_THROW_UNLESS(max_points >= 2, "ROC curve: max_points ", max_points, " must be at least 2 (both endpoints)");
+                                                const std::vector<std::uint8_t>& labels,
+                                                int max_points) {
+  FS_THROW_UNLESS(max_points >= 2, "ROC curve: max_points ", max_points,
+                  " must be at least 2 (both endpoints)");
   const std::vector<std::size_t> order = SortedByScoreDescending(scores, labels);
   std::int64_t pos = 0, neg = 0;
   for (const auto l : labels) (l ? pos : neg) += 1;

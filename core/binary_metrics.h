@@ -17,8 +17,8 @@ struct BinaryMetrics {
 /// @param scores [n] classifier outputs (higher = more likely positive); NaN is an Error.
 /// @param labels [n] 1 = positive, 0 = negative. Both classes must be present (else Error).
 /// @param threshold predicted positive when score >= threshold.
-BinaryMetrics EvaluateBinary(const std::vector<double>& scores, const std::vector<std::uint8_t>& labels,
-                             double threshold = 0.5);
+BinaryMetrics EvaluateBinary(const std::vector<double>& scores,
+                             const std::vector<std::uint8_t>& labels, double threshold = 0.5);
 
 /// ROC curve as (false positive rate, true positive rate) points, at most `max_points` of them
 /// (evenly thinned; max_points >= 2, else Error), from (0, 0) to (1, 1).

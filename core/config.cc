@@ -1,10 +1,10 @@
 #include "core/config.h"
 
 #include <cstdlib>
-#include <fstream>
-#include <map>
 #include <filesystem>
+#include <fstream>
 #include <iomanip>
+#include <map>
 
 namespace foresight::config {
 
@@ -40,10 +40,14 @@ std::optional<YAML::Node> YamlReader::Take(const char* key) {
 void YamlReader::FailAt(const std::string& path, const YAML::Node& node,
                         const std::string& expected) const {
   std::string text;
-  if (node.IsScalar()) text = "'" + node.Scalar() + "'";
-  else if (node.IsSequence()) text = "a list";
-  else if (node.IsMap()) text = "a mapping";
-  else text = "nothing";
+  if (node.IsScalar())
+    text = "'" + node.Scalar() + "'";
+  else if (node.IsSequence())
+    text = "a list";
+  else if (node.IsMap())
+    text = "a mapping";
+  else
+    text = "nothing";
   std::string where = source_;
   if (node.Mark().line >= 0 && source_.rfind('<', 0) != 0)
     where += ":" + std::to_string(node.Mark().line + 1);
@@ -60,8 +64,8 @@ void YamlReader::CheckNoUnknownKeys() const {
       std::string where = source_;
       if (kv.first.Mark().line >= 0 && source_.rfind('<', 0) != 0)
         where += ":" + std::to_string(kv.first.Mark().line + 1);
-      Fail(where, ": unknown key '", internal::JoinPath(prefix_, key), "' (known keys here: ", known,
-           ")");
+      Fail(where, ": unknown key '", internal::JoinPath(prefix_, key),
+           "' (known keys here: ", known, ")");
     }
   }
 }
@@ -86,7 +90,8 @@ std::string YamlWriter::FormatDouble(double v) {
 }
 
 namespace {
-// yaml-cpp's Node::operator= assigns through the handle, so walk by recursion (copy-construct only).
+// yaml-cpp's Node::operator= assigns through the handle, so walk by recursion (copy-construct
+// only).
 void SetPath(YAML::Node node, const std::vector<std::string>& keys, std::size_t i,
              const YAML::Node& value, const std::string& assignment) {
   // `name[k]`: element k of an existing list of mappings (e.g. groups[0].count=5).
@@ -100,8 +105,8 @@ void SetPath(YAML::Node node, const std::vector<std::string>& keys, std::size_t 
     YAML::Node list = node[name];
     FS_THROW_UNLESS(list.IsSequence(), "override '", assignment, "': '", name,
                     "' is not a list in the config");
-    FS_THROW_UNLESS(static_cast<std::size_t>(*index) < list.size(), "override '", assignment, "': '",
-                    name, "' has ", list.size(), " elements, no index ", *index);
+    FS_THROW_UNLESS(static_cast<std::size_t>(*index) < list.size(), "override '", assignment,
+                    "': '", name, "' has ", list.size(), " elements, no index ", *index);
     if (i + 1 == keys.size()) {
       list[static_cast<std::size_t>(*index)] = value;
       return;
@@ -156,8 +161,8 @@ void RefuseDuplicateKeys(const YAML::Node& node, const std::string& source) {
       const std::string key = item.first.Scalar();
       const int line = item.first.Mark().line + 1;
       const auto [it, inserted] = seen.emplace(key, line);
-      FS_THROW_UNLESS(inserted, source, ":", line, ": key '", key, "' is repeated (first at line ", it->second,
-                      "); give each key once");
+      FS_THROW_UNLESS(inserted, source, ":", line, ": key '", key, "' is repeated (first at line ",
+                      it->second, "); give each key once");
     }
     RefuseDuplicateKeys(item.second, source);
   }
@@ -180,15 +185,17 @@ YAML::Node LoadYamlFile(const std::string& path) {
   constexpr std::uintmax_t kMaxConfigBytes = 1 << 20;
   std::error_code ec;
   const std::uintmax_t bytes = std::filesystem::file_size(path, ec);
-  FS_THROW_UNLESS(!ec || !std::filesystem::exists(path), path, ": cannot read config file (", ec.message(), ")");
-  FS_THROW_UNLESS(ec || bytes <= kMaxConfigBytes, path, ": config file has ", bytes, " bytes; at most ",
-                  kMaxConfigBytes, " are accepted");
+  FS_THROW_UNLESS(!ec || !std::filesystem::exists(path), path, ": cannot read config file (",
+                  ec.message(), ")");
+  FS_THROW_UNLESS(ec || bytes <= kMaxConfigBytes, path, ": config file has ", bytes,
+                  " bytes; at most ", kMaxConfigBytes, " are accepted");
   std::ifstream in(path);
   FS_THROW_UNLESS(in.good(), path, ": cannot open config file");
   std::stringstream ss;
   ss << in.rdbuf();
   const YAML::Node node = ParseYaml(ss.str(), path);
-  FS_THROW_UNLESS(node && !node.IsNull(), path, ": config file is empty; a config names at least its 'model'");
+  FS_THROW_UNLESS(node && !node.IsNull(), path,
+                  ": config file is empty; a config names at least its 'model'");
   return node;
 }
 

@@ -73,10 +73,14 @@ struct IsStructVector<std::vector<S>> : IsStruct<S> {};
 
 template <typename T>
 const char* TypeName() {
-  if constexpr (std::is_same_v<T, bool>) return "bool";
-  else if constexpr (std::is_integral_v<T>) return "integer";
-  else if constexpr (std::is_floating_point_v<T>) return "number";
-  else return "string";
+  if constexpr (std::is_same_v<T, bool>)
+    return "bool";
+  else if constexpr (std::is_integral_v<T>)
+    return "integer";
+  else if constexpr (std::is_floating_point_v<T>)
+    return "number";
+  else
+    return "string";
 }
 std::string JoinPath(const std::string& prefix, const std::string& key);
 }  // namespace internal
@@ -115,12 +119,13 @@ class YamlReader {
       }
       *value = std::move(out);
     } else if constexpr (IsVector<T>::value) {
-      if (!child.IsSequence()) FailAt(path, child, std::string("a list of ") +
-                                                       internal::TypeName<typename T::value_type>());
+      if (!child.IsSequence())
+        FailAt(path, child,
+               std::string("a list of ") + internal::TypeName<typename T::value_type>());
       T out;
       for (std::size_t i = 0; i < child.size(); ++i) {
-        out.push_back(ReadScalar<typename T::value_type>(child[i], path + "[" + std::to_string(i) + "]",
-                                                         range));
+        out.push_back(ReadScalar<typename T::value_type>(
+            child[i], path + "[" + std::to_string(i) + "]", range));
       }
       *value = std::move(out);
     } else {
@@ -169,9 +174,12 @@ class YamlReader {
       v = n.Scalar();
     } else if constexpr (std::is_same_v<T, bool>) {
       const std::string& s = n.Scalar();
-      if (s == "true" || s == "True") v = true;
-      else if (s == "false" || s == "False") v = false;
-      else FailAt(path, n, "true or false");
+      if (s == "true" || s == "True")
+        v = true;
+      else if (s == "false" || s == "False")
+        v = false;
+      else
+        FailAt(path, n, "true or false");
     } else if constexpr (std::is_integral_v<T>) {
       const std::optional<long long> maybe = ParseInteger(n.Scalar());
       if (!maybe) FailAt(path, n, ExpectText<T>(range));
@@ -271,7 +279,8 @@ class DocCollector {
       DocCollector sub(rows_, path);
       value->Serialize(&sub);
     } else if constexpr (internal::IsStructVector<T>::value) {
-      // The list itself, then the fields of one element (defaults of a default element) as key[].field.
+      // The list itself, then the fields of one element (defaults of a default element) as
+      // key[].field.
       const std::string def = value->empty() ? "[]" : std::to_string(value->size()) + " entries";
       rows_->push_back({path, "list of mapping", def, "", doc});
       typename T::value_type element{};
@@ -287,10 +296,14 @@ class DocCollector {
       std::string text = e.c_str();  // "{v: ...}"
       text = text.size() > 5 ? text.substr(4, text.size() - 5) : "";
       std::string type;
-      if constexpr (std::is_same_v<T, std::vector<double>>) type = "list of number";
-      else if constexpr (std::is_same_v<T, std::vector<std::string>>) type = "list of string";
-      else if constexpr (std::is_same_v<T, std::vector<int>>) type = "list of integer";
-      else type = internal::TypeName<T>();
+      if constexpr (std::is_same_v<T, std::vector<double>>)
+        type = "list of number";
+      else if constexpr (std::is_same_v<T, std::vector<std::string>>)
+        type = "list of string";
+      else if constexpr (std::is_same_v<T, std::vector<int>>)
+        type = "list of integer";
+      else
+        type = internal::TypeName<T>();
       rows_->push_back({path, type, text, range.Describe(), doc});
     }
   }
@@ -381,8 +394,9 @@ std::string ReferenceTable() {
   std::ostringstream os;
   os << "| key | type | default | allowed | description |\n|---|---|---|---|---|\n";
   for (const auto& r : rows)
-    os << "| `" << r.path << "` | " << r.type << " | " << (r.default_value.empty() ? "" : "`" + r.default_value + "`")
-       << " | " << r.allowed << " | " << r.doc << " |\n";
+    os << "| `" << r.path << "` | " << r.type << " | "
+       << (r.default_value.empty() ? "" : "`" + r.default_value + "`") << " | " << r.allowed
+       << " | " << r.doc << " |\n";
   return os.str();
 }
 

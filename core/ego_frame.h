@@ -5,7 +5,8 @@
 /// Origin: the last observed point. x axis: along the displacement from the first to the last
 /// observed point (identity rotation when `rotate` is false or the displacement is below 1 mm).
 /// A trajectory distribution predicted in the ego frame maps to the world exactly:
-///   W_world = W_ego R',  V_world = R V_ego R',  U unchanged,  o_world(t) = origin + W_world' phi(t).
+///   W_world = W_ego R',  V_world = R V_ego R',  U unchanged,  o_world(t) = origin + W_world'
+///   phi(t).
 
 #include <Eigen/Core>
 #include <cmath>

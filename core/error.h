@@ -32,7 +32,7 @@ template <typename... Args>
 }  // namespace foresight
 
 /// Throws foresight::Error(message...) unless `cond` holds. Use for user input, not invariants.
-#define FS_THROW_UNLESS(cond, ...)                 \
-  do {                                             \
-    if (!(cond)) ::foresight::Fail(__VA_ARGS__);   \
+#define FS_THROW_UNLESS(cond, ...)               \
+  do {                                           \
+    if (!(cond)) ::foresight::Fail(__VA_ARGS__); \
   } while (0)

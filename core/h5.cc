@@ -44,13 +44,21 @@ class Handle {
 template <typename T>
 hid_t MemType();
 template <>
-hid_t MemType<double>() { return H5T_NATIVE_DOUBLE; }
+hid_t MemType<double>() {
+  return H5T_NATIVE_DOUBLE;
+}
 template <>
-hid_t MemType<float>() { return H5T_NATIVE_FLOAT; }
+hid_t MemType<float>() {
+  return H5T_NATIVE_FLOAT;
+}
 template <>
-hid_t MemType<std::int64_t>() { return H5T_NATIVE_INT64; }
+hid_t MemType<std::int64_t>() {
+  return H5T_NATIVE_INT64;
+}
 template <>
-hid_t MemType<std::uint8_t>() { return H5T_NATIVE_UINT8; }
+hid_t MemType<std::uint8_t>() {
+  return H5T_NATIVE_UINT8;
+}
 
 std::string ObjectName(const std::string& object) { return object.empty() ? "/" : object; }
 
@@ -109,7 +117,6 @@ void File::CloseQuietly() noexcept {
   }
 }
 
-
 void File::Close() {
   if (id_ < 0) return;
   const hid_t id = id_;
@@ -163,8 +170,8 @@ std::vector<std::string> File::List(const std::string& group) const {
   FS_THROW_UNLESS(H5Gget_info(g.get(), &info) >= 0, path_, ": cannot read group '", group, "'");
   std::vector<std::string> names;
   for (hsize_t i = 0; i < info.nlinks; ++i) {
-    ssize_t n = H5Lget_name_by_idx(g.get(), ".", H5_INDEX_NAME, H5_ITER_INC, i, nullptr, 0,
-                                   H5P_DEFAULT);
+    ssize_t n =
+        H5Lget_name_by_idx(g.get(), ".", H5_INDEX_NAME, H5_ITER_INC, i, nullptr, 0, H5P_DEFAULT);
     if (n < 0) continue;
     std::string name(static_cast<std::size_t>(n), '\0');
     H5Lget_name_by_idx(g.get(), ".", H5_INDEX_NAME, H5_ITER_INC, i, name.data(), name.size() + 1,
@@ -261,8 +268,8 @@ std::string File::GetStringAttr(const std::string& object, const std::string& na
 std::int64_t File::GetIntAttr(const std::string& object, const std::string& name) const {
   Handle attr = OpenAttr(id_, path_, object, name);
   Handle type(H5Aget_type(attr.get()), H5Tclose);
-  FS_THROW_UNLESS(H5Tget_class(type.get()) == H5T_INTEGER, path_, ": attribute '", name,
-                  "' on '", object, "' is not an integer");
+  FS_THROW_UNLESS(H5Tget_class(type.get()) == H5T_INTEGER, path_, ": attribute '", name, "' on '",
+                  object, "' is not an integer");
   std::int64_t v = 0;
   FS_THROW_UNLESS(H5Aread(attr.get(), H5T_NATIVE_INT64, &v) >= 0, path_,
                   ": cannot read attribute '", name, "'");
@@ -335,9 +342,9 @@ Array<T> ReadRaw(hid_t file, const std::string& path, const std::string& name,
   }
   out.data.resize(count);
   if (count > 0)
-    FS_THROW_UNLESS(H5Dread(ds.get(), MemType<T>(), H5S_ALL, H5S_ALL, H5P_DEFAULT,
-                            out.data.data()) >= 0,
-                    path, ": cannot read dataset '", name, "' (file truncated or corrupt?)");
+    FS_THROW_UNLESS(
+        H5Dread(ds.get(), MemType<T>(), H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data.data()) >= 0, path,
+        ": cannot read dataset '", name, "' (file truncated or corrupt?)");
   return out;
 }
 
@@ -357,11 +364,13 @@ Matrix ToMatrix(const Array<T>& a, const std::string& path, const std::string& n
 }
 }  // namespace
 
-void File::Write(const std::string& name, const double* data, const std::vector<std::size_t>& shape) {
+void File::Write(const std::string& name, const double* data,
+                 const std::vector<std::size_t>& shape) {
   EnsureParentGroups(name);
   WriteRaw(id_, path_, name, data, shape);
 }
-void File::Write(const std::string& name, const float* data, const std::vector<std::size_t>& shape) {
+void File::Write(const std::string& name, const float* data,
+                 const std::vector<std::size_t>& shape) {
   EnsureParentGroups(name);
   WriteRaw(id_, path_, name, data, shape);
 }
@@ -384,13 +393,13 @@ void File::WriteString(const std::string& name, const std::string& text) {
   H5Tset_strpad(type.get(), H5T_STR_NULLPAD);
   Handle space(H5Screate(H5S_SCALAR), H5Sclose);
   if (H5Lexists(id_, name.c_str(), H5P_DEFAULT) > 0) H5Ldelete(id_, name.c_str(), H5P_DEFAULT);
-  Handle ds(H5Dcreate2(id_, name.c_str(), type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT,
-                       H5P_DEFAULT),
-            H5Dclose);
+  Handle ds(
+      H5Dcreate2(id_, name.c_str(), type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+      H5Dclose);
   std::string padded = text.empty() ? std::string(1, '\0') : text;
-  FS_THROW_UNLESS(ds.ok() && H5Dwrite(ds.get(), type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT,
-                                      padded.data()) >= 0,
-                  path_, ": cannot write string dataset '", name, "'");
+  FS_THROW_UNLESS(
+      ds.ok() && H5Dwrite(ds.get(), type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, padded.data()) >= 0,
+      path_, ": cannot write string dataset '", name, "'");
 }
 
 std::string File::ReadString(const std::string& name) const {

@@ -3,7 +3,6 @@
 /// Every failure throws foresight::Error naming the file and the object.
 
 #include <Eigen/Core>
-
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -55,7 +54,8 @@ class File {
   void Write(const std::string& name, const float* data, const std::vector<std::size_t>& shape);
   void Write(const std::string& name, const std::int64_t* data,
              const std::vector<std::size_t>& shape);
-  void Write(const std::string& name, const std::uint8_t* data, const std::vector<std::size_t>& shape);
+  void Write(const std::string& name, const std::uint8_t* data,
+             const std::vector<std::size_t>& shape);
   void WriteString(const std::string& name, const std::string& text);
 
   Array<double> ReadDouble(const std::string& name) const;

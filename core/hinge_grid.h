@@ -8,7 +8,6 @@
 /// needs one exponential per nearby row and column instead of one per feature.
 
 #include <Eigen/Core>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -19,7 +18,8 @@
 namespace foresight {
 
 struct HingeGridConfig {
-  double x_min = -20, x_max = 20;  ///< m; inducing x = x_min + i * spacing, i < round((x_max - x_min) / spacing)
+  double x_min = -20,
+         x_max = 20;  ///< m; inducing x = x_min + i * spacing, i < round((x_max - x_min) / spacing)
   double y_min = -25, y_max = 10;  ///< m; likewise in y
   double spacing = 0.5;            ///< m between neighbouring inducing points
   double gamma = 6.71;             ///< 1/m^2, kernel exp(-gamma d^2)
@@ -31,7 +31,8 @@ struct HingeGridConfig {
     a->Visit("x_max", &x_max, config::Range::Any(), "end of the inducing x range, exclusive (m)");
     a->Visit("y_min", &y_min, config::Range::Any(), "first inducing y (m)");
     a->Visit("y_max", &y_max, config::Range::Any(), "end of the inducing y range, exclusive (m)");
-    a->Visit("spacing", &spacing, config::Range::Positive(), "distance between inducing points (m)");
+    a->Visit("spacing", &spacing, config::Range::Positive(),
+             "distance between inducing points (m)");
     a->Visit("gamma", &gamma, config::Range::Positive(), "RBF kernel exp(-gamma d^2) (1/m^2)");
     a->Visit("cutoff_radius", &cutoff_radius, config::Range::Positive(),
              "features of inducing points farther than this are zero (m)");
@@ -53,7 +54,8 @@ class HingeGrid {
   /// Upper bound on the number of non-zero features of one point.
   int max_active() const { return window_ * window_; }
   Eigen::Vector2d Centre(int t) const {
-    return {config_.x_min + (t % nx_) * config_.spacing, config_.y_min + (t / nx_) * config_.spacing};
+    return {config_.x_min + (t % nx_) * config_.spacing,
+            config_.y_min + (t / nx_) * config_.spacing};
   }
   /// True when two grids give identical features (same inducing points, gamma and cut-off).
   bool SameFeatures(const HingeGrid& other) const;
@@ -76,8 +78,8 @@ class HingeGrid {
 
   HingeGridConfig config_;
   int nx_ = 0, ny_ = 0;
-  int window_ = 0;         ///< inducing points per axis within the cut-off
-  double cutoff2_ = 0;     ///< cutoff_radius^2
+  int window_ = 0;      ///< inducing points per axis within the cut-off
+  double cutoff2_ = 0;  ///< cutoff_radius^2
 };
 
 template <bool kGradient>
@@ -90,8 +92,10 @@ int HingeGrid::Visit(double x, double y, int* idx, double* phi, double* gx, doub
   const double lo_y = std::ceil(fy - r / s), hi_y = std::floor(fy + r / s);
   // Off the grid: return before casting, since far points (|x| / s > 2^31) overflow an int.
   if (!(hi_x >= 0 && lo_x <= nx_ - 1 && hi_y >= 0 && lo_y <= ny_ - 1)) return 0;
-  const int ix0 = std::max(0, static_cast<int>(lo_x)), ix1 = std::min(nx_ - 1, static_cast<int>(hi_x));
-  const int iy0 = std::max(0, static_cast<int>(lo_y)), iy1 = std::min(ny_ - 1, static_cast<int>(hi_y));
+  const int ix0 = std::max(0, static_cast<int>(lo_x)),
+            ix1 = std::min(nx_ - 1, static_cast<int>(hi_x));
+  const int iy0 = std::max(0, static_cast<int>(lo_y)),
+            iy1 = std::min(ny_ - 1, static_cast<int>(hi_y));
   // Row and column factors (window_ is small: at most 2 r / s + 1 entries each).
   constexpr int kMaxWindow = 64;
   double ex[kMaxWindow], dx[kMaxWindow], ey[kMaxWindow], dy[kMaxWindow];

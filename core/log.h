@@ -16,10 +16,16 @@ void SetStderrLevel(Level level);
 void Write(Level level, const std::string& message);
 
 template <typename... Args>
-void Info(const Args&... args) { Write(Level::kInfo, foresight::internal::Concat(args...)); }
+void Info(const Args&... args) {
+  Write(Level::kInfo, foresight::internal::Concat(args...));
+}
 template <typename... Args>
-void Warn(const Args&... args) { Write(Level::kWarn, foresight::internal::Concat(args...)); }
+void Warn(const Args&... args) {
+  Write(Level::kWarn, foresight::internal::Concat(args...));
+}
 template <typename... Args>
-void Debug(const Args&... args) { Write(Level::kDebug, foresight::internal::Concat(args...)); }
+void Debug(const Args&... args) {
+  Write(Level::kDebug, foresight::internal::Concat(args...));
+}
 
 }  // namespace foresight::log

@@ -14,8 +14,7 @@ double MatrixNormal::LogPdf(const Eigen::MatrixXd& w) const {
   const Eigen::MatrixXd d = w - mean;
   // A = L_U^-1 D, B = A L_V^-T  =>  tr[V^-1 D' U^-1 D] = ||B||_F^2.
   const Eigen::MatrixXd a = chol_u.triangularView<Eigen::Lower>().solve(d);
-  const Eigen::MatrixXd b =
-      chol_v.triangularView<Eigen::Lower>().solve(a.transpose()).transpose();
+  const Eigen::MatrixXd b = chol_v.triangularView<Eigen::Lower>().solve(a.transpose()).transpose();
   const double log_det_u = 2.0 * chol_u.diagonal().array().log().sum();
   const double log_det_v = 2.0 * chol_v.diagonal().array().log().sum();
   return -0.5 * b.squaredNorm() - m * std::log(2.0 * M_PI) - 0.5 * m * log_det_v - log_det_u;
@@ -50,11 +49,13 @@ double MatrixNormalMixture::LogPdf(const Eigen::MatrixXd& w) const {
   return LogSumExp(terms);
 }
 
-double LogGaussian2(const Eigen::Vector2d& x, const Eigen::Vector2d& mu, const Eigen::Matrix2d& cov) {
+double LogGaussian2(const Eigen::Vector2d& x, const Eigen::Vector2d& mu,
+                    const Eigen::Matrix2d& cov) {
   const double det = cov(0, 0) * cov(1, 1) - cov(0, 1) * cov(1, 0);
   const Eigen::Vector2d d = x - mu;
   const double q = (d[0] * (cov(1, 1) * d[0] - cov(0, 1) * d[1]) +
-                    d[1] * (-cov(1, 0) * d[0] + cov(0, 0) * d[1])) / det;
+                    d[1] * (-cov(1, 0) * d[0] + cov(0, 0) * d[1])) /
+                   det;
   return -0.5 * q - std::log(2.0 * M_PI) - 0.5 * std::log(det);
 }
 

@@ -35,7 +35,8 @@ struct MatrixNormalMixture {
 };
 
 /// log N(x; mu, Sigma) for a 2-d Gaussian.
-double LogGaussian2(const Eigen::Vector2d& x, const Eigen::Vector2d& mu, const Eigen::Matrix2d& cov);
+double LogGaussian2(const Eigen::Vector2d& x, const Eigen::Vector2d& mu,
+                    const Eigen::Matrix2d& cov);
 
 /// log(sum exp(v)) computed stably.
 double LogSumExp(const Eigen::VectorXd& v);

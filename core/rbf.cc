@@ -11,8 +11,10 @@ TimeBasis::TimeBasis(int num_centres, double t_begin, double t_end, double gamma
   FS_THROW_UNLESS(num_centres >= 1, "TimeBasis: num_centres must be >= 1, got ", num_centres);
   FS_THROW_UNLESS(gamma > 0 && std::isfinite(gamma), "TimeBasis: gamma must be > 0, got ", gamma);
   FS_THROW_UNLESS(t_end >= t_begin, "TimeBasis: t_end ", t_end, " < t_begin ", t_begin);
-  if (num_centres == 1) centres_ = Eigen::VectorXd::Constant(1, 0.5 * (t_begin + t_end));
-  else centres_ = Eigen::VectorXd::LinSpaced(num_centres, t_begin, t_end);
+  if (num_centres == 1)
+    centres_ = Eigen::VectorXd::Constant(1, 0.5 * (t_begin + t_end));
+  else
+    centres_ = Eigen::VectorXd::LinSpaced(num_centres, t_begin, t_end);
 }
 
 TimeBasis::TimeBasis(Eigen::VectorXd centres, double gamma)

@@ -41,7 +41,8 @@ class TimeBasis {
   double gamma_ = 1.0;
 };
 
-/// Precomputed ridge solver for a fixed set of sample times: W = S Y with S = (P'P + lambda I)^-1 P'.
+/// Precomputed ridge solver for a fixed set of sample times: W = S Y with S = (P'P + lambda I)^-1
+/// P'.
 class RidgeProjector {
  public:
   RidgeProjector(const TimeBasis& basis, const Eigen::VectorXd& times, double lambda);

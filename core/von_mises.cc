@@ -25,8 +25,8 @@ constexpr double kNormalSamplerKappa = 1e6;
 ///   I0(k) = sum_j (k^2/4)^j / (j!)^2,   I1(k) = (k/2) sum_j (k^2/4)^j / (j! (j+1)!).
 void SeriesScaled(double kappa, double* i0e, double* i1e) {
   const double q = 0.25 * kappa * kappa;
-  double t0 = 1.0, s0 = 1.0;   // term and sum of I0
-  double t1 = 1.0, s1 = 1.0;   // of I1 / (k/2)
+  double t0 = 1.0, s0 = 1.0;  // term and sum of I0
+  double t1 = 1.0, s1 = 1.0;  // of I1 / (k/2)
   for (int j = 1; j < 500; ++j) {
     t0 *= q / (static_cast<double>(j) * j);
     t1 *= q / (static_cast<double>(j) * (j + 1));
@@ -126,7 +126,10 @@ double InverseA1(double r) {
   for (int it = 0; it < 200; ++it) {
     const double f = BesselRatioA1(k) - r;
     if (f == 0) break;
-    if (f < 0) lo = k; else hi = k;
+    if (f < 0)
+      lo = k;
+    else
+      hi = k;
     const double step = f / BesselRatioA1Derivative(k);
     double next = k - step;
     if (!(next > lo && next < hi)) next = lo > 0 ? std::sqrt(lo * hi) : 0.5 * hi;
@@ -197,7 +200,8 @@ double SampleVonMises(double mu, double kappa, std::mt19937_64* rng) {
 VonMisesFit FitVonMises(const Eigen::Ref<const Eigen::VectorXd>& theta,
                         const Eigen::Ref<const Eigen::VectorXd>& weight) {
   FS_THROW_UNLESS(theta.size() == weight.size() && theta.size() > 0, "FitVonMises: theta [",
-                  theta.size(), "] and weight [", weight.size(), "] must have the same positive size");
+                  theta.size(), "] and weight [", weight.size(),
+                  "] must have the same positive size");
   double c = 0, s = 0, w = 0;
   for (Eigen::Index i = 0; i < theta.size(); ++i) {
     FS_THROW_UNLESS(weight[i] >= 0 && std::isfinite(weight[i]), "FitVonMises: weight ", i, " is ",

@@ -10,7 +10,8 @@ namespace foresight {
 
 /// theta wrapped to [-pi, pi).
 double WrapAngle(double theta);
-/// log I0(kappa) for kappa >= 0, finite for any finite kappa (exponentially scaled form above ~700).
+/// log I0(kappa) for kappa >= 0, finite for any finite kappa (exponentially scaled form above
+/// ~700).
 double LogBesselI0(double kappa);
 /// log I0(kappa) - kappa = log of the exponentially scaled Bessel function (errata ch 4): finite
 /// for every finite kappa >= 0, -> -0.5 log(2 pi kappa) as kappa -> inf. Negative or NaN kappa is
@@ -53,7 +54,9 @@ struct VonMisesMixtureBatch {
 /// AL = mean_n p(theta_n) (density, 1/rad), MRE = mean_n min_r |wrap(theta_n - mu_r)| (rad).
 /// MRE uses the wrapped angular difference (the thesis prints |theta - mu|; on the circle the
 /// difference must be wrapped, see the code note).
-double AverageLikelihood(const VonMisesMixtureBatch& mixtures, const Eigen::Ref<const Eigen::VectorXd>& theta);
-double MinimumRotationError(const VonMisesMixtureBatch& mixtures, const Eigen::Ref<const Eigen::VectorXd>& theta);
+double AverageLikelihood(const VonMisesMixtureBatch& mixtures,
+                         const Eigen::Ref<const Eigen::VectorXd>& theta);
+double MinimumRotationError(const VonMisesMixtureBatch& mixtures,
+                            const Eigen::Ref<const Eigen::VectorXd>& theta);
 
 }  // namespace foresight

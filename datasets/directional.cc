@@ -41,9 +41,9 @@ struct SampleColumns {
 
 void LogStats(const std::string& path, const DirectionalReadStats& s) {
   log::Info(path, ": ", s.kept, " direction samples from ", s.points, " points in ", s.tracks,
-            " tracks (no heading at ", s.first_points, " track starts; dropped ", s.dropped_standing,
-            " standing, ", s.dropped_jump, " jumps, ", s.dropped_gap, " after gaps, ",
-            s.dropped_short_track, " in short tracks)");
+            " tracks (no heading at ", s.first_points, " track starts; dropped ",
+            s.dropped_standing, " standing, ", s.dropped_jump, " jumps, ", s.dropped_gap,
+            " after gaps, ", s.dropped_short_track, " in short tracks)");
 }
 
 std::string Trim(const std::string& text) {
@@ -91,7 +91,8 @@ std::vector<PixelPoint> ParseTrackLine(const std::string& text, const std::strin
   std::size_t start = 0;
   for (;;) {
     const std::size_t end = inner.find("];[", start);
-    const std::string item = inner.substr(start, end == std::string::npos ? std::string::npos : end - start);
+    const std::string item =
+        inner.substr(start, end == std::string::npos ? std::string::npos : end - start);
     std::istringstream fields(item);
     std::vector<std::string> f;
     for (std::string w; fields >> w;) f.push_back(w);
@@ -125,8 +126,8 @@ DirectionalSamples DirectionalSamples::Select(const std::vector<Eigen::Index>& i
   s.theta.resize(n);
   for (Eigen::Index i = 0; i < n; ++i) {
     const Eigen::Index j = index[static_cast<std::size_t>(i)];
-    FS_THROW_UNLESS(j >= 0 && j < size(), "DirectionalSamples::Select: row ", j,
-                    " is outside [0, ", size(), ")");
+    FS_THROW_UNLESS(j >= 0 && j < size(), "DirectionalSamples::Select: row ", j, " is outside [0, ",
+                    size(), ")");
     s.x[i] = x[j];
     s.y[i] = y[j];
     s.t[i] = t[j];
@@ -150,7 +151,8 @@ void DirectionalSamples::Validate(const std::string& where) const {
   }
 }
 
-DirectionalSamples ReadDirectionalGridCsv(const std::string& path, DirectionalReadStats* stats_out) {
+DirectionalSamples ReadDirectionalGridCsv(const std::string& path,
+                                          DirectionalReadStats* stats_out) {
   std::ifstream in(path);
   FS_THROW_UNLESS(in.good(), path, ": cannot open directional grid csv");
   static const char* kHeader = "x_m,y_m,orientation_raw_rad,path_id";
@@ -210,8 +212,10 @@ DirectionalSamples ReadDirectionalGridCsv(const std::string& path, DirectionalRe
         const double heading = WrapAngle(v[2] + M_PI / 2);
         const double mismatch = std::abs(WrapAngle(heading - std::atan2(dy, dx)));
         FS_THROW_UNLESS(mismatch < 1e-4, path, ":", line, ": orientation_raw_rad ", v[2],
-                        " gives heading ", heading, " (orientation + pi/2) but the step from the "
-                        "previous row points at ", std::atan2(dy, dx), " (", mismatch,
+                        " gives heading ", heading,
+                        " (orientation + pi/2) but the step from the "
+                        "previous row points at ",
+                        std::atan2(dy, dx), " (", mismatch,
                         " rad apart): not the README convention");
         out.Add(v[0], v[1], static_cast<double>(row_in_path) * kDirectionalGridSecondsPerRow,
                 heading);
@@ -232,8 +236,8 @@ DirectionalSamples ReadDirectionalGridCsv(const std::string& path, DirectionalRe
 
 DirectionalSamples ReadEdinburghTracks(const std::string& path, const HeadingFilter& filter,
                                        DirectionalReadStats* stats_out) {
-  FS_THROW_UNLESS(filter.min_speed >= 0 && filter.max_speed > filter.min_speed && filter.max_gap > 0 &&
-                      filter.min_track_points >= 2,
+  FS_THROW_UNLESS(filter.min_speed >= 0 && filter.max_speed > filter.min_speed &&
+                      filter.max_gap > 0 && filter.min_track_points >= 2,
                   "heading filter: need 0 <= min_speed < max_speed, max_gap > 0 and "
                   "min_track_points >= 2 (min_speed ",
                   filter.min_speed, ", max_speed ", filter.max_speed, ", max_gap ", filter.max_gap,
@@ -262,14 +266,17 @@ DirectionalSamples ReadEdinburghTracks(const std::string& path, const HeadingFil
       std::string a, b, c;
       values >> a >> b >> c;
       const auto n = ParseInteger(a), s = ParseInteger(b), e = ParseInteger(c);
-      FS_THROW_UNLESS(n && s && e, where, ": Properties must start with 'n_points start_frame "
-                      "end_frame', got '", a, " ", b, " ", c, "'");
+      FS_THROW_UNLESS(n && s && e, where,
+                      ": Properties must start with 'n_points start_frame "
+                      "end_frame', got '",
+                      a, " ", b, " ", c, "'");
       properties[trimmed.substr(11, eq - 11)] = {*n, *s, *e};
       continue;
     }
     FS_THROW_UNLESS(trimmed.rfind("TRACK.", 0) == 0, where,
                     ": expected a comment (%), Properties.R<k>=[...] or TRACK.R<k>=[[...]]; line, "
-                    "got '", trimmed.substr(0, 40), "'");
+                    "got '",
+                    trimmed.substr(0, 40), "'");
     std::string id;
     Track track;
     track.points = ParseTrackLine(trimmed, where, &id);
@@ -387,7 +394,8 @@ std::vector<std::vector<Eigen::Index>> KFoldTestIndices(Eigen::Index n, int k, s
   for (std::size_t i = perm.size() - 1; i > 0; --i) std::swap(perm[i], perm[rng() % (i + 1)]);
   std::vector<std::vector<Eigen::Index>> folds(static_cast<std::size_t>(k));
   for (int f = 0; f < k; ++f) {
-    const auto begin = static_cast<std::ptrdiff_t>(n * f / k), end = static_cast<std::ptrdiff_t>(n * (f + 1) / k);
+    const auto begin = static_cast<std::ptrdiff_t>(n * f / k),
+               end = static_cast<std::ptrdiff_t>(n * (f + 1) / k);
     folds[static_cast<std::size_t>(f)].assign(perm.begin() + begin, perm.begin() + end);
     std::sort(folds[static_cast<std::size_t>(f)].begin(), folds[static_cast<std::size_t>(f)].end());
   }

@@ -16,7 +16,8 @@ struct DirectionalSamples {
   Eigen::Index size() const { return x.size(); }
   /// Rows `index` (for splits).
   DirectionalSamples Select(const std::vector<Eigen::Index>& index) const;
-  /// Throws an Error naming `where` if empty, any value is non-finite or theta is outside [-pi, pi).
+  /// Throws an Error naming `where` if empty, any value is non-finite or theta is outside [-pi,
+  /// pi).
   void Validate(const std::string& where) const;
 };
 
@@ -34,9 +35,9 @@ struct DirectionalReadStats {
 };
 
 struct HeadingFilter {
-  double min_speed = 0.1;   ///< m/s; slower steps are "standing"
-  double max_speed = 4.0;   ///< m/s; faster steps are tracking jumps
-  double max_gap = 2.0;     ///< s; longer gaps between consecutive points break the track
+  double min_speed = 0.1;    ///< m/s; slower steps are "standing"
+  double max_speed = 4.0;    ///< m/s; faster steps are tracking jumps
+  double max_gap = 2.0;      ///< s; longer gaps between consecutive points break the track
   int min_track_points = 5;  ///< tracks with fewer points (false detections) are dropped whole
 };
 
@@ -59,12 +60,14 @@ inline constexpr double kEdinburghFramesPerSecond = 9.0;
 /// t = (row index within its path) * kDirectionalGridSecondsPerRow. The first row of a path has no
 /// heading (first_points); a repeated way-point is dropped_standing; a step longer than
 /// kDirectionalGridMaxStep is dropped_jump. Positions are kept as they are (m, right-handed).
-DirectionalSamples ReadDirectionalGridCsv(const std::string& path, DirectionalReadStats* stats = nullptr);
+DirectionalSamples ReadDirectionalGridCsv(const std::string& path,
+                                          DirectionalReadStats* stats = nullptr);
 
 /// ../shared/data/edinburgh_forum/tracks.*.txt: pixels (y down) -> metres (right-handed),
 /// irregular frame times -> seconds since the first point of the file.
-///   x = x_px * kEdinburghMetresPerPixel,  y = (kEdinburghImageHeight - 1 - y_px) * kEdinburghMetresPerPixel,
-///   t = (frame - earliest frame of the file) / kEdinburghFramesPerSecond,
+///   x = x_px * kEdinburghMetresPerPixel,  y = (kEdinburghImageHeight - 1 - y_px) *
+///   kEdinburghMetresPerPixel, t = (frame - earliest frame of the file) /
+///   kEdinburghFramesPerSecond,
 /// theta of point i = atan2(y_i - y_{i-1}, x_i - x_{i-1}) (metres), kept at point i. Per step:
 /// dt > max_gap -> dropped_gap (the track restarts there); two points in one frame or speed >
 /// max_speed -> dropped_jump; speed < min_speed or no motion -> dropped_standing. Tracks with fewer
@@ -84,11 +87,11 @@ DirectionalSamples ReadEdinburghTracks(const std::string& path, const HeadingFil
 /// heading) stop at the square's border. Same config, same samples (own draws on mt19937_64).
 struct CrossingFlowConfig {
   int num_tracks = 400;
-  double duration = 100.0;   ///< s (time axis of the map)
-  double size = 10.0;        ///< m (square side)
-  double speed = 1.2;        ///< m/s
-  double heading_noise = 0.15;  ///< rad (per step)
-  double sample_period = 0.5;   ///< s between samples along a track
+  double duration = 100.0;          ///< s (time axis of the map)
+  double size = 10.0;               ///< m (square side)
+  double speed = 1.2;               ///< m/s
+  double heading_noise = 0.15;      ///< rad (per step)
+  double sample_period = 0.5;       ///< s between samples along a track
   double dominant_fraction = 0.95;  ///< share of the tracks of each half that go the dominant way
   std::uint64_t seed = 0;
 };

@@ -6,8 +6,8 @@
 #include <sstream>
 
 #include "core/error.h"
-#include "core/parse.h"
 #include "core/log.h"
+#include "core/parse.h"
 
 namespace foresight {
 namespace {
@@ -21,11 +21,11 @@ struct Row {
 double ParseField(const std::string& token, const std::string& path, std::size_t line,
                   const char* column) {
   const std::optional<double> parsed = ParseDouble(token);
-  FS_THROW_UNLESS(parsed.has_value(), path, ":", line, ": column '", column,
-                  "' is not a number: '", token, "'");
+  FS_THROW_UNLESS(parsed.has_value(), path, ":", line, ": column '", column, "' is not a number: '",
+                  token, "'");
   const double v = *parsed;
-  FS_THROW_UNLESS(std::isfinite(v), path, ":", line, ": column '", column,
-                  "' is not finite: '", token, "'");
+  FS_THROW_UNLESS(std::isfinite(v), path, ":", line, ": column '", column, "' is not finite: '",
+                  token, "'");
   return v;
 }
 
@@ -48,12 +48,13 @@ TrackSet ReadEthUcy(const std::string& path, double seconds_per_step, EthUcyRead
     std::istringstream fields(text);
     std::vector<std::string> tok;
     for (std::string t; fields >> t;) tok.push_back(t);
-    FS_THROW_UNLESS(tok.size() == 4, path, ":", line, ": expected 4 columns (frame_id ped_id x y), got ",
-                    tok.size());
+    FS_THROW_UNLESS(tok.size() == 4, path, ":", line,
+                    ": expected 4 columns (frame_id ped_id x y), got ", tok.size());
     Row r{};
     r.frame = ParseField(tok[0], path, line, kColumns[0]);
     const double ped = ParseField(tok[1], path, line, kColumns[1]);
-    FS_THROW_UNLESS(ped == std::floor(ped), path, ":", line, ": ped_id is not an integer: '", tok[1], "'");
+    FS_THROW_UNLESS(ped == std::floor(ped), path, ":", line, ": ped_id is not an integer: '",
+                    tok[1], "'");
     FS_THROW_UNLESS(r.frame == std::floor(r.frame), path, ":", line,
                     ": frame_id is not an integer: '", tok[0], "'");
     r.ped = static_cast<std::int64_t>(ped);
@@ -78,7 +79,8 @@ TrackSet ReadEthUcy(const std::string& path, double seconds_per_step, EthUcyRead
   // Frame step: most common positive difference within a pedestrian.
   std::map<long, std::size_t> diffs;
   for (const auto& [ped, seq] : by_ped)
-    for (std::size_t i = 1; i < seq.size(); ++i) ++diffs[std::lround(seq[i].first - seq[i - 1].first)];
+    for (std::size_t i = 1; i < seq.size(); ++i)
+      ++diffs[std::lround(seq[i].first - seq[i - 1].first)];
   long step = 0;
   std::size_t best = 0;
   for (const auto& [d, c] : diffs)

@@ -1,12 +1,11 @@
 #include "datasets/pedestrian_data.h"
 
-#include "datasets/data_root.h"
-
 #include <cstdlib>
 #include <filesystem>
 
 #include "core/error.h"
 #include "core/log.h"
+#include "datasets/data_root.h"
 #include "datasets/eth_ucy.h"
 #include "datasets/track_store.h"
 
@@ -49,7 +48,8 @@ TrackSet LoadFiles(const PedestrianDataConfig& c, const std::vector<std::string>
 TrackSplit LoadPedestrianSplits(const PedestrianDataConfig& c, std::uint64_t seed) {
   if (c.format == TrackFormat::kSynthetic) {
     TrackSet all = GenerateSyntheticPedestrians(c.synthetic);
-    log::Info("synthetic pedestrians: ", all.tracks.size(), " tracks, ", all.NumPoints(), " points");
+    log::Info("synthetic pedestrians: ", all.tracks.size(), " tracks, ", all.NumPoints(),
+              " points");
     return SplitTracks(all, c.val_fraction, c.test_fraction, seed);
   }
   FS_THROW_UNLESS(!c.train_files.empty(), "data.train_files is empty for format ",

@@ -48,7 +48,8 @@ struct PedestrianDataConfig {
              "fraction of tracks held out for validation when val_files is empty");
     a->Visit("test_fraction", &test_fraction, config::Range::Closed(0, 0.9),
              "fraction of tracks held out for testing when test_files is empty");
-    a->Visit("synthetic", &synthetic, config::Range::Any(), "synthetic generator (format: synthetic)");
+    a->Visit("synthetic", &synthetic, config::Range::Any(),
+             "synthetic generator (format: synthetic)");
   }
 };
 

@@ -41,8 +41,9 @@ TrackSet ReadTrackStore(const std::string& path) {
   TrackSet set;
   set.source = f.GetStringAttr("/", "source");
   set.seconds_per_step = f.GetDoubleAttr("/", "seconds_per_step");
-  FS_THROW_UNLESS(std::isfinite(set.seconds_per_step) && set.seconds_per_step > 0, path, ": attribute seconds_per_step is ",
-                  set.seconds_per_step, "; expected a positive number of seconds");
+  FS_THROW_UNLESS(std::isfinite(set.seconds_per_step) && set.seconds_per_step > 0, path,
+                  ": attribute seconds_per_step is ", set.seconds_per_step,
+                  "; expected a positive number of seconds");
   const auto ids = f.ReadInt("/tracks/agent_id");
   const auto offsets = f.ReadInt("/tracks/offsets");
   const auto time = f.ReadDouble("/tracks/time");
@@ -55,8 +56,9 @@ TrackSet ReadTrackStore(const std::string& path) {
   const auto num_points = static_cast<std::int64_t>(time.Size());
   for (std::size_t k = 0; k < ids.Size(); ++k) {
     const std::int64_t begin = offsets.data[k], end = offsets.data[k + 1];
-    FS_THROW_UNLESS(0 <= begin && begin <= end && end <= num_points, path, ": /tracks/offsets of track ",
-                    k, " is [", begin, ", ", end, "), expected 0 <= begin <= end <= ", num_points);
+    FS_THROW_UNLESS(0 <= begin && begin <= end && end <= num_points, path,
+                    ": /tracks/offsets of track ", k, " is [", begin, ", ", end,
+                    "), expected 0 <= begin <= end <= ", num_points);
   }
   for (std::size_t k = 0; k < ids.Size(); ++k) {
     Track t;

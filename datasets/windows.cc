@@ -15,12 +15,14 @@ WindowSet MakeWindows(const TrackSet& set, const WindowConfig& c) {
   const double dt = set.seconds_per_step;
   int count = 0, short_tracks = 0;
   for (const Track& t : set.tracks) {
-    if (t.size() >= len) count += (t.size() - len) / c.stride + 1;
-    else ++short_tracks;
+    if (t.size() >= len)
+      count += (t.size() - len) / c.stride + 1;
+    else
+      ++short_tracks;
   }
   if (short_tracks > 0)
-    log::Info(set.source, ": ", short_tracks, " of ", set.tracks.size(), " tracks are shorter than ", len,
-              " points and give no window");
+    log::Info(set.source, ": ", short_tracks, " of ", set.tracks.size(),
+              " tracks are shorter than ", len, " points and give no window");
   WindowSet w;
   w.seconds_per_step = dt;
   w.observed = c.observed;
@@ -33,7 +35,8 @@ WindowSet MakeWindows(const TrackSet& set, const WindowConfig& c) {
     const Track& t = set.tracks[ti];
     for (int s = 0; s + len <= t.size(); s += c.stride) {
       for (int i = 1; i < len; ++i) {
-        const double step = t.time[static_cast<std::size_t>(s + i)] - t.time[static_cast<std::size_t>(s + i - 1)];
+        const double step =
+            t.time[static_cast<std::size_t>(s + i)] - t.time[static_cast<std::size_t>(s + i - 1)];
         FS_THROW_UNLESS(std::abs(step - dt) < 1e-6 * std::max(1.0, dt), set.source, ": track ",
                         t.agent_id, " is not sampled every ", dt, " s (step ", step, " s)");
       }
@@ -96,7 +99,8 @@ TrackSplit SplitTracks(const TrackSet& set, double val_fraction, double test_fra
   std::shuffle(order.begin(), order.end(), rng);
   const auto n = order.size();
   const auto n_val = static_cast<std::size_t>(std::llround(val_fraction * static_cast<double>(n)));
-  const auto n_test = static_cast<std::size_t>(std::llround(test_fraction * static_cast<double>(n)));
+  const auto n_test =
+      static_cast<std::size_t>(std::llround(test_fraction * static_cast<double>(n)));
   TrackSplit out;
   for (TrackSet* s : {&out.train, &out.val, &out.test}) {
     s->source = set.source;

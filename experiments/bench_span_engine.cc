@@ -17,7 +17,8 @@ const SpanPredictor& Model(int components) {
   auto it = models.find(components);
   if (it == models.end()) {
     const std::string path = (std::filesystem::temp_directory_path() /
-                              ("bench_span_R" + std::to_string(components) + ".h5")).string();
+                              ("bench_span_R" + std::to_string(components) + ".h5"))
+                                 .string();
     testing::RandomSpanSpec spec;
     spec.basis = 8;
     spec.components = components;

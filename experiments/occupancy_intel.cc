@@ -1,21 +1,21 @@
 // Occupancy-map reproductions of thesis ch 3 on a CARMEN log (default: Intel), one run:
 //  1. every map kind (Fast-BHM, Hilbert map, grid float32 / uint8, OctoMap) on the every-10th-scan
 //     split, and in the sparse case (train on every 10th training scan, same test scans);
-//  2. size against quality: artifact bytes vs AUC for Fast-BHM at several feature spacings, grids at
+//  2. size against quality: artifact bytes vs AUC for Fast-BHM at several feature spacings, grids
+//  at
 //     several resolutions, and the fusion of discretised Fast-BHM outputs by a log-odds grid update
 //     (four quadrant robots) at several resolutions.
 // Writes OUT/occupancy_intel.md, OUT/occupancy_size_quality.csv and OUT/occupancy_size_quality.png.
 //
 // Usage: occupancy_experiments [--config configs/occupancy/intel.yaml] [--out results]
 
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
-
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <sstream>
 
 #include "core/error.h"
@@ -48,14 +48,16 @@ OccupancyExperimentConfig WithSpacing(OccupancyExperimentConfig c, double spacin
 }
 
 /// A Fast-BHM trained on the listed scans of `points`, in order.
-HingeMap TrainOnScans(const OccupancyExperimentConfig& c, const LabelledPoints& points, const std::vector<int>& scans) {
+HingeMap TrainOnScans(const OccupancyExperimentConfig& c, const LabelledPoints& points,
+                      const std::vector<int>& scans) {
   FastBhmLearner l(HingeGrid(c.features), c.fast_bhm);
   UpdateOnScans(&l, points, scans);
   return l.ToMap();
 }
 
 /// Log-odds fusion of discretised map outputs (the grid update rule the thesis compares against).
-GridMap FuseDiscretised(const std::vector<const OccupancyMap*>& maps, const GridMapConfig& g, CellType type) {
+GridMap FuseDiscretised(const std::vector<const OccupancyMap*>& maps, const GridMapConfig& g,
+                        CellType type) {
   GridGeometry geo;
   geo.x_min = g.x_min;
   geo.y_min = g.y_min;
@@ -68,7 +70,8 @@ GridMap FuseDiscretised(const std::vector<const OccupancyMap*>& maps, const Grid
   const double l_max = std::log(g.p_max / (1 - g.p_max)), l_min = std::log(g.p_min / (1 - g.p_min));
   for (int iy = 0; iy < geo.ny; ++iy)
     for (int ix = 0; ix < geo.nx; ++ix) {
-      const double x = geo.x_min + (ix + 0.5) * geo.resolution, y = geo.y_min + (iy + 0.5) * geo.resolution;
+      const double x = geo.x_min + (ix + 0.5) * geo.resolution,
+                   y = geo.y_min + (iy + 0.5) * geo.resolution;
       double l = 0;
       for (std::size_t k = 0; k < maps.size(); ++k) {
         const double q = std::clamp(maps[k]->Probability(x, y, &ws[k]), 1e-6, 1 - 1e-6);
@@ -93,11 +96,16 @@ void PlotCurves(const std::vector<Row>& rows, const std::string& path) {
   amin = std::floor(amin * 50) / 50;
   amax = std::min(1.0, std::ceil(amax * 50) / 50);
   const double lb0 = std::floor(std::log10(bmin)), lb1 = std::ceil(std::log10(bmax));
-  auto px = [&](double bytes) { return left + int((std::log10(bytes) - lb0) / (lb1 - lb0) * (w - left - right)); };
-  auto py = [&](double auc) { return h - bottom - int((auc - amin) / (amax - amin) * (h - bottom - top)); };
+  auto px = [&](double bytes) {
+    return left + int((std::log10(bytes) - lb0) / (lb1 - lb0) * (w - left - right));
+  };
+  auto py = [&](double auc) {
+    return h - bottom - int((auc - amin) / (amax - amin) * (h - bottom - top));
+  };
   cv::rectangle(img, {left, top}, {w - right, h - bottom}, {0, 0, 0});
   for (double e = lb0; e <= lb1; e += 1) {
-    cv::putText(img, "1e" + std::to_string(int(e)), {px(std::pow(10, e)) - 12, h - bottom + 20}, cv::FONT_HERSHEY_SIMPLEX, 0.45, {0, 0, 0});
+    cv::putText(img, "1e" + std::to_string(int(e)), {px(std::pow(10, e)) - 12, h - bottom + 20},
+                cv::FONT_HERSHEY_SIMPLEX, 0.45, {0, 0, 0});
   }
   for (double a = amin; a <= amax + 1e-9; a += 0.02) {
     std::ostringstream s;
@@ -105,21 +113,25 @@ void PlotCurves(const std::vector<Row>& rows, const std::string& path) {
     s << std::fixed << a;
     cv::putText(img, s.str(), {15, py(a) + 5}, cv::FONT_HERSHEY_SIMPLEX, 0.45, {0, 0, 0});
   }
-  cv::putText(img, "artifact bytes (log)", {w / 2 - 120, h - 15}, cv::FONT_HERSHEY_SIMPLEX, 0.55, {0, 0, 0});
+  cv::putText(img, "artifact bytes (log)", {w / 2 - 120, h - 15}, cv::FONT_HERSHEY_SIMPLEX, 0.55,
+              {0, 0, 0});
   cv::putText(img, "AUC", {15, 20}, cv::FONT_HERSHEY_SIMPLEX, 0.55, {0, 0, 0});
-  const std::vector<cv::Scalar> colours{{200, 60, 20}, {30, 30, 200}, {30, 150, 30}, {150, 30, 150}, {0, 140, 220}, {90, 90, 90}};
+  const std::vector<cv::Scalar> colours{{200, 60, 20},  {30, 30, 200}, {30, 150, 30},
+                                        {150, 30, 150}, {0, 140, 220}, {90, 90, 90}};
   std::map<std::string, std::vector<Row>> by;
   for (const auto& r : rows) by[r.method].push_back(r);
   int k = 0;
   for (auto& [name, list] : by) {
-    std::sort(list.begin(), list.end(), [](const Row& a, const Row& b) { return a.bytes < b.bytes; });
+    std::sort(list.begin(), list.end(),
+              [](const Row& a, const Row& b) { return a.bytes < b.bytes; });
     const cv::Scalar col = colours[k % colours.size()];
     for (std::size_t i = 0; i < list.size(); ++i) {
       const cv::Point p(px(list[i].bytes), py(list[i].auc));
       cv::circle(img, p, 4, col, cv::FILLED);
       if (i > 0) cv::line(img, {px(list[i - 1].bytes), py(list[i - 1].auc)}, p, col, 2);
     }
-    cv::putText(img, name, {w - right + 10, top + 20 + 22 * k}, cv::FONT_HERSHEY_SIMPLEX, 0.5, col, 2);
+    cv::putText(img, name, {w - right + 10, top + 20 + 22 * k}, cv::FONT_HERSHEY_SIMPLEX, 0.5, col,
+                2);
     ++k;
   }
   FS_THROW_UNLESS(cv::imwrite(path, img), path, ": cannot write PNG");
@@ -131,35 +143,44 @@ int main(int argc, char** argv) try {
   std::string config_path = "configs/occupancy/intel.yaml", out = "results";
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string k = argv[i];
-    if (k == "--config") config_path = argv[i + 1];
-    else if (k == "--out") out = argv[i + 1];
-    else Fail("unknown option ", k, " (use --config FILE --out DIR)");
+    if (k == "--config")
+      config_path = argv[i + 1];
+    else if (k == "--out")
+      out = argv[i + 1];
+    else
+      Fail("unknown option ", k, " (use --config FILE --out DIR)");
   }
   fs::create_directories(out);
-  const OccupancyExperimentConfig base = config::LoadExperimentConfig<OccupancyExperimentConfig>(config_path, {});
+  const OccupancyExperimentConfig base =
+      config::LoadExperimentConfig<OccupancyExperimentConfig>(config_path, {});
   std::ostringstream md;
-  md << "# Occupancy maps on `" << base.data.file << "` (measured by `build/bin/occupancy_experiments --config "
-     << config_path << "`)\n\n";
+  md << "# Occupancy maps on `" << base.data.file
+     << "` (measured by `build/bin/occupancy_experiments --config " << config_path << "`)\n\n";
 
   // 1. Every model, full and sparse training data.
-  md << "| training data | model | AUC | precision | recall | bytes | train s |\n|---|---|---|---|---|---|---|\n";
+  md << "| training data | model | AUC | precision | recall | bytes | train s "
+        "|\n|---|---|---|---|---|---|---|\n";
   for (const int stride : {1, 10}) {
     OccupancyExperimentConfig c = base;
     c.data.train_scan_stride = stride;
     const OccupancyData data = LoadOccupancyData(c);
-    const std::string label = stride == 1 ? "all training scans" : "every 10th training scan (sparse)";
-    for (const auto& [model, cell] : std::vector<std::pair<std::string, CellType>>{
-             {kFastBhmType, CellType::kFloat32}, {kHilbertMapType, CellType::kFloat32},
-             {kGridMapType, CellType::kFloat32}, {kGridMapType, CellType::kUint8}}) {
+    const std::string label =
+        stride == 1 ? "all training scans" : "every 10th training scan (sparse)";
+    for (const auto& [model, cell] :
+         std::vector<std::pair<std::string, CellType>>{{kFastBhmType, CellType::kFloat32},
+                                                       {kHilbertMapType, CellType::kFloat32},
+                                                       {kGridMapType, CellType::kFloat32},
+                                                       {kGridMapType, CellType::kUint8}}) {
       c.grid.cell_type = cell;
       double secs = 0;
       const auto map = TrainOccupancyMap(model, c, data, &secs);
       const BinaryMetrics m = EvaluateMap(*map, data.test);
-      const std::string name = model == kGridMapType ? model + (cell == CellType::kUint8 ? " (uint8, " : " (float32, ") +
-                                                           std::to_string(c.grid.resolution).substr(0, 4) + " m)"
-                                                     : model;
-      md << "| " << label << " | " << name << " | " << m.auc << " | " << m.precision << " | " << m.recall << " | "
-         << ArtifactBytes(*map, c) << " | " << secs << " |\n";
+      const std::string name =
+          model == kGridMapType ? model + (cell == CellType::kUint8 ? " (uint8, " : " (float32, ") +
+                                      std::to_string(c.grid.resolution).substr(0, 4) + " m)"
+                                : model;
+      md << "| " << label << " | " << name << " | " << m.auc << " | " << m.precision << " | "
+         << m.recall << " | " << ArtifactBytes(*map, c) << " | " << secs << " |\n";
     }
     {
       // Fast-BHM at 0.4 m spacing: about twice OctoMap's serialized size.
@@ -167,12 +188,13 @@ int main(int argc, char** argv) try {
       double secs = 0;
       const auto map = TrainOccupancyMap(kFastBhmType, f, data, &secs);
       const BinaryMetrics m = EvaluateMap(*map, data.test);
-      md << "| " << label << " | occupancy.fast_bhm (0.4 m spacing) | " << m.auc << " | " << m.precision << " | "
-         << m.recall << " | " << ArtifactBytes(*map, f) << " | " << secs << " |\n";
+      md << "| " << label << " | occupancy.fast_bhm (0.4 m spacing) | " << m.auc << " | "
+         << m.precision << " | " << m.recall << " | " << ArtifactBytes(*map, f) << " | " << secs
+         << " |\n";
     }
     const OctomapFigures o = RunOctomapBaseline(data, c.data.points.max_range, 0.1, 3);
-    md << "| " << label << " | OctoMap 0.1 m | " << o.auc << " | " << o.precision << " | " << o.recall << " | " << o.bytes
-       << " | " << o.insert_s << " |\n";
+    md << "| " << label << " | OctoMap 0.1 m | " << o.auc << " | " << o.precision << " | "
+       << o.recall << " | " << o.bytes << " | " << o.insert_s << " |\n";
     std::cout << "done: " << label << "\n";
   }
 
@@ -190,16 +212,18 @@ int main(int argc, char** argv) try {
       c.grid.resolution = r;
       c.grid.cell_type = t;
       const auto map = TrainOccupancyMap(kGridMapType, c, data);
-      rows.push_back({t == CellType::kUint8 ? "grid uint8" : "grid float32", r, ArtifactBytes(*map, c),
-                      EvaluateMap(*map, data.test).auc});
+      rows.push_back({t == CellType::kUint8 ? "grid uint8" : "grid float32", r,
+                      ArtifactBytes(*map, c), EvaluateMap(*map, data.test).auc});
     }
   }
   {
-    // Four quadrant robots, each a Fast-BHM of about 10,000 features (thesis), discretised and fused.
+    // Four quadrant robots, each a Fast-BHM of about 10,000 features (thesis), discretised and
+    // fused.
     const double spacing = std::sqrt((base.features.x_max - base.features.x_min) *
                                      (base.features.y_max - base.features.y_min) / 10000.0);
     const OccupancyExperimentConfig c = WithSpacing(base, spacing);
-    const auto quadrants = QuadrantSplit(data.train, FirstScans(data.train), c.fusion.centre_x, c.fusion.centre_y);
+    const auto quadrants =
+        QuadrantSplit(data.train, FirstScans(data.train), c.fusion.centre_x, c.fusion.centre_y);
     std::vector<HingeMap> locals;
     for (const auto& scans : quadrants) locals.push_back(TrainOnScans(c, data.train, scans));
     std::vector<const OccupancyMap*> ptrs;
@@ -209,8 +233,9 @@ int main(int argc, char** argv) try {
         GridMapConfig g = base.grid;
         g.resolution = r;
         const GridMap fused = FuseDiscretised(ptrs, g, t);
-        rows.push_back({t == CellType::kUint8 ? "discretised fusion uint8" : "discretised fusion float32", r,
-                        ArtifactBytes(fused, base), EvaluateMap(fused, data.test).auc});
+        rows.push_back(
+            {t == CellType::kUint8 ? "discretised fusion uint8" : "discretised fusion float32", r,
+             ArtifactBytes(fused, base), EvaluateMap(fused, data.test).auc});
       }
     }
     for (const double s : {1.0, 0.5, 0.4, 0.3}) {
@@ -219,8 +244,10 @@ int main(int argc, char** argv) try {
       for (const auto& scans : quadrants) qs.push_back(TrainOnScans(cs, data.train, scans));
       std::vector<const HingeMap*> qp;
       for (const auto& m : qs) qp.push_back(&m);
-      const HingeMap fused = FuseMaps(qp, std::vector<std::string>(qp.size(), "quadrant"), cs.fusion.options);
-      rows.push_back({"fused Fast-BHM", s, ArtifactBytes(fused, cs), EvaluateMap(fused, data.test).auc});
+      const HingeMap fused =
+          FuseMaps(qp, std::vector<std::string>(qp.size(), "quadrant"), cs.fusion.options);
+      rows.push_back(
+          {"fused Fast-BHM", s, ArtifactBytes(fused, cs), EvaluateMap(fused, data.test).auc});
     }
   }
   std::ofstream csv(out + "/occupancy_size_quality.csv");

@@ -19,8 +19,8 @@ std::string ReadText(const std::string& path) {
 }
 
 namespace {
-void OverwriteAttrRaw(const std::string& path, const std::string& object, const std::string& name, hid_t type,
-                      const void* value) {
+void OverwriteAttrRaw(const std::string& path, const std::string& object, const std::string& name,
+                      hid_t type, const void* value) {
   const hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
   ASSERT_GE(f, 0) << path;
   const hid_t o = H5Oopen(f, object.c_str(), H5P_DEFAULT);
@@ -36,15 +36,19 @@ void OverwriteAttrRaw(const std::string& path, const std::string& object, const 
 }
 }  // namespace
 
-void OverwriteAttr(const std::string& path, const std::string& object, const std::string& name, std::int64_t value) {
+void OverwriteAttr(const std::string& path, const std::string& object, const std::string& name,
+                   std::int64_t value) {
   OverwriteAttrRaw(path, object, name, H5T_NATIVE_INT64, &value);
 }
 
-void OverwriteAttr(const std::string& path, const std::string& object, const std::string& name, double value) {
+void OverwriteAttr(const std::string& path, const std::string& object, const std::string& name,
+                   double value) {
   OverwriteAttrRaw(path, object, name, H5T_NATIVE_DOUBLE, &value);
 }
 
-void Truncate(const std::string& path, std::size_t bytes) { std::filesystem::resize_file(path, bytes); }
+void Truncate(const std::string& path, std::size_t bytes) {
+  std::filesystem::resize_file(path, bytes);
+}
 
 std::string SharedDataDir() {
   const char* src = std::getenv("FORESIGHT_SOURCE_DIR");

@@ -5,9 +5,8 @@
 #include <gtest/gtest.h>
 #include <sys/resource.h>
 
-#include <csignal>
-
 #include <Eigen/Core>
+#include <csignal>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -21,13 +20,15 @@
 namespace foresight::testing {
 
 /// Expects `fn` to throw foresight::Error whose message contains every `parts` entry.
-inline void ExpectErrorContains(const std::function<void()>& fn, const std::vector<std::string>& parts) {
+inline void ExpectErrorContains(const std::function<void()>& fn,
+                                const std::vector<std::string>& parts) {
   try {
     fn();
     ADD_FAILURE() << "expected foresight::Error";
   } catch (const Error& e) {
     const std::string what = e.what();
-    for (const auto& p : parts) EXPECT_NE(what.find(p), std::string::npos) << "'" << p << "' not in: " << what;
+    for (const auto& p : parts)
+      EXPECT_NE(what.find(p), std::string::npos) << "'" << p << "' not in: " << what;
     EXPECT_EQ(what.find('\n'), std::string::npos) << "error message is not one line: " << what;
   }
 }
@@ -37,7 +38,8 @@ class TempDir {
  public:
   TempDir() {
     std::random_device rd;
-    path_ = std::filesystem::temp_directory_path() / ("foresight_test_" + std::to_string(rd()) + std::to_string(rd()));
+    path_ = std::filesystem::temp_directory_path() /
+            ("foresight_test_" + std::to_string(rd()) + std::to_string(rd()));
     std::filesystem::create_directories(path_);
   }
   ~TempDir() {
@@ -79,8 +81,10 @@ void WriteText(const std::string& path, const std::string& text);
 /// The whole text of `path` (an empty string when it cannot be read).
 std::string ReadText(const std::string& path);
 /// Replaces attribute `name` of `object` in an existing HDF5 file (edited-artifact tests).
-void OverwriteAttr(const std::string& path, const std::string& object, const std::string& name, std::int64_t value);
-void OverwriteAttr(const std::string& path, const std::string& object, const std::string& name, double value);
+void OverwriteAttr(const std::string& path, const std::string& object, const std::string& name,
+                   std::int64_t value);
+void OverwriteAttr(const std::string& path, const std::string& object, const std::string& name,
+                   double value);
 /// Keeps the first `bytes` bytes of `path`.
 void Truncate(const std::string& path, std::size_t bytes);
 

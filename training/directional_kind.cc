@@ -16,15 +16,18 @@ ExperimentKind DirectionalKind() {
   k.resumable = true;
   k.reference = [] { return config::ReferenceTable<DirectionalExperimentConfig>(); };
   k.train = [](const TrainRequest& req) {
-    FS_THROW_UNLESS(req.config != "default" && !req.config.empty(),
-                    "directional maps have no embedded default config; name one (configs/directional/*.yaml)");
-    const auto c = config::LoadExperimentConfig<DirectionalExperimentConfig>(req.config, req.overrides);
+    FS_THROW_UNLESS(
+        req.config != "default" && !req.config.empty(),
+        "directional maps have no embedded default config; name one (configs/directional/*.yaml)");
+    const auto c =
+        config::LoadExperimentConfig<DirectionalExperimentConfig>(req.config, req.overrides);
     DirectionalRunResult r;
     {
       const ScopedInterruptFlag interrupt;
       TrainHooks hooks;
       hooks.interrupt = interrupt.flag();
-      r = RunDirectionalExperiment(c, req.run_dir, req.resume, hooks);  // trains, exports and evaluates each fold
+      r = RunDirectionalExperiment(c, req.run_dir, req.resume,
+                                   hooks);  // trains, exports and evaluates each fold
     }
     if (r.interrupted) Fail("interrupted; continue with --resume --run-dir ", req.run_dir);
     std::cout << r.report.BriefReport() << "\n"

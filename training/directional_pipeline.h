@@ -1,14 +1,15 @@
 #pragma once
 /// Continuous spatiotemporal directional maps (thesis ch 4) through the one pipeline:
-///   samples (x, y, t, theta) -> K folds -> per fold: train the spatiotemporal (and spatial) network
-///   with the trainer, export, query the Eigen engine on the test fold; fit the directional grid
-///   maps (UM, MM, dense variants) on the same training split -> AL and MRE per method.
+///   samples (x, y, t, theta) -> K folds -> per fold: train the spatiotemporal (and spatial)
+///   network with the trainer, export, query the Eigen engine on the test fold; fit the directional
+///   grid maps (UM, MM, dense variants) on the same training split -> AL and MRE per method.
 ///
 /// Run directory:
 ///   config.yaml, log.txt, eval.json, eval.csv (one row per method and fold), model.h5 (the
-///   spatiotemporal model of fold 0, trained on fold 0's training split; model_spatial.h5 likewise),
-///   folds/<k>/<spatiotemporal|spatial>/{metrics.csv, checkpoints/, model.h5, training_summary.json},
-///   plots/directions.png (mixture means over the data), plots/trajectories.png (generated paths).
+///   spatiotemporal model of fold 0, trained on fold 0's training split; model_spatial.h5
+///   likewise), folds/<k>/<spatiotemporal|spatial>/{metrics.csv, checkpoints/, model.h5,
+///   training_summary.json}, plots/directions.png (mixture means over the data),
+///   plots/trajectories.png (generated paths).
 /// Resume continues every unfinished fold network from its last checkpoint and skips finished ones.
 
 #include <string>
@@ -30,14 +31,16 @@ DirectionalSamples LoadDirectionalSamples(const DirectionalExperimentConfig& con
 /// Trains one network on `train` (early stopping / best epoch on `val`) into `dir` and exports
 /// dir/model.h5 from the best checkpoint. `features` must be resolved (no auto flags). An already
 /// exported dir is left alone (returns a summary with reason kAlreadyComplete).
-TrainingSummary TrainDirectionalNet(const DirectionalExperimentConfig& config, const DirectionalFeatureConfig& features,
+TrainingSummary TrainDirectionalNet(const DirectionalExperimentConfig& config,
+                                    const DirectionalFeatureConfig& features,
                                     DirectionalVariant variant, const DirectionalSamples& train,
-                                    const DirectionalSamples& val, const std::string& dir, bool resume,
-                                    const TrainHooks& hooks = {});
+                                    const DirectionalSamples& val, const std::string& dir,
+                                    bool resume, const TrainHooks& hooks = {});
 
 /// Writes an artifact of `net` (schema: docs/artifact_schema.md, model_type directional_map).
 void WriteDirectionalArtifact(DirectionalNetImpl& net, const DirectionalFeatureConfig& features,
-                              const std::string& config_yaml, std::int64_t seed, const std::string& path);
+                              const std::string& config_yaml, std::int64_t seed,
+                              const std::string& path);
 
 /// Rebuilds the LibTorch network of an artifact (parity tests, benchmark).
 struct LoadedDirectionalNet {
@@ -79,8 +82,9 @@ inline const RunDirectoryRules kDirectionalRunRules{{"folds", "model.h5", "eval.
 
 /// The whole experiment into `run_dir` (see above). A fresh start refuses a directory that holds
 /// an earlier run. Empty or non-finite data is an Error naming the source.
-DirectionalRunResult RunDirectionalExperiment(const DirectionalExperimentConfig& config, const std::string& run_dir,
-                                              bool resume, const TrainHooks& hooks = {});
+DirectionalRunResult RunDirectionalExperiment(const DirectionalExperimentConfig& config,
+                                              const std::string& run_dir, bool resume,
+                                              const TrainHooks& hooks = {});
 
 /// Rewrites every fold network's model.h5 from its best checkpoint and the run's model.h5 (fold 0).
 /// A fold without a checkpoint is an Error naming it. @return the run's artifact path.

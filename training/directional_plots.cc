@@ -1,10 +1,9 @@
 #include "training/directional_plots.h"
 
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
-
 #include <algorithm>
 #include <cmath>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <vector>
 
 #include "core/error.h"
@@ -12,8 +11,10 @@
 
 namespace foresight {
 
-Eigen::Matrix<double, Eigen::Dynamic, 2> GenerateTrajectory(const DirectionalMap& map, const Eigen::Vector2d& start,
-                                                            double t, double step, int steps, std::mt19937_64* rng) {
+Eigen::Matrix<double, Eigen::Dynamic, 2> GenerateTrajectory(const DirectionalMap& map,
+                                                            const Eigen::Vector2d& start, double t,
+                                                            double step, int steps,
+                                                            std::mt19937_64* rng) {
   auto ws = map.MakeWorkspace();
   Eigen::Matrix<double, Eigen::Dynamic, 2> path(steps + 1, 2);
   path.row(0) = start.transpose();
@@ -53,12 +54,14 @@ struct Canvas {
   double scale;       // px per m
   int w, h;
   cv::Point Px(double x, double y, int x0, int y0) const {
-    return {x0 + static_cast<int>(std::lround((x - e[0]) * scale)), y0 + static_cast<int>(std::lround((e[3] - y) * scale))};
+    return {x0 + static_cast<int>(std::lround((x - e[0]) * scale)),
+            y0 + static_cast<int>(std::lround((e[3] - y) * scale))};
   }
 };
 
-void Draw(const DirectionalSamples& data, const std::vector<Panel>& panels, const DirectionalEvalConfig& eval,
-          std::uint64_t seed, bool trajectories, const std::string& png) {
+void Draw(const DirectionalSamples& data, const std::vector<Panel>& panels,
+          const DirectionalEvalConfig& eval, std::uint64_t seed, bool trajectories,
+          const std::string& png) {
   const DirectionalFeatureConfig& f = panels[0].map->features().config();
   Canvas cv_;
   cv_.e = Eigen::Vector4d(f.x_min, f.x_max, f.y_min, f.y_max);
@@ -86,7 +89,8 @@ void Draw(const DirectionalSamples& data, const std::vector<Panel>& panels, cons
     cv::Mat roi = canvas(cv::Rect(x0, y0, cv_.w + 1, cv_.h + 1));  // drawing clipped to the panel
     if (!trajectories) {
       // Arrows on a grid of at most 24 x 24 points.
-      const int nx = std::min(24, std::max(4, f.cells_x)), ny = std::min(24, std::max(4, f.cells_y));
+      const int nx = std::min(24, std::max(4, f.cells_x)),
+                ny = std::min(24, std::max(4, f.cells_y));
       const double sx = (f.x_max - f.x_min) / nx, sy = (f.y_max - f.y_min) / ny;
       const double len = 0.45 * std::min(sx, sy);
       for (int iy = 0; iy < ny; ++iy)
@@ -96,7 +100,8 @@ void Draw(const DirectionalSamples& data, const std::vector<Panel>& panels, cons
           for (int r = 0; r < p.map->components(); ++r) {
             if (ws.alpha[r] < 0.1) continue;
             const double l = len * std::sqrt(ws.alpha[r]);
-            cv::arrowedLine(roi, cv_.Px(x, y, 0, 0), cv_.Px(x + l * std::cos(ws.mu[r]), y + l * std::sin(ws.mu[r]), 0, 0),
+            cv::arrowedLine(roi, cv_.Px(x, y, 0, 0),
+                            cv_.Px(x + l * std::cos(ws.mu[r]), y + l * std::sin(ws.mu[r]), 0, 0),
                             {40, 40, 40}, 1, cv::LINE_AA, 0, 0.3);
           }
         }
@@ -106,12 +111,14 @@ void Draw(const DirectionalSamples& data, const std::vector<Panel>& panels, cons
       const double step = eval.plot_step > 0 ? eval.plot_step : cell / 6.0;
       for (int n = 0; n < eval.plot_trajectories; ++n) {
         Eigen::Index i = pick(rng);
-        for (int tries = 0; tries < 50 && std::abs(data.t[i] - p.t) > p.window; ++tries) i = pick(rng);
-        const auto path = GenerateTrajectory(*p.map, {data.x[i], data.y[i]}, p.t, step, eval.plot_steps, &rng);
+        for (int tries = 0; tries < 50 && std::abs(data.t[i] - p.t) > p.window; ++tries)
+          i = pick(rng);
+        const auto path =
+            GenerateTrajectory(*p.map, {data.x[i], data.y[i]}, p.t, step, eval.plot_steps, &rng);
         const cv::Scalar colour((37 * n) % 200, (91 * n + 60) % 200, 200);
         for (Eigen::Index s = 0; s + 1 < path.rows(); ++s)
-          cv::line(roi, cv_.Px(path(s, 0), path(s, 1), 0, 0), cv_.Px(path(s + 1, 0), path(s + 1, 1), 0, 0), colour, 2,
-                   cv::LINE_AA);
+          cv::line(roi, cv_.Px(path(s, 0), path(s, 1), 0, 0),
+                   cv_.Px(path(s + 1, 0), path(s + 1, 1), 0, 0), colour, 2, cv::LINE_AA);
         cv::circle(roi, cv_.Px(path(0, 0), path(0, 1), 0, 0), 4, {0, 0, 220}, -1);
       }
     }
@@ -122,8 +129,9 @@ void Draw(const DirectionalSamples& data, const std::vector<Panel>& panels, cons
 
 }  // namespace
 
-void PlotDirectionalMaps(const DirectionalSamples& data, const DirectionalMap& st, const DirectionalMap* spatial,
-                         const DirectionalEvalConfig& eval, std::uint64_t seed, const std::string& dir) {
+void PlotDirectionalMaps(const DirectionalSamples& data, const DirectionalMap& st,
+                         const DirectionalMap* spatial, const DirectionalEvalConfig& eval,
+                         std::uint64_t seed, const std::string& dir) {
   const DirectionalFeatureConfig& f = st.features().config();
   const double range = f.t_max - f.t_min;
   auto fmt = [](double v) {
@@ -137,7 +145,8 @@ void PlotDirectionalMaps(const DirectionalSamples& data, const DirectionalMap& s
     panels.push_back({std::string(VariantName(st.variant())) + ", t = " + fmt(t) + " s", &st, t,
                       range > 0 ? 0.25 * range : INFINITY});
   }
-  if (spatial) panels.push_back({"spatial (all times)", spatial, 0.5 * (f.t_min + f.t_max), INFINITY});
+  if (spatial)
+    panels.push_back({"spatial (all times)", spatial, 0.5 * (f.t_min + f.t_max), INFINITY});
   Draw(data, panels, eval, seed, false, dir + "/directions.png");
   Draw(data, panels, eval, seed, true, dir + "/trajectories.png");
 }

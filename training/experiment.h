@@ -22,12 +22,12 @@ struct TrainRequest {
 /// One method's steps. An empty step is one the kind does not have: the command says so in one
 /// line. Steps report expected failures as foresight::Error with what and where.
 struct ExperimentKind {
-  std::string tag;              ///< the `model:` value of its configs (a family: `occupancy.`)
-  bool tag_is_prefix = false;   ///< `tag` is a prefix (`occupancy.` matches occupancy.fast_bhm)
-  std::string summary;          ///< one line: the method and its thesis chapter
-  std::string configs;          ///< where its configs live (for the reference), e.g. configs/span/*.yaml
-  bool resumable = false;       ///< `train --resume` continues a killed run
-  std::string no_step_hint;     ///< what to do instead of a step the kind lacks (one clause)
+  std::string tag;             ///< the `model:` value of its configs (a family: `occupancy.`)
+  bool tag_is_prefix = false;  ///< `tag` is a prefix (`occupancy.` matches occupancy.fast_bhm)
+  std::string summary;         ///< one line: the method and its thesis chapter
+  std::string configs;     ///< where its configs live (for the reference), e.g. configs/span/*.yaml
+  bool resumable = false;  ///< `train --resume` continues a killed run
+  std::string no_step_hint;  ///< what to do instead of a step the kind lacks (one clause)
   /// Every key of its config with its default (config::ReferenceTable<Config>).
   std::function<std::string()> reference;
   /// Trains into request.run_dir, exports the artifact and (request.evaluate) evaluates it.
@@ -36,7 +36,8 @@ struct ExperimentKind {
   std::function<std::string(const std::string& run_dir)> export_run;
   /// Evaluates the run's artifact with the run's config (+ overrides, e.g. data.root); writes
   /// run_dir/eval.json. @return its text.
-  std::function<std::string(const std::string& run_dir, const std::vector<std::string>& overrides)> evaluate;
+  std::function<std::string(const std::string& run_dir, const std::vector<std::string>& overrides)>
+      evaluate;
 
   bool Matches(const std::string& model_tag) const;
   /// The one-line Error for a step (`train`, `export`, `eval`) this kind does not have.

@@ -28,8 +28,8 @@ template <typename Config>
 Config LoadRequestConfig(const TrainRequest& req, const std::string& embedded_default,
                          const std::string& default_name) {
   if (req.config.empty() || req.config == "default")
-    return config::ExperimentConfigFromYaml<Config>(embedded_default, "<embedded " + default_name + ">",
-                                                    req.overrides);
+    return config::ExperimentConfigFromYaml<Config>(
+        embedded_default, "<embedded " + default_name + ">", req.overrides);
   return config::LoadExperimentConfig<Config>(req.config, req.overrides);
 }
 

@@ -13,9 +13,12 @@ constexpr NavigationMethod kAllMethods[] = {NavigationMethod::kSpan, NavigationM
 
 const char* MethodName(NavigationMethod method) {
   switch (method) {
-    case NavigationMethod::kSpan: return "span";
-    case NavigationMethod::kReactive: return "reactive";
-    case NavigationMethod::kClRrtStar: return "cl_rrt_star";
+    case NavigationMethod::kSpan:
+      return "span";
+    case NavigationMethod::kReactive:
+      return "reactive";
+    case NavigationMethod::kClRrtStar:
+      return "cl_rrt_star";
   }
   return "";
 }

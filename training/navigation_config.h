@@ -19,24 +19,31 @@ struct NavigationPredictorConfig {
   /// SPAN artifact (model.h5). When it does not exist, `foresight navigate` trains one there first
   /// (LibTorch builds): tracks from `tracks`, then the SPAN config `train_config` on them.
   std::string artifact = "runs/navigation_predictor/model.h5";
-  std::string train_config = "default";  ///< "default": the embedded configs/navigation/predictor.yaml
+  std::string train_config =
+      "default";  ///< "default": the embedded configs/navigation/predictor.yaml
   /// Training tracks: "scenario" records the simulated crowd of this config's scenario without the
   /// robot; "replay" reads `replay` (a recorded file other than the one navigated).
   std::string tracks = "scenario";
-  int record_episodes = 12;      ///< scenario: seeded runs recorded
-  double record_duration = 60;   ///< scenario: seconds per run
-  /// Std of Gaussian noise added to recorded simulated positions (m): a tracker's measurement noise.
-  /// Noise-free simulated tracks make the matrix-normal likelihood degenerate (near-zero residuals).
+  int record_episodes = 12;     ///< scenario: seeded runs recorded
+  double record_duration = 60;  ///< scenario: seconds per run
+  /// Std of Gaussian noise added to recorded simulated positions (m): a tracker's measurement
+  /// noise. Noise-free simulated tracks make the matrix-normal likelihood degenerate (near-zero
+  /// residuals).
   double position_noise = 0.02;
-  ReplayConfig replay;           ///< tracks: replay
+  ReplayConfig replay;  ///< tracks: replay
 
   template <class A>
   void Serialize(A* a) {
-    a->Visit("artifact", &artifact, config::Range::Any(), "SPAN artifact; trained there first when missing");
-    a->Visit("train_config", &train_config, config::Range::Any(), "SPAN config used to train a missing artifact ('default': the embedded configs/navigation/predictor.yaml)");
+    a->Visit("artifact", &artifact, config::Range::Any(),
+             "SPAN artifact; trained there first when missing");
+    a->Visit("train_config", &train_config, config::Range::Any(),
+             "SPAN config used to train a missing artifact ('default': the embedded "
+             "configs/navigation/predictor.yaml)");
     a->Visit("tracks", &tracks, config::Range::Any(), "training tracks: scenario | replay");
-    a->Visit("record_episodes", &record_episodes, config::Range::Closed(1, 10000), "simulated runs recorded");
-    a->Visit("record_duration", &record_duration, config::Range::Positive(), "seconds per recorded run");
+    a->Visit("record_episodes", &record_episodes, config::Range::Closed(1, 10000),
+             "simulated runs recorded");
+    a->Visit("record_duration", &record_duration, config::Range::Positive(),
+             "seconds per recorded run");
     a->Visit("position_noise", &position_noise, config::Range::NonNegative(),
              "std of measurement noise added to recorded simulated positions (m)");
     a->Visit("replay", &replay, config::Range::Any(), "recorded training tracks (tracks: replay)");
@@ -47,22 +54,24 @@ enum class NavigationMapKind { kFastBhm, kGrid };
 
 /// The static occupancy map: an artifact, or built from the scenario's obstacles.
 struct NavigationMapConfig {
-  std::string artifact;            ///< occupancy-map artifact; empty: build DIR/map.h5 from the scenario
+  std::string artifact;  ///< occupancy-map artifact; empty: build DIR/map.h5 from the scenario
   NavigationMapKind kind = NavigationMapKind::kFastBhm;
   double raster_resolution = 0.1;  ///< m, scenario obstacles sampled at this step (labelled points)
-  double spacing = 0.25;           ///< m, Fast-BHM inducing-point spacing (gamma scales as spacing^-2)
+  double spacing = 0.25;  ///< m, Fast-BHM inducing-point spacing (gamma scales as spacing^-2)
   double field_resolution = 0.05;  ///< m, raster of the swept occupancy used by the controllers
 
   template <class A>
   void Serialize(A* a) {
-    a->Visit("artifact", &artifact, config::Range::Any(), "occupancy-map artifact; empty: build from the scenario");
+    a->Visit("artifact", &artifact, config::Range::Any(),
+             "occupancy-map artifact; empty: build from the scenario");
     a->VisitEnum("kind", &kind,
                  config::EnumNames<NavigationMapKind>{{NavigationMapKind::kFastBhm, "fast_bhm"},
                                                       {NavigationMapKind::kGrid, "grid"}},
                  "map built from the scenario");
     a->Visit("raster_resolution", &raster_resolution, config::Range::Closed(0.01, 1.0),
              "sampling step of the scenario obstacles (m)");
-    a->Visit("spacing", &spacing, config::Range::Closed(0.05, 2.0), "Fast-BHM inducing-point spacing (m)");
+    a->Visit("spacing", &spacing, config::Range::Closed(0.05, 2.0),
+             "Fast-BHM inducing-point spacing (m)");
     a->Visit("field_resolution", &field_resolution, config::Range::Closed(0.01, 0.4),
              "resolution of the swept-occupancy raster (m)");
   }
@@ -73,13 +82,17 @@ struct SpanControllerConfig {
   template <class A>
   void Serialize(A* a) {
     auto& o = options;
-    a->Visit("kappa", &o.kappa, config::Range::NonNegative(), "weight of the inverse time-to-collision");
+    a->Visit("kappa", &o.kappa, config::Range::NonNegative(),
+             "weight of the inverse time-to-collision");
     a->Visit("epsilon", &o.epsilon, config::Range::Open(0, 1), "chance threshold of a collision");
     a->Visit("horizon", &o.horizon, config::Range::Positive(), "look-ahead horizon T (s)");
-    a->Visit("initialisations", &o.initialisations, config::Range::Closed(1, 100), "COBYLA starts per cycle");
-    a->Visit("max_evaluations", &o.max_evaluations, config::Range::Closed(3, 10000), "COBYLA evaluations per start");
+    a->Visit("initialisations", &o.initialisations, config::Range::Closed(1, 100),
+             "COBYLA starts per cycle");
+    a->Visit("max_evaluations", &o.max_evaluations, config::Range::Closed(3, 10000),
+             "COBYLA evaluations per start");
     a->Visit("xtol", &o.xtol, config::Range::Positive(), "COBYLA tolerance on the controls");
-    a->Visit("initial_step", &o.initial_step, config::Range::Positive(), "COBYLA initial trust radius");
+    a->Visit("initial_step", &o.initial_step, config::Range::Positive(),
+             "COBYLA initial trust radius");
     a->Visit("geodesic_goal", &o.geodesic_goal, config::Range::Any(),
              "goal term as the distance around static obstacles (false: ||x(T) - g|| as printed)");
   }
@@ -89,7 +102,8 @@ struct ReactiveControllerConfig {
   double heading_weight = 0.5;  ///< m per rad of heading error in the one-step cost
   template <class A>
   void Serialize(A* a) {
-    a->Visit("heading_weight", &heading_weight, config::Range::NonNegative(), "cost of heading error (m/rad)");
+    a->Visit("heading_weight", &heading_weight, config::Range::NonNegative(),
+             "cost of heading error (m/rad)");
   }
 };
 
@@ -98,12 +112,16 @@ struct ClRrtStarConfig {
   template <class A>
   void Serialize(A* a) {
     auto& o = options;
-    a->Visit("budget_s", &o.budget_s, config::Range::Positive(), "planning time budget per cycle (s)");
-    a->Visit("max_iterations", &o.max_iterations, config::Range::AtLeast(1), "RRT* iterations per cycle");
+    a->Visit("budget_s", &o.budget_s, config::Range::Positive(),
+             "planning time budget per cycle (s)");
+    a->Visit("max_iterations", &o.max_iterations, config::Range::AtLeast(1),
+             "RRT* iterations per cycle");
     a->Visit("range", &o.range, config::Range::Positive(), "RRT* extension step (m)");
-    a->Visit("goal_tolerance", &o.goal_tolerance, config::Range::Positive(), "planner goal radius (m)");
+    a->Visit("goal_tolerance", &o.goal_tolerance, config::Range::Positive(),
+             "planner goal radius (m)");
     a->Visit("lookahead", &o.lookahead, config::Range::Positive(), "pure-pursuit look-ahead (m)");
-    a->Visit("check_resolution", &o.check_resolution, config::Range::Positive(), "edge checking step (m)");
+    a->Visit("check_resolution", &o.check_resolution, config::Range::Positive(),
+             "edge checking step (m)");
     a->Visit("min_progress", &o.min_progress, config::Range::NonNegative(),
              "a partial plan is followed when it ends this much closer to the goal (m)");
   }
@@ -120,14 +138,15 @@ struct NavigationVideoConfig {
   bool enabled = true;
   std::string method = "span";  ///< whose episode is filmed
   int episode = 0;
-  int samples = 3;              ///< sampled predicted futures drawn per pedestrian
+  int samples = 3;  ///< sampled predicted futures drawn per pedestrian
   double pixels_per_metre = 30;
   template <class A>
   void Serialize(A* a) {
     a->Visit("enabled", &enabled, config::Range::Any(), "write DIR/episode.avi");
     a->Visit("method", &method, config::Range::Any(), "method of the filmed episode");
     a->Visit("episode", &episode, config::Range::AtLeast(0), "filmed episode");
-    a->Visit("samples", &samples, config::Range::Closed(0, 20), "predicted futures drawn per pedestrian");
+    a->Visit("samples", &samples, config::Range::Closed(0, 20),
+             "predicted futures drawn per pedestrian");
     a->Visit("pixels_per_metre", &pixels_per_metre, config::Range::Closed(5, 200), "video scale");
   }
 };
@@ -140,10 +159,10 @@ struct NavigationExperimentConfig {
   NavigationMapConfig map;
   std::vector<std::string> methods{"span", "reactive", "cl_rrt_star"};
   int episodes = 20;
-  double max_time = 60;          ///< s per episode
-  double dt = 0.1;               ///< s, control period and simulation step
-  double goal_tolerance = 0.5;   ///< m
-  double sensing_range = 10;     ///< m, pedestrians farther from the robot are not observed
+  double max_time = 60;                 ///< s per episode
+  double dt = 0.1;                      ///< s, control period and simulation step
+  double goal_tolerance = 0.5;          ///< m
+  double sensing_range = 10;            ///< m, pedestrians farther from the robot are not observed
   double v_max = 1.0, omega_max = 1.0;  ///< control limits (v in [-v_max, v_max])
   SpanControllerConfig span;
   ReactiveControllerConfig reactive;
@@ -157,13 +176,17 @@ struct NavigationExperimentConfig {
     a->Visit("scenario", &scenario, config::Range::Any(), "crowd scenario");
     a->Visit("predictor", &predictor, config::Range::Any(), "SPAN pedestrian predictor");
     a->Visit("map", &map, config::Range::Any(), "static occupancy map");
-    a->Visit("methods", &methods, config::Range::Any(), "controllers compared: span | reactive | cl_rrt_star");
+    a->Visit("methods", &methods, config::Range::Any(),
+             "controllers compared: span | reactive | cl_rrt_star");
     a->Visit("episodes", &episodes, config::Range::Closed(1, 100000), "episodes per method");
     // At most a day: the cycle count max_time / dt must stay far inside an int.
-    a->Visit("max_time", &max_time, config::Range::OpenClosed(0, 86400), "time limit of an episode (s)");
+    a->Visit("max_time", &max_time, config::Range::OpenClosed(0, 86400),
+             "time limit of an episode (s)");
     a->Visit("dt", &dt, config::Range::Closed(0.01, 1.0), "control period and simulation step (s)");
-    a->Visit("goal_tolerance", &goal_tolerance, config::Range::Positive(), "goal reached within this distance (m)");
-    a->Visit("sensing_range", &sensing_range, config::Range::Positive(), "observation range of pedestrians (m)");
+    a->Visit("goal_tolerance", &goal_tolerance, config::Range::Positive(),
+             "goal reached within this distance (m)");
+    a->Visit("sensing_range", &sensing_range, config::Range::Positive(),
+             "observation range of pedestrians (m)");
     a->Visit("v_max", &v_max, config::Range::Positive(), "linear velocity limit (m/s)");
     a->Visit("omega_max", &omega_max, config::Range::Positive(), "angular velocity limit (rad/s)");
     a->Visit("span", &span, config::Range::Any(), "SPAN controller");
@@ -177,6 +200,5 @@ struct NavigationExperimentConfig {
   std::vector<NavigationMethod> Methods() const;
   bool Uses(NavigationMethod method) const;
 };
-
 
 }  // namespace foresight

@@ -14,6 +14,7 @@ namespace foresight {
 /// directory of a SPAN run: the artifact is named model.h5). A killed training resumes from its
 /// last checkpoint. @return the artifact path.
 /// @param embedded_default SPAN config text used when predictor.train_config is "default".
-std::string EnsureNavigationPredictor(const NavigationExperimentConfig& config, const std::string& embedded_default);
+std::string EnsureNavigationPredictor(const NavigationExperimentConfig& config,
+                                      const std::string& embedded_default);
 
 }  // namespace foresight

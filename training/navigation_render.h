@@ -4,7 +4,6 @@
 
 #include <opencv2/core.hpp>
 #include <opencv2/videoio.hpp>
-
 #include <random>
 #include <string>
 #include <vector>
@@ -19,7 +18,9 @@ class MapCanvas {
   MapCanvas(const OccupancyRaster& raster, double pixels_per_metre);
   cv::Mat Background() const { return background_.clone(); }
   cv::Point Pixel(double x, double y) const;
-  int Length(double metres) const { return std::max(1, static_cast<int>(std::lround(metres * scale_))); }
+  int Length(double metres) const {
+    return std::max(1, static_cast<int>(std::lround(metres * scale_)));
+  }
 
  private:
   Eigen::Vector4d extent_;
@@ -30,11 +31,12 @@ class MapCanvas {
 class VideoRecorder final : public EpisodeRecorder {
  public:
   /// Opens `path` (an Error naming it when OpenCV cannot write the video).
-  VideoRecorder(const std::string& path, const OccupancyRaster& raster, const NavigationVideoConfig& config, double dt,
-                std::uint64_t seed);
+  VideoRecorder(const std::string& path, const OccupancyRaster& raster,
+                const NavigationVideoConfig& config, double dt, std::uint64_t seed);
   void Frame(double time, const nav::UnicycleState& robot, const Eigen::Vector2d& goal,
-             const std::vector<CrowdAgent>& agents, const std::vector<TrajectoryDistribution>* predictions,
-             int num_predictions, const Eigen::Matrix2Xd& path_so_far) override;
+             const std::vector<CrowdAgent>& agents,
+             const std::vector<TrajectoryDistribution>* predictions, int num_predictions,
+             const Eigen::Matrix2Xd& path_so_far) override;
   int frames() const { return frames_; }
 
  private:
@@ -48,7 +50,7 @@ class VideoRecorder final : public EpisodeRecorder {
 };
 
 /// Every episode's path per method (one colour each) over the map, with starts and goals.
-void DrawPaths(const std::string& path, const OccupancyRaster& raster, const NavigationExperimentConfig& config,
-               const std::vector<EpisodeResult>& results);
+void DrawPaths(const std::string& path, const OccupancyRaster& raster,
+               const NavigationExperimentConfig& config, const std::vector<EpisodeResult>& results);
 
 }  // namespace foresight

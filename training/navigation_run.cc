@@ -1,7 +1,5 @@
 #include "training/navigation_run.h"
 
-#include <opencv2/imgproc.hpp>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -11,6 +9,7 @@
 #include <iomanip>
 #include <limits>
 #include <numeric>
+#include <opencv2/imgproc.hpp>
 #include <queue>
 #include <sstream>
 #include <unordered_map>
@@ -31,12 +30,11 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-bool UsesPredictor(const NavigationExperimentConfig& c) {
-  return c.Uses(NavigationMethod::kSpan);
-}
+bool UsesPredictor(const NavigationExperimentConfig& c) { return c.Uses(NavigationMethod::kSpan); }
 
 /// Fast-BHM (or grid) map of the scenario's obstacles, saved as an artifact at `path`.
-void BuildScenarioMap(const NavigationExperimentConfig& c, const OccupancyRaster& raster, const std::string& path) {
+void BuildScenarioMap(const NavigationExperimentConfig& c, const OccupancyRaster& raster,
+                      const std::string& path) {
   const Eigen::Vector4d e = raster.extent;
   const double step = c.map.raster_resolution, margin = 1.0;
   const int nx = static_cast<int>(std::ceil((e[1] - e[0] + 2 * margin) / step));
@@ -56,7 +54,8 @@ void BuildScenarioMap(const NavigationExperimentConfig& c, const OccupancyRaster
         int occ = 0;
         for (int sy = 0; sy < 4; ++sy)
           for (int sx = 0; sx < 4; ++sx)
-            occ += raster.Occupied(g.x_min + (ix + (sx + 0.5) / 4) * step, g.y_min + (iy + (sy + 0.5) / 4) * step);
+            occ += raster.Occupied(g.x_min + (ix + (sx + 0.5) / 4) * step,
+                                   g.y_min + (iy + (sy + 0.5) / 4) * step);
         p(iy, ix) = 0.05f + 0.9f * static_cast<float>(occ) / 16.0f;
       }
     GridMap(g, p, CellType::kFloat32).Save(path, yaml, c.seed);
@@ -97,7 +96,8 @@ Eigen::MatrixXf DistanceToObstacles(const OccupancyRaster& r) {
   cv::distanceTransform(free, dist, cv::DIST_L2, cv::DIST_MASK_PRECISE);
   Eigen::MatrixXf out(rows, cols);
   for (int i = 0; i < rows; ++i)
-    for (int j = 0; j < cols; ++j) out(i, j) = dist.at<float>(i + 1, j + 1) * static_cast<float>(r.resolution);
+    for (int j = 0; j < cols; ++j)
+      out(i, j) = dist.at<float>(i + 1, j + 1) * static_cast<float>(r.resolution);
   return out;
 }
 
@@ -110,10 +110,13 @@ bool CellOf(const OccupancyRaster& r, double x, double y, int* row, int* col) {
 }
 
 /// Breadth-first search over raster cells with clearance > radius.
-bool Reachable(const NavigationResources& res, const Eigen::Vector2d& a, const Eigen::Vector2d& b, double radius) {
+bool Reachable(const NavigationResources& res, const Eigen::Vector2d& a, const Eigen::Vector2d& b,
+               double radius) {
   int r0, c0, r1, c1;
-  if (!CellOf(res.raster, a.x(), a.y(), &r0, &c0) || !CellOf(res.raster, b.x(), b.y(), &r1, &c1)) return false;
-  const int rows = static_cast<int>(res.static_distance.rows()), cols = static_cast<int>(res.static_distance.cols());
+  if (!CellOf(res.raster, a.x(), a.y(), &r0, &c0) || !CellOf(res.raster, b.x(), b.y(), &r1, &c1))
+    return false;
+  const int rows = static_cast<int>(res.static_distance.rows()),
+            cols = static_cast<int>(res.static_distance.cols());
   std::vector<std::uint8_t> seen(static_cast<std::size_t>(rows) * cols, 0);
   std::queue<std::pair<int, int>> q;
   q.push({r0, c0});
@@ -144,7 +147,8 @@ double Percentile(std::vector<double> v, double q) {
 }
 
 std::unique_ptr<nav::NavigationController> MakeController(const NavigationExperimentConfig& c,
-                                                          const NavigationResources& res, NavigationMethod method,
+                                                          const NavigationResources& res,
+                                                          NavigationMethod method,
                                                           std::uint64_t seed) {
   nav::ControlLimits limits{-c.v_max, c.v_max, c.omega_max};
   nav::SpanControllerOptions o = c.span.options;
@@ -156,14 +160,16 @@ std::unique_ptr<nav::NavigationController> MakeController(const NavigationExperi
     case NavigationMethod::kSpan:
       return std::make_unique<nav::SpanController>(res.predictor.get(), res.field.get(), o);
     case NavigationMethod::kReactive:
-      return std::make_unique<nav::ReactiveController>(res.field.get(), o, c.reactive.heading_weight);
+      return std::make_unique<nav::ReactiveController>(res.field.get(), o,
+                                                       c.reactive.heading_weight);
     case NavigationMethod::kClRrtStar: {
       nav::ClRrtStarOptions r = c.cl_rrt_star.options;
       r.robot_radius = o.robot_radius;
       r.pedestrian_radius = o.pedestrian_radius;
       r.epsilon = o.epsilon;
       r.limits = limits;
-      return std::make_unique<nav::ClRrtStarController>(res.field.get(), res.raster.extent, r, seed);
+      return std::make_unique<nav::ClRrtStarController>(res.field.get(), res.raster.extent, r,
+                                                        seed);
     }
   }
   Fail("navigation: method ", static_cast<int>(method), " has no controller");
@@ -184,7 +190,8 @@ double NavigationResources::StaticDistance(double x, double y) const {
   return static_distance(r, c);
 }
 
-NavigationResources PrepareNavigation(const NavigationExperimentConfig& c, const std::string& out_dir) {
+NavigationResources PrepareNavigation(const NavigationExperimentConfig& c,
+                                      const std::string& out_dir) {
   c.Validate("navigation config");  // configs built in code get the same checks as loaded ones
   NavigationResources res;
   res.raster = ScenarioOccupancy(c.scenario, 0.05);
@@ -195,15 +202,17 @@ NavigationResources PrepareNavigation(const NavigationExperimentConfig& c, const
     BuildScenarioMap(c, res.raster, map_path);
   }
   res.map = LoadOccupancyMap(map_path);
-  res.field = std::make_unique<nav::StaticCollisionField>(*res.map, c.scenario.robot_radius, c.map.field_resolution);
+  res.field = std::make_unique<nav::StaticCollisionField>(*res.map, c.scenario.robot_radius,
+                                                          c.map.field_resolution);
   if (UsesPredictor(c)) {
     FS_THROW_UNLESS(fs::exists(c.predictor.artifact), "predictor.artifact: ", c.predictor.artifact,
-                    " not found (train it with `foresight navigate` in a LibTorch build, or `foresight train`)");
+                    " not found (train it with `foresight navigate` in a LibTorch build, or "
+                    "`foresight train`)");
     res.predictor = std::make_unique<SpanPredictor>(SpanPredictor::Load(c.predictor.artifact));
     const double ratio = res.predictor->seconds_per_step() / c.dt;
-    FS_THROW_UNLESS(std::abs(ratio - std::round(ratio)) < 1e-6 && ratio >= 1, "predictor.artifact: ",
-                    c.predictor.artifact, " observes every ", res.predictor->seconds_per_step(),
-                    " s, not a multiple of dt = ", c.dt, " s");
+    FS_THROW_UNLESS(std::abs(ratio - std::round(ratio)) < 1e-6 && ratio >= 1,
+                    "predictor.artifact: ", c.predictor.artifact, " observes every ",
+                    res.predictor->seconds_per_step(), " s, not a multiple of dt = ", c.dt, " s");
   }
   return res;
 }
@@ -221,7 +230,8 @@ EpisodeResult RunEpisode(const NavigationExperimentConfig& c, const NavigationRe
 
   // Observation window: p points every `stride` steps, the last one now.
   const int p = res.predictor ? res.predictor->observed() : 5;
-  const int stride = res.predictor ? static_cast<int>(std::lround(res.predictor->seconds_per_step() / c.dt)) : 1;
+  const int stride =
+      res.predictor ? static_cast<int>(std::lround(res.predictor->seconds_per_step() / c.dt)) : 1;
   const std::size_t keep = static_cast<std::size_t>((p - 1) * stride + 1);
   std::unordered_map<std::int64_t, std::deque<Eigen::Vector2d>> history;
   auto observe = [&] {
@@ -247,7 +257,8 @@ EpisodeResult RunEpisode(const NavigationExperimentConfig& c, const NavigationRe
   auto clearance = [&] {
     double clear = res.StaticDistance(s.x, s.y) - r_robot;
     for (const CrowdAgent& a : crowd->agents())
-      if (a.active) clear = std::min(clear, (a.position - s.position()).norm() - r_robot - a.radius);
+      if (a.active)
+        clear = std::min(clear, (a.position - s.position()).norm() - r_robot - a.radius);
     return clear;
   };
   double t = 0.0, min_clear = clearance();
@@ -282,11 +293,12 @@ EpisodeResult RunEpisode(const NavigationExperimentConfig& c, const NavigationRe
     } catch (const std::exception& e) {  // controllers do not throw; count it if one ever does
       u = nav::ControlOutcome::Stop(nav::ControlStatus::kError, e.what());
     }
-    out.cycle_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    out.cycle_ms.push_back(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
     if (!u.solved()) {
       if (out.solve_failures == 0)
-        log::Info(out.method, " episode ", episode, ": first unsolved cycle at t = ", t, " s: ",
-                  nav::ToString(u.status), " (", u.message, ")");
+        log::Info(out.method, " episode ", episode, ": first unsolved cycle at t = ", t,
+                  " s: ", nav::ToString(u.status), " (", u.message, ")");
       ++out.solve_failures;
     }
     const nav::Control cmd = limits.Clamp(u.command);
@@ -306,24 +318,27 @@ EpisodeResult RunEpisode(const NavigationExperimentConfig& c, const NavigationRe
     double clear = res.StaticDistance(s.x, s.y) - r_robot;
     if (clear < 0) out.doc_static += c.dt;
     for (const CrowdAgent& a : crowd->agents())
-      if (a.active) clear = std::min(clear, (a.position - s.position()).norm() - r_robot - a.radius);
+      if (a.active)
+        clear = std::min(clear, (a.position - s.position()).norm() - r_robot - a.radius);
     if (clear < 0) out.doc += c.dt;
     min_clear = std::min(min_clear, clear);
     if (recorder) try {
-      Eigen::Matrix2Xd so_far(2, static_cast<Eigen::Index>(path.size()));
-      for (std::size_t i = 0; i < path.size(); ++i) so_far.col(static_cast<Eigen::Index>(i)) = path[i];
-      recorder->Frame(t, s, goal, crowd->agents(), controller->Predictions(), controller->PredictedPedestrians(),
-                      so_far);
-    } catch (const std::exception& e) {  // a video problem must not lose the episode
-      log::Warn("video: ", e.what(), "; no more frames");
-      recorder = nullptr;
-    }
+        Eigen::Matrix2Xd so_far(2, static_cast<Eigen::Index>(path.size()));
+        for (std::size_t i = 0; i < path.size(); ++i)
+          so_far.col(static_cast<Eigen::Index>(i)) = path[i];
+        recorder->Frame(t, s, goal, crowd->agents(), controller->Predictions(),
+                        controller->PredictedPedestrians(), so_far);
+      } catch (const std::exception& e) {  // a video problem must not lose the episode
+        log::Warn("video: ", e.what(), "; no more frames");
+        recorder = nullptr;
+      }
   }
   if (!out.reached && (s.position() - goal).norm() <= c.goal_tolerance) out.reached = true;
   out.ttg = out.reached ? t : c.max_time;
   out.min_clearance = min_clear;
   out.path.resize(2, static_cast<Eigen::Index>(path.size()));
-  for (std::size_t i = 0; i < path.size(); ++i) out.path.col(static_cast<Eigen::Index>(i)) = path[i];
+  for (std::size_t i = 0; i < path.size(); ++i)
+    out.path.col(static_cast<Eigen::Index>(i)) = path[i];
   return out;
 }
 
@@ -348,7 +363,9 @@ MethodSummary Summarise(const std::string& method, const std::vector<EpisodeResu
   if (m.episodes == 0) return m;
   m.success_rate = static_cast<double>(reached) / m.episodes;
   m.collision_free_rate = static_cast<double>(free) / m.episodes;
-  m.ttg_mean = ttg.empty() ? std::nan("") : std::accumulate(ttg.begin(), ttg.end(), 0.0) / static_cast<double>(ttg.size());
+  m.ttg_mean = ttg.empty()
+                   ? std::nan("")
+                   : std::accumulate(ttg.begin(), ttg.end(), 0.0) / static_cast<double>(ttg.size());
   m.doc_mean = doc / m.episodes;
   m.min_clearance_mean = clear / m.episodes;
   m.min_clearance = worst;
@@ -358,66 +375,85 @@ MethodSummary Summarise(const std::string& method, const std::vector<EpisodeResu
   return m;
 }
 
-std::string SummaryJson(const NavigationExperimentConfig& c, int episodes, const std::vector<MethodSummary>& s) {
+std::string SummaryJson(const NavigationExperimentConfig& c, int episodes,
+                        const std::vector<MethodSummary>& s) {
   std::ostringstream j;
   std::string name;
   for (char ch : c.scenario.name) {
     if (ch == '"' || ch == '\\') name += '\\';
     if (static_cast<unsigned char>(ch) >= 0x20) name += ch;
   }
-  j << "{\n  \"scenario\": \"" << name << "\",\n  \"episodes\": " << episodes << ",\n  \"seed\": " << c.seed;
+  j << "{\n  \"scenario\": \"" << name << "\",\n  \"episodes\": " << episodes
+    << ",\n  \"seed\": " << c.seed;
   for (const MethodSummary& m : s) {
     j << ",\n  \"" << m.method << "\": {\"success_rate\": " << Json(m.success_rate)
-      << ", \"collision_free_rate\": " << Json(m.collision_free_rate) << ", \"ttg_mean\": " << Json(m.ttg_mean)
-      << ", \"doc_mean\": " << Json(m.doc_mean) << ", \"min_clearance\": " << Json(m.min_clearance)
-      << ", \"min_clearance_mean\": " << Json(m.min_clearance_mean) << ", \"cycle_ms_median\": " << Json(m.cycle_ms_median)
-      << ", \"cycle_ms_p99\": " << Json(m.cycle_ms_p99) << ", \"cycle_ms_max\": " << Json(m.cycle_ms_max)
+      << ", \"collision_free_rate\": " << Json(m.collision_free_rate)
+      << ", \"ttg_mean\": " << Json(m.ttg_mean) << ", \"doc_mean\": " << Json(m.doc_mean)
+      << ", \"min_clearance\": " << Json(m.min_clearance)
+      << ", \"min_clearance_mean\": " << Json(m.min_clearance_mean)
+      << ", \"cycle_ms_median\": " << Json(m.cycle_ms_median)
+      << ", \"cycle_ms_p99\": " << Json(m.cycle_ms_p99)
+      << ", \"cycle_ms_max\": " << Json(m.cycle_ms_max)
       << ", \"solve_failures\": " << m.solve_failures << ", \"episodes\": " << m.episodes << "}";
   }
   j << "\n}\n";
   return j.str();
 }
 
-std::vector<MethodSummary> RunNavigation(const NavigationExperimentConfig& c, const std::string& out_dir, int episodes) {
+std::vector<MethodSummary> RunNavigation(const NavigationExperimentConfig& c,
+                                         const std::string& out_dir, int episodes) {
   fs::create_directories(out_dir);
   const int n = episodes > 0 ? episodes : c.episodes;
   const NavigationResources res = PrepareNavigation(c, out_dir);
   // Every episode's start and goal must be free and connected on the static map.
   for (int e = 0; e < n; ++e) {
-    const EpisodeEndpoints ends = MakeEpisodeEndpoints(c.scenario, static_cast<std::uint64_t>(c.seed) + e);
+    const EpisodeEndpoints ends =
+        MakeEpisodeEndpoints(c.scenario, static_cast<std::uint64_t>(c.seed) + e);
     const Eigen::Vector2d start(ends.start[0], ends.start[1]);
     const double r = c.scenario.robot_radius;
-    FS_THROW_UNLESS(res.StaticDistance(start.x(), start.y()) > r, "scenario.robot_start: (", start.transpose(),
-                    ") of episode ", e, " is in collision with a static obstacle");
-    FS_THROW_UNLESS(res.StaticDistance(ends.goal.x(), ends.goal.y()) > r, "scenario.robot_goal: (", ends.goal.transpose(),
-                    ") of episode ", e, " is inside or too close to a static obstacle");
-    FS_THROW_UNLESS(Reachable(res, start, ends.goal, r), "scenario.robot_goal: (", ends.goal.transpose(),
-                    ") of episode ", e, " is unreachable from the start on the static map");
-    // The controllers see the map artifact (through the swept field), not the raster: check there too.
+    FS_THROW_UNLESS(res.StaticDistance(start.x(), start.y()) > r, "scenario.robot_start: (",
+                    start.transpose(), ") of episode ", e,
+                    " is in collision with a static obstacle");
+    FS_THROW_UNLESS(res.StaticDistance(ends.goal.x(), ends.goal.y()) > r, "scenario.robot_goal: (",
+                    ends.goal.transpose(), ") of episode ", e,
+                    " is inside or too close to a static obstacle");
+    FS_THROW_UNLESS(Reachable(res, start, ends.goal, r), "scenario.robot_goal: (",
+                    ends.goal.transpose(), ") of episode ", e,
+                    " is unreachable from the start on the static map");
+    // The controllers see the map artifact (through the swept field), not the raster: check there
+    // too.
     MapWorkspace ws = res.field->MakeWorkspace();
     const double eps = c.span.options.epsilon;
-    FS_THROW_UNLESS(!res.field->Collides(start.x(), start.y(), eps, &ws), "scenario.robot_start: (", start.transpose(),
-                    ") of episode ", e, " is in collision on the map artifact (swept occupancy above epsilon ", eps, ")");
-    FS_THROW_UNLESS(!res.field->Collides(ends.goal.x(), ends.goal.y(), eps, &ws), "scenario.robot_goal: (",
-                    ends.goal.transpose(), ") of episode ", e, " is occupied on the map artifact");
-    FS_THROW_UNLESS(nav::GoalDistanceField(*res.field, ends.goal, eps).Reaches(start), "scenario.robot_goal: (",
-                    ends.goal.transpose(), ") of episode ", e, " is unreachable from the start on the map artifact");
+    FS_THROW_UNLESS(!res.field->Collides(start.x(), start.y(), eps, &ws), "scenario.robot_start: (",
+                    start.transpose(), ") of episode ", e,
+                    " is in collision on the map artifact (swept occupancy above epsilon ", eps,
+                    ")");
+    FS_THROW_UNLESS(!res.field->Collides(ends.goal.x(), ends.goal.y(), eps, &ws),
+                    "scenario.robot_goal: (", ends.goal.transpose(), ") of episode ", e,
+                    " is occupied on the map artifact");
+    FS_THROW_UNLESS(nav::GoalDistanceField(*res.field, ends.goal, eps).Reaches(start),
+                    "scenario.robot_goal: (", ends.goal.transpose(), ") of episode ", e,
+                    " is unreachable from the start on the map artifact");
   }
   std::vector<EpisodeResult> results;
   std::ofstream csv(out_dir + "/episodes.csv");
-  csv << "method,episode,seed,reached,ttg,doc,doc_static,min_clearance,path_length,cycles,solve_failures,cycle_ms_median,cycle_ms_p99\n";
+  csv << "method,episode,seed,reached,ttg,doc,doc_static,min_clearance,path_length,cycles,solve_"
+         "failures,cycle_ms_median,cycle_ms_p99\n";
   for (const NavigationMethod method : c.Methods()) {
     for (int e = 0; e < n; ++e) {
       std::unique_ptr<VideoRecorder> video;
       if (c.video.enabled && MethodName(method) == c.video.method && e == c.video.episode)
-        video = std::make_unique<VideoRecorder>(out_dir + "/episode.avi", res.raster, c.video, c.dt, c.seed);
+        video = std::make_unique<VideoRecorder>(out_dir + "/episode.avi", res.raster, c.video, c.dt,
+                                                c.seed);
       EpisodeResult r = RunEpisode(c, res, method, e, video.get());
-      csv << r.method << ',' << r.episode << ',' << r.seed << ',' << r.reached << ',' << r.ttg << ',' << r.doc << ',' << r.doc_static << ','
-          << r.min_clearance << ',' << r.path_length << ',' << r.cycles << ',' << r.solve_failures << ','
-          << Percentile(r.cycle_ms, 0.5) << ',' << Percentile(r.cycle_ms, 0.99) << '\n';
+      csv << r.method << ',' << r.episode << ',' << r.seed << ',' << r.reached << ',' << r.ttg
+          << ',' << r.doc << ',' << r.doc_static << ',' << r.min_clearance << ',' << r.path_length
+          << ',' << r.cycles << ',' << r.solve_failures << ',' << Percentile(r.cycle_ms, 0.5) << ','
+          << Percentile(r.cycle_ms, 0.99) << '\n';
       csv.flush();
-      log::Info(r.method, " episode ", e, ": ", r.reached ? "reached" : "not reached", " ttg ", r.ttg, " s, doc ", r.doc,
-                " s, min clearance ", r.min_clearance, " m, cycle median ", Percentile(r.cycle_ms, 0.5), " ms");
+      log::Info(r.method, " episode ", e, ": ", r.reached ? "reached" : "not reached", " ttg ",
+                r.ttg, " s, doc ", r.doc, " s, min clearance ", r.min_clearance,
+                " m, cycle median ", Percentile(r.cycle_ms, 0.5), " ms");
       results.push_back(std::move(r));
     }
   }

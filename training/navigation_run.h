@@ -25,7 +25,8 @@ struct NavigationResources {
   std::unique_ptr<OccupancyMap> map;
   std::unique_ptr<nav::StaticCollisionField> field;
   OccupancyRaster raster;
-  Eigen::MatrixXf static_distance;  ///< [rows x cols] of `raster`: distance to the nearest obstacle (m)
+  Eigen::MatrixXf
+      static_distance;  ///< [rows x cols] of `raster`: distance to the nearest obstacle (m)
   std::unique_ptr<SpanPredictor> predictor;  ///< null when no method needs it
   double StaticDistance(double x, double y) const;
 };
@@ -33,7 +34,8 @@ struct NavigationResources {
 /// Builds DIR/map.h5 from the scenario (or loads map.artifact), and loads predictor.artifact when a
 /// method needs it. Wrong artifact kinds, a start or goal in collision or an unreachable goal (no
 /// free path on the static raster) are Errors naming the config key.
-NavigationResources PrepareNavigation(const NavigationExperimentConfig& config, const std::string& out_dir);
+NavigationResources PrepareNavigation(const NavigationExperimentConfig& config,
+                                      const std::string& out_dir);
 
 struct EpisodeResult {
   std::string method;
@@ -56,13 +58,16 @@ class EpisodeRecorder {
   virtual ~EpisodeRecorder() = default;
   /// Called after each control cycle with the controller's predictions (SPAN; else empty).
   virtual void Frame(double time, const nav::UnicycleState& robot, const Eigen::Vector2d& goal,
-                     const std::vector<CrowdAgent>& agents, const std::vector<TrajectoryDistribution>* predictions,
-                     int num_predictions, const Eigen::Matrix2Xd& path_so_far) = 0;
+                     const std::vector<CrowdAgent>& agents,
+                     const std::vector<TrajectoryDistribution>* predictions, int num_predictions,
+                     const Eigen::Matrix2Xd& path_so_far) = 0;
 };
 
-/// Runs one episode of `method` (span | reactive | cl_rrt_star). Never throws from the control loop.
-EpisodeResult RunEpisode(const NavigationExperimentConfig& config, const NavigationResources& resources,
-                         NavigationMethod method, int episode, EpisodeRecorder* recorder = nullptr);
+/// Runs one episode of `method` (span | reactive | cl_rrt_star). Never throws from the control
+/// loop.
+EpisodeResult RunEpisode(const NavigationExperimentConfig& config,
+                         const NavigationResources& resources, NavigationMethod method, int episode,
+                         EpisodeRecorder* recorder = nullptr);
 
 struct MethodSummary {
   std::string method;
@@ -82,10 +87,11 @@ inline const RunDirectoryRules kNavigationRunRules{{"summary.json", "episodes.cs
 
 /// Runs every method for `episodes` episodes (config.episodes when <= 0) into `out_dir`.
 /// @return the summaries, in config.methods order.
-std::vector<MethodSummary> RunNavigation(const NavigationExperimentConfig& config, const std::string& out_dir,
-                                         int episodes = 0);
+std::vector<MethodSummary> RunNavigation(const NavigationExperimentConfig& config,
+                                         const std::string& out_dir, int episodes = 0);
 
 /// summary.json text: {"scenario": ..., "episodes": N, "<method>": {...}, ...}.
-std::string SummaryJson(const NavigationExperimentConfig& config, int episodes, const std::vector<MethodSummary>& s);
+std::string SummaryJson(const NavigationExperimentConfig& config, int episodes,
+                        const std::vector<MethodSummary>& s);
 
 }  // namespace foresight

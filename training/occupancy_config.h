@@ -23,10 +23,11 @@ enum class ScanSource { kCarmen, kSynthetic };
 
 struct OccupancyDataConfig {
   ScanSource format = ScanSource::kSynthetic;
-  std::string root;  ///< directory of relative file names (empty: $FORESIGHT_DATA or ../shared/data)
+  std::string
+      root;  ///< directory of relative file names (empty: $FORESIGHT_DATA or ../shared/data)
   std::string file;  ///< CARMEN log (format: carmen)
   OccupancyPointsConfig points;
-  int test_every = 10;        ///< scan i is a test scan when i % test_every == test_offset
+  int test_every = 10;  ///< scan i is a test scan when i % test_every == test_offset
   int test_offset = 9;
   int train_scan_stride = 1;  ///< train on every k-th training scan (10: the sparse case)
   int val_every = 0;          ///< > 0: every val_every-th training scan is held out for validation
@@ -35,18 +36,23 @@ struct OccupancyDataConfig {
   template <class A>
   void Serialize(A* a) {
     a->VisitEnum("format", &format,
-                 config::EnumNames<ScanSource>{{ScanSource::kCarmen, "carmen"}, {ScanSource::kSynthetic, "synthetic"}},
+                 config::EnumNames<ScanSource>{{ScanSource::kCarmen, "carmen"},
+                                               {ScanSource::kSynthetic, "synthetic"}},
                  "source of the laser scans");
-    a->Visit("root", &root, config::Range::Any(), "directory for relative file names (empty: $FORESIGHT_DATA or ../shared/data)");
+    a->Visit("root", &root, config::Range::Any(),
+             "directory for relative file names (empty: $FORESIGHT_DATA or ../shared/data)");
     a->Visit("file", &file, config::Range::Any(), "CARMEN log (format: carmen)");
     a->Visit("points", &points, config::Range::Any(), "labelled points from beams");
-    a->Visit("test_every", &test_every, config::Range::Closed(2, 1000), "every k-th scan is a test scan");
-    a->Visit("test_offset", &test_offset, config::Range::AtLeast(0), "which scan of each k is the test scan");
+    a->Visit("test_every", &test_every, config::Range::Closed(2, 1000),
+             "every k-th scan is a test scan");
+    a->Visit("test_offset", &test_offset, config::Range::AtLeast(0),
+             "which scan of each k is the test scan");
     a->Visit("train_scan_stride", &train_scan_stride, config::Range::Closed(1, 1000),
              "train on every k-th training scan only (sparse case: 10)");
     a->Visit("val_every", &val_every, config::Range::Closed(0, 1000),
              "> 0: hold out every k-th training scan for validation (hyper-parameter choice)");
-    a->Visit("synthetic", &synthetic, config::Range::Any(), "simulated floor plan and robots (format: synthetic)");
+    a->Visit("synthetic", &synthetic, config::Range::Any(),
+             "simulated floor plan and robots (format: synthetic)");
   }
 };
 
@@ -54,13 +60,14 @@ struct FusionExperimentConfig {
   enum class Robots { kQuadrants, kRecorded };
   Robots robots = Robots::kQuadrants;  ///< how scans are assigned to robots
   double centre_x = 0, centre_y = 0;   ///< quadrant centre (m)
-  int merges = 4;                      ///< repeated fusion after each 1/merges of every robot's data
+  int merges = 4;  ///< repeated fusion after each 1/merges of every robot's data
   FusionOptions options;
 
   template <class A>
   void Serialize(A* a) {
     a->VisitEnum("robots", &robots,
-                 config::EnumNames<Robots>{{Robots::kQuadrants, "quadrants"}, {Robots::kRecorded, "recorded"}},
+                 config::EnumNames<Robots>{{Robots::kQuadrants, "quadrants"},
+                                           {Robots::kRecorded, "recorded"}},
                  "robots of the scans: quadrant of the mean hit point, or as recorded (synthetic)");
     a->Visit("centre_x", &centre_x, config::Range::Any(), "quadrant centre x (m)");
     a->Visit("centre_y", &centre_y, config::Range::Any(), "quadrant centre y (m)");
@@ -76,7 +83,8 @@ struct OccupancyEvalConfig {
 
   template <class A>
   void Serialize(A* a) {
-    a->Visit("plot_resolution", &plot_resolution, config::Range::Positive(), "m per pixel of the map PNG");
+    a->Visit("plot_resolution", &plot_resolution, config::Range::Positive(),
+             "m per pixel of the map PNG");
     a->Visit("roc_points", &roc_points, config::Range::Closed(2, 100000), "rows of roc.csv");
   }
 };
@@ -97,14 +105,17 @@ struct OccupancyExperimentConfig {
   template <class A>
   void Serialize(A* a) {
     a->Visit("model", &model, config::Range::Any(),
-             "occupancy.fast_bhm | occupancy.bhm | occupancy.hilbert | occupancy.grid | occupancy.fusion");
+             "occupancy.fast_bhm | occupancy.bhm | occupancy.hilbert | occupancy.grid | "
+             "occupancy.fusion");
     a->Visit("seed", &seed, config::Range::Any(), "seed of point sampling and SGD order");
     a->Visit("data", &data, config::Range::Any(), "scans, labelled points and splits");
-    a->Visit("features", &features, config::Range::Any(), "hinge feature grid (Hilbert maps, BHMs)");
+    a->Visit("features", &features, config::Range::Any(),
+             "hinge feature grid (Hilbert maps, BHMs)");
     a->Visit("fast_bhm", &fast_bhm, config::Range::Any(), "Fast-BHM / BHM variational EM");
     a->Visit("hilbert", &hilbert, config::Range::Any(), "Hilbert map SGD");
     a->Visit("grid", &grid, config::Range::Any(), "occupancy grid baseline");
-    a->Visit("fusion", &fusion, config::Range::Any(), "multi-robot fusion (model: occupancy.fusion)");
+    a->Visit("fusion", &fusion, config::Range::Any(),
+             "multi-robot fusion (model: occupancy.fusion)");
     a->VisitEnum("precision", &precision,
                  config::EnumNames<StoredPrecision>{{StoredPrecision::kFloat32, "float32"},
                                                     {StoredPrecision::kFloat64, "float64"}},
@@ -114,6 +125,5 @@ struct OccupancyExperimentConfig {
   /// Rules across keys; errors name `source` and the key.
   void Validate(const std::string& source) const;
 };
-
 
 }  // namespace foresight

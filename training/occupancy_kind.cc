@@ -20,10 +20,13 @@ ExperimentKind OccupancyKind() {
   k.resumable = false;  // one pass of seconds
   k.reference = [] { return config::ReferenceTable<OccupancyExperimentConfig>(); };
   k.train = [](const TrainRequest& req) {
-    FS_THROW_UNLESS(req.config != "default" && !req.config.empty(),
-                    "occupancy maps have no embedded default config; name one (configs/occupancy/*.yaml)");
-    const auto c = config::LoadExperimentConfig<OccupancyExperimentConfig>(req.config, req.overrides);
-    FS_THROW_UNLESS(!req.resume, "--resume: occupancy maps train in one pass (seconds); run again into a new "
+    FS_THROW_UNLESS(
+        req.config != "default" && !req.config.empty(),
+        "occupancy maps have no embedded default config; name one (configs/occupancy/*.yaml)");
+    const auto c =
+        config::LoadExperimentConfig<OccupancyExperimentConfig>(req.config, req.overrides);
+    FS_THROW_UNLESS(!req.resume,
+                    "--resume: occupancy maps train in one pass (seconds); run again into a new "
                     "or empty --run-dir");
     TrainOccupancyRun(c, req.run_dir);
     std::cout << "artifact: " << req.run_dir << "/model.h5\n";
@@ -33,12 +36,14 @@ ExperimentKind OccupancyKind() {
   };
   k.export_run = [](const std::string& run_dir) {
     const std::string artifact = run_dir + "/model.h5";
-    FS_THROW_UNLESS(std::filesystem::exists(artifact), artifact, ": not found (train the map first)");
+    FS_THROW_UNLESS(std::filesystem::exists(artifact), artifact,
+                    ": not found (train the map first)");
     (void)LoadOccupancyMap(artifact);  // the engine loads what training wrote
     return artifact;
   };
   k.evaluate = [](const std::string& run_dir, const std::vector<std::string>& overrides) {
-    return EvaluateOccupancyRun(LoadRunConfig<OccupancyExperimentConfig>(run_dir, overrides), run_dir);
+    return EvaluateOccupancyRun(LoadRunConfig<OccupancyExperimentConfig>(run_dir, overrides),
+                                run_dir);
   };
   return k;
 }

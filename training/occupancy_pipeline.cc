@@ -37,16 +37,20 @@ std::string Json(double v) {
 }
 
 std::string MetricsJson(const BinaryMetrics& m) {
-  return "{\"auc\": " + Json(m.auc) + ", \"precision\": " + Json(m.precision) + ", \"recall\": " + Json(m.recall) + "}";
+  return "{\"auc\": " + Json(m.auc) + ", \"precision\": " + Json(m.precision) +
+         ", \"recall\": " + Json(m.recall) + "}";
 }
 
-void WriteRoc(const OccupancyMap& map, const LabelledPoints& test, int points, const std::string& path) {
+void WriteRoc(const OccupancyMap& map, const LabelledPoints& test, int points,
+              const std::string& path) {
   MapWorkspace ws = map.MakeWorkspace();
   std::vector<double> scores(test.size());
-  for (std::int64_t i = 0; i < test.size(); ++i) scores[i] = map.Probability(test.xy(0, i), test.xy(1, i), &ws);
+  for (std::int64_t i = 0; i < test.size(); ++i)
+    scores[i] = map.Probability(test.xy(0, i), test.xy(1, i), &ws);
   std::ofstream out(path);
   out << "false_positive_rate,true_positive_rate\n";
-  for (const auto& [fpr, tpr] : RocCurve(scores, test.occupied, points)) out << fpr << "," << tpr << "\n";
+  for (const auto& [fpr, tpr] : RocCurve(scores, test.occupied, points))
+    out << fpr << "," << tpr << "\n";
 }
 
 }  // namespace
@@ -66,14 +70,16 @@ OccupancyData LoadOccupancyData(const OccupancyExperimentConfig& c) {
   if (d.format == ScanSource::kCarmen) {
     FS_THROW_UNLESS(!d.file.empty(), "data.file: no CARMEN log given (format: carmen)");
     const std::string path = ResolveDataFile(d.root, d.file);
-    FS_THROW_UNLESS(fs::exists(path), path, ": CARMEN log not found (set data.root or $FORESIGHT_DATA)");
+    FS_THROW_UNLESS(fs::exists(path), path,
+                    ": CARMEN log not found (set data.root or $FORESIGHT_DATA)");
     data.scans = ReadCarmenLog(path);
   } else {
     const FloorPlan plan = GenerateFloorPlan(d.synthetic, static_cast<std::uint64_t>(c.seed));
     data.scans = SimulateRobots(plan, d.synthetic, static_cast<std::uint64_t>(c.seed));
   }
   data.points = SampleLabelledPoints(data.scans, d.points, static_cast<std::uint64_t>(c.seed));
-  const ScanSplit split = SplitEveryKth(static_cast<int>(data.scans.size()), d.test_every, d.test_offset);
+  const ScanSplit split =
+      SplitEveryKth(static_cast<int>(data.scans.size()), d.test_every, d.test_offset);
   data.test_scans = split.test;
   for (std::size_t i = 0; i < split.train.size(); i += d.train_scan_stride) {
     const auto k = i / d.train_scan_stride;
@@ -83,20 +89,23 @@ OccupancyData LoadOccupancyData(const OccupancyExperimentConfig& c) {
       data.train_scans.push_back(split.train[i]);
     }
   }
-  FS_THROW_UNLESS(!data.train_scans.empty() && !data.test_scans.empty(), "data: ", data.scans.size(),
-                  " scans leave ", data.train_scans.size(), " training and ", data.test_scans.size(),
+  FS_THROW_UNLESS(!data.train_scans.empty() && !data.test_scans.empty(),
+                  "data: ", data.scans.size(), " scans leave ", data.train_scans.size(),
+                  " training and ", data.test_scans.size(),
                   " test scans; need at least one of each");
   data.train = SelectScans(data.points, data.train_scans);
   data.test = SelectScans(data.points, data.test_scans);
   if (!data.val_scans.empty()) data.val = SelectScans(data.points, data.val_scans);
-  log::Info("occupancy data: ", data.scans.size(), " scans, ", data.points.size(), " labelled points (",
-            data.points.dropped_beams, " beams dropped); train ", data.train_scans.size(), " scans / ",
-            data.train.size(), " points, val ", data.val_scans.size(), " scans, test ", data.test_scans.size(),
-            " scans / ", data.test.size(), " points");
+  log::Info("occupancy data: ", data.scans.size(), " scans, ", data.points.size(),
+            " labelled points (", data.points.dropped_beams, " beams dropped); train ",
+            data.train_scans.size(), " scans / ", data.train.size(), " points, val ",
+            data.val_scans.size(), " scans, test ", data.test_scans.size(), " scans / ",
+            data.test.size(), " points");
   return data;
 }
 
-std::unique_ptr<OccupancyMap> TrainOccupancyMap(const std::string& model, const OccupancyExperimentConfig& c,
+std::unique_ptr<OccupancyMap> TrainOccupancyMap(const std::string& model,
+                                                const OccupancyExperimentConfig& c,
                                                 const OccupancyData& data, double* seconds) {
   const auto start = std::chrono::steady_clock::now();
   std::unique_ptr<OccupancyMap> map;
@@ -109,8 +118,9 @@ std::unique_ptr<OccupancyMap> TrainOccupancyMap(const std::string& model, const 
     UpdateOnScans(&learner, data.train, FirstScans(data.train));
     map = std::make_unique<HingeMap>(learner.ToMap());
   } else if (model == kHilbertMapType) {
-    map = std::make_unique<HingeMap>(TrainHilbertMap(HingeGrid(c.features), c.hilbert, data.train.xy,
-                                                     data.train.occupied.data(), static_cast<std::uint64_t>(c.seed)));
+    map = std::make_unique<HingeMap>(TrainHilbertMap(HingeGrid(c.features), c.hilbert,
+                                                     data.train.xy, data.train.occupied.data(),
+                                                     static_cast<std::uint64_t>(c.seed)));
   } else if (model == kGridMapType) {
     map = std::make_unique<GridMap>(BuildGridMap(c.grid, data.TrainScanList()));
   } else {
@@ -121,7 +131,8 @@ std::unique_ptr<OccupancyMap> TrainOccupancyMap(const std::string& model, const 
   return map;
 }
 
-void SaveOccupancyMap(const OccupancyMap& map, const std::string& path, const OccupancyExperimentConfig& c) {
+void SaveOccupancyMap(const OccupancyMap& map, const std::string& path,
+                      const OccupancyExperimentConfig& c) {
   const std::string yaml = config::ToYaml(c);
   if (const auto* h = dynamic_cast<const HingeMap*>(&map)) {
     h->Save(path, yaml, c.seed, c.precision);
@@ -133,8 +144,9 @@ void SaveOccupancyMap(const OccupancyMap& map, const std::string& path, const Oc
 }
 
 std::int64_t ArtifactBytes(const OccupancyMap& map, const OccupancyExperimentConfig& c) {
-  const fs::path tmp = fs::temp_directory_path() /
-                       ("foresight_artifact_size_" + std::to_string(reinterpret_cast<std::uintptr_t>(&map)) + ".h5");
+  const fs::path tmp =
+      fs::temp_directory_path() /
+      ("foresight_artifact_size_" + std::to_string(reinterpret_cast<std::uintptr_t>(&map)) + ".h5");
   SaveOccupancyMap(map, tmp.string(), c);
   const auto bytes = static_cast<std::int64_t>(fs::file_size(tmp));
   fs::remove(tmp);
@@ -155,7 +167,8 @@ FusionResult RunFusion(const OccupancyExperimentConfig& c, const OccupancyData& 
   // Robots: lists of indices into data.train's scans, in recording order.
   std::vector<std::vector<int>> robots;
   if (c.fusion.robots == FusionExperimentConfig::Robots::kQuadrants) {
-    const auto q = QuadrantSplit(data.train, FirstScans(data.train), c.fusion.centre_x, c.fusion.centre_y);
+    const auto q =
+        QuadrantSplit(data.train, FirstScans(data.train), c.fusion.centre_x, c.fusion.centre_y);
     for (const auto& list : q)
       if (!list.empty()) robots.push_back(list);
   } else {
@@ -163,8 +176,9 @@ FusionResult RunFusion(const OccupancyExperimentConfig& c, const OccupancyData& 
     for (const int id : data.train.robot) max_robot = std::max(max_robot, id);
     robots.resize(max_robot + 1);
     for (int s = 0; s < data.train.num_scans(); ++s) robots[data.train.robot[s]].push_back(s);
-    robots.erase(std::remove_if(robots.begin(), robots.end(), [](const auto& l) { return l.empty(); }),
-                 robots.end());
+    robots.erase(
+        std::remove_if(robots.begin(), robots.end(), [](const auto& l) { return l.empty(); }),
+        robots.end());
   }
   FS_THROW_UNLESS(robots.size() >= 2, "fusion: the training scans belong to ", robots.size(),
                   " robot(s); need at least two (check fusion.robots / centre)");
@@ -198,7 +212,8 @@ FusionResult RunFusion(const OccupancyExperimentConfig& c, const OccupancyData& 
     for (const auto& scans : robots) {
       const std::size_t b = scans.size() * m / merges, e = scans.size() * (m + 1) / merges;
       const std::vector<int> chunk(scans.begin() + b, scans.begin() + e);
-      FastBhmLearner l = global ? FastBhmLearner(*global, c.fast_bhm) : FastBhmLearner(grid, c.fast_bhm);
+      FastBhmLearner l =
+          global ? FastBhmLearner(*global, c.fast_bhm) : FastBhmLearner(grid, c.fast_bhm);
       UpdateOnScans(&l, data.train, chunk);
       copies.push_back(l.ToMap());
     }
@@ -223,7 +238,8 @@ void TrainOccupancyRun(const OccupancyExperimentConfig& c, const std::string& ru
     std::ofstream out(run_dir + "/training_summary.json");
     out << "{\"seconds\": " << Json(Seconds(start)) << ", \"robots\": " << r.robot_scans.size()
         << ", \"robot_scans\": [";
-    for (std::size_t i = 0; i < r.robot_scans.size(); ++i) out << (i ? ", " : "") << r.robot_scans[i];
+    for (std::size_t i = 0; i < r.robot_scans.size(); ++i)
+      out << (i ? ", " : "") << r.robot_scans[i];
     out << "], \"merges\": " << c.fusion.merges << "}\n";
   } else {
     double secs = 0;
@@ -241,7 +257,8 @@ std::string EvaluateOccupancyRun(const OccupancyExperimentConfig& c, const std::
   fs::create_directories(run_dir + "/plots");
   std::ostringstream json;
   json << "{\n  \"model\": \"" << c.model << "\",\n  \"train_scans\": " << data.train_scans.size()
-       << ",\n  \"test_scans\": " << data.test_scans.size() << ",\n  \"train_points\": " << data.train.size()
+       << ",\n  \"test_scans\": " << data.test_scans.size()
+       << ",\n  \"train_points\": " << data.train.size()
        << ",\n  \"test_points\": " << data.test.size() << ",\n";
   if (c.model == "occupancy.fusion") {
     // Evaluates what ships: the maps as loaded from their artifacts.
@@ -252,21 +269,28 @@ std::string EvaluateOccupancyRun(const OccupancyExperimentConfig& c, const std::
     const BinaryMetrics once = EvaluateMap(*once_map, data.test);
     const BinaryMetrics repeated = EvaluateMap(*repeated_map, data.test);
     json << "  \"merges\": " << c.fusion.merges << ",\n  \"auc_single\": " << Json(single.auc)
-         << ",\n  \"auc_fuse_once\": " << Json(once.auc) << ",\n  \"auc_repeated\": " << Json(repeated.auc)
-         << ",\n  \"single\": " << MetricsJson(single) << ",\n  \"fuse_once\": " << MetricsJson(once)
+         << ",\n  \"auc_fuse_once\": " << Json(once.auc)
+         << ",\n  \"auc_repeated\": " << Json(repeated.auc)
+         << ",\n  \"single\": " << MetricsJson(single)
+         << ",\n  \"fuse_once\": " << MetricsJson(once)
          << ",\n  \"repeated\": " << MetricsJson(repeated) << ",\n  \"auc\": " << Json(repeated.auc)
-         << ",\n  \"precision\": " << Json(repeated.precision) << ",\n  \"recall\": " << Json(repeated.recall)
+         << ",\n  \"precision\": " << Json(repeated.precision)
+         << ",\n  \"recall\": " << Json(repeated.recall)
          << ",\n  \"artifact_bytes\": " << fs::file_size(artifact) << "\n}\n";
-    WriteMapPanels({{"single map", single_map.get()}, {"fused once", once_map.get()},
+    WriteMapPanels({{"single map", single_map.get()},
+                    {"fused once", once_map.get()},
                     {"repeatedly fused", repeated_map.get()}},
                    c.eval.plot_resolution, run_dir + "/plots/map.png");
-    log::Info("fusion AUC: single ", single.auc, ", fuse once ", once.auc, ", repeated ", repeated.auc);
+    log::Info("fusion AUC: single ", single.auc, ", fuse once ", once.auc, ", repeated ",
+              repeated.auc);
   } else {
     const std::unique_ptr<OccupancyMap> loaded = LoadOccupancyMap(artifact);  // evaluate what ships
     const BinaryMetrics m = EvaluateMap(*loaded, data.test);
     json << "  \"auc\": " << Json(m.auc) << ",\n  \"precision\": " << Json(m.precision)
-         << ",\n  \"recall\": " << Json(m.recall) << ",\n  \"artifact_bytes\": " << fs::file_size(artifact);
-    if (data.val.size() > 0) json << ",\n  \"val\": " << MetricsJson(EvaluateMap(*loaded, data.val));
+         << ",\n  \"recall\": " << Json(m.recall)
+         << ",\n  \"artifact_bytes\": " << fs::file_size(artifact);
+    if (data.val.size() > 0)
+      json << ",\n  \"val\": " << MetricsJson(EvaluateMap(*loaded, data.val));
     json << "\n}\n";
     WriteRoc(*loaded, data.test, c.eval.roc_points, run_dir + "/roc.csv");
     WriteMapPanels({{c.model, loaded.get()}}, c.eval.plot_resolution, run_dir + "/plots/map.png");

@@ -19,8 +19,8 @@ namespace foresight {
 
 /// Scans and labelled points of an experiment, split by scan.
 struct OccupancyData {
-  std::vector<LaserScan> scans;   ///< all scans, in recording order
-  LabelledPoints points;          ///< labelled points of all scans (scan s of points = scans[s])
+  std::vector<LaserScan> scans;  ///< all scans, in recording order
+  LabelledPoints points;         ///< labelled points of all scans (scan s of points = scans[s])
   std::vector<int> train_scans, val_scans, test_scans;  ///< indices into scans, in order
   LabelledPoints train, val, test;                      ///< points of those scans
   std::vector<LaserScan> TrainScanList() const;         ///< the training scans themselves
@@ -32,10 +32,13 @@ OccupancyData LoadOccupancyData(const OccupancyExperimentConfig& config);
 
 /// Trains one map of kind `model` (occupancy.fast_bhm | bhm | hilbert | grid) on the training
 /// scans, in recording order. `seconds` receives the wall-clock training time.
-std::unique_ptr<OccupancyMap> TrainOccupancyMap(const std::string& model, const OccupancyExperimentConfig& config,
-                                                const OccupancyData& data, double* seconds = nullptr);
+std::unique_ptr<OccupancyMap> TrainOccupancyMap(const std::string& model,
+                                                const OccupancyExperimentConfig& config,
+                                                const OccupancyData& data,
+                                                double* seconds = nullptr);
 /// Writes the map's artifact (hinge maps with config.precision).
-void SaveOccupancyMap(const OccupancyMap& map, const std::string& path, const OccupancyExperimentConfig& config);
+void SaveOccupancyMap(const OccupancyMap& map, const std::string& path,
+                      const OccupancyExperimentConfig& config);
 /// Size in bytes of the artifact SaveOccupancyMap would write (measured via a temporary file).
 std::int64_t ArtifactBytes(const OccupancyMap& map, const OccupancyExperimentConfig& config);
 /// AUC, precision and recall (threshold 0.5) of the map's probabilities on labelled points.
@@ -57,6 +60,7 @@ void TrainOccupancyRun(const OccupancyExperimentConfig& config, const std::strin
 
 /// Evaluates the run's maps as loaded from their artifacts on the held-out scans: writes
 /// eval.json, roc.csv (single maps) and plots/map.png. @return the eval.json text.
-std::string EvaluateOccupancyRun(const OccupancyExperimentConfig& config, const std::string& run_dir);
+std::string EvaluateOccupancyRun(const OccupancyExperimentConfig& config,
+                                 const std::string& run_dir);
 
 }  // namespace foresight

@@ -15,6 +15,7 @@ struct MapPanel {
 };
 
 /// Renders every map over the first map's extent at `resolution` m per pixel, side by side.
-void WriteMapPanels(const std::vector<MapPanel>& panels, double resolution, const std::string& png_path);
+void WriteMapPanels(const std::vector<MapPanel>& panels, double resolution,
+                    const std::string& png_path);
 
 }  // namespace foresight

@@ -10,7 +10,8 @@
 
 namespace foresight {
 
-OctomapFigures RunOctomapBaseline(const OccupancyData& data, double max_range, double resolution, int repeats) {
+OctomapFigures RunOctomapBaseline(const OccupancyData& data, double max_range, double resolution,
+                                  int repeats) {
   OctomapFigures f;
   std::unique_ptr<octomap::OcTree> tree;
   std::vector<double> times;
@@ -27,9 +28,11 @@ OctomapFigures RunOctomapBaseline(const OccupancyData& data, double max_range, d
         cloud.push_back(static_cast<float>(scan.x + range * std::cos(a)),
                         static_cast<float>(scan.y + range * std::sin(a)), 0.0f);
       }
-      tree->insertPointCloud(cloud, octomap::point3d(static_cast<float>(scan.x), static_cast<float>(scan.y), 0.0f));
+      tree->insertPointCloud(
+          cloud, octomap::point3d(static_cast<float>(scan.x), static_cast<float>(scan.y), 0.0f));
     }
-    times.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    times.push_back(
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   }
   std::sort(times.begin(), times.end());
   f.insert_s = times[times.size() / 2];

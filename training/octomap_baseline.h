@@ -11,12 +11,13 @@
 namespace foresight {
 
 struct OctomapFigures {
-  double insert_s = 0;          ///< wall-clock time to insert all training scans (median of repeats)
+  double insert_s = 0;  ///< wall-clock time to insert all training scans (median of repeats)
   double auc = 0, precision = 0, recall = 0;  ///< on data.test
-  std::int64_t bytes = 0;       ///< writeBinary size (maximum-likelihood compressed tree)
-  std::int64_t memory = 0;      ///< OcTree::memoryUsage()
+  std::int64_t bytes = 0;   ///< writeBinary size (maximum-likelihood compressed tree)
+  std::int64_t memory = 0;  ///< OcTree::memoryUsage()
 };
 
-OctomapFigures RunOctomapBaseline(const OccupancyData& data, double max_range, double resolution, int repeats);
+OctomapFigures RunOctomapBaseline(const OccupancyData& data, double max_range, double resolution,
+                                  int repeats);
 
 }  // namespace foresight

@@ -20,8 +20,10 @@ std::string Clock(double seconds) {
   if (!std::isfinite(seconds) || seconds < 0) return "--:--";
   const long s = std::lround(seconds);
   char buf[32];
-  if (s >= 3600) std::snprintf(buf, sizeof buf, "%ld:%02ld:%02ld", s / 3600, (s / 60) % 60, s % 60);
-  else std::snprintf(buf, sizeof buf, "%02ld:%02ld", s / 60, s % 60);
+  if (s >= 3600)
+    std::snprintf(buf, sizeof buf, "%ld:%02ld:%02ld", s / 3600, (s / 60) % 60, s % 60);
+  else
+    std::snprintf(buf, sizeof buf, "%02ld:%02ld", s / 60, s % 60);
   return buf;
 }
 }  // namespace
@@ -50,8 +52,10 @@ void Progress::EndStep(int step, const std::string& summary) {
     std::fprintf(stderr, "\r\033[K");
   }
   if (bar_ || lines_) {
-    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-    std::fprintf(stderr, "epoch %d/%d %s [%s]\n", step + 1, total_, summary.c_str(), Clock(elapsed).c_str());
+    const double elapsed =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    std::fprintf(stderr, "epoch %d/%d %s [%s]\n", step + 1, total_, summary.c_str(),
+                 Clock(elapsed).c_str());
     std::fflush(stderr);
   }
 }

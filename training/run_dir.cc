@@ -19,7 +19,8 @@ std::string ReadText(const std::string& path) {
 
 void StartRunDirectory(const std::string& run_dir, const std::string& resolved_yaml, bool resume,
                        const RunDirectoryRules& rules) {
-  FS_THROW_UNLESS(!resume || rules.resumable, "--resume: this kind runs in one pass and cannot be continued; "
+  FS_THROW_UNLESS(!resume || rules.resumable,
+                  "--resume: this kind runs in one pass and cannot be continued; "
                   "run it again into a new or empty --run-dir");
   const std::string config_path = run_dir + "/config.yaml";
   if (resume) {
@@ -32,7 +33,8 @@ void StartRunDirectory(const std::string& run_dir, const std::string& resolved_y
       const fs::path p = fs::path(run_dir) / marker;
       const bool present = fs::is_directory(p) ? !fs::is_empty(p) : fs::exists(p);
       FS_THROW_UNLESS(!present, run_dir, ": already holds a run (", marker, "); ",
-                      rules.resumable ? "continue it with --resume, or " : "", "use a new or empty --run-dir");
+                      rules.resumable ? "continue it with --resume, or " : "",
+                      "use a new or empty --run-dir");
     }
     fs::create_directories(run_dir);
     std::ofstream out(config_path);

@@ -12,10 +12,12 @@ void SpanExperimentConfig::Validate(const std::string& source) const {
                   ": key 'data.synthetic.max_steps' must be >= data.synthetic.min_steps");
   FS_THROW_UNLESS(c.data.val_fraction + c.data.test_fraction < 1.0, source,
                   ": keys 'data.val_fraction' + 'data.test_fraction' must be < 1");
-  FS_THROW_UNLESS(c.data.synthetic.min_steps >= c.windows.observed + c.windows.predicted ||
-                      c.data.format != TrackFormat::kSynthetic,
-                  source, ": key 'data.synthetic.min_steps' must be >= windows.observed + windows.predicted");
-  FS_THROW_UNLESS(!c.network.hidden.empty(), source, ": key 'network.hidden' must list at least one layer");
+  FS_THROW_UNLESS(
+      c.data.synthetic.min_steps >= c.windows.observed + c.windows.predicted ||
+          c.data.format != TrackFormat::kSynthetic,
+      source, ": key 'data.synthetic.min_steps' must be >= windows.observed + windows.predicted");
+  FS_THROW_UNLESS(!c.network.hidden.empty(), source,
+                  ": key 'network.hidden' must list at least one layer");
 }
 
 }  // namespace foresight

@@ -14,10 +14,10 @@
 namespace foresight {
 
 struct SpanEvalConfig {
-  int num_samples = 20;             ///< samples for best-of-N metrics
-  std::int64_t sample_seed = 7;     ///< seed of the evaluation sampler
-  int plot_tracks = 6;              ///< windows drawn in plots/samples.png
-  int max_windows = 0;              ///< evaluate at most this many test windows (0: all)
+  int num_samples = 20;          ///< samples for best-of-N metrics
+  std::int64_t sample_seed = 7;  ///< seed of the evaluation sampler
+  int plot_tracks = 6;           ///< windows drawn in plots/samples.png
+  int max_windows = 0;           ///< evaluate at most this many test windows (0: all)
 
   template <class A>
   void Serialize(A* a) {
@@ -53,6 +53,5 @@ struct SpanExperimentConfig {
   /// Rules across keys; errors name `source` and the key.
   void Validate(const std::string& source) const;
 };
-
 
 }  // namespace foresight

@@ -22,7 +22,8 @@ namespace fs = std::filesystem;
 namespace {
 
 EgoFrame FrameOfWindow(const WindowSet& w, int n) {
-  return EgoFrame::FromPast(w.observed, [&](int i) { return w.Past(n, i); }, true);
+  return EgoFrame::FromPast(
+      w.observed, [&](int i) { return w.Past(n, i); }, true);
 }
 
 /// Constant velocity from the last observed step, with a Gaussian per horizon fitted on training
@@ -40,8 +41,8 @@ struct ConstantVelocity {
       const EgoFrame frame = FrameOfWindow(train, n);
       const Eigen::Vector2d v = train.Past(n, p - 1) - train.Past(n, p - 2);
       for (int k = 0; k < f; ++k) {
-        const Eigen::Vector2d r =
-            frame.rotation.transpose() * (train.Future(n, k) - (train.Past(n, p - 1) + (k + 1) * v));
+        const Eigen::Vector2d r = frame.rotation.transpose() *
+                                  (train.Future(n, k) - (train.Past(n, p - 1) + (k + 1) * v));
         cv.cov_ego[static_cast<std::size_t>(k)] += r * r.transpose();
       }
     }
@@ -84,7 +85,8 @@ std::string Flow(const YAML::Node& node) {
 
 /// "key.path = trained, not given" for the first leaf where `trained` and `given` differ, else "".
 /// Both come from the same config struct, so they have the same keys.
-std::string FirstDifference(const YAML::Node& trained, const YAML::Node& given, const std::string& path) {
+std::string FirstDifference(const YAML::Node& trained, const YAML::Node& given,
+                            const std::string& path) {
   if (trained.IsMap() && given.IsMap()) {
     for (const auto& kv : trained) {
       const std::string key = kv.first.as<std::string>();
@@ -100,8 +102,8 @@ std::string FirstDifference(const YAML::Node& trained, const YAML::Node& given, 
 /// data, windows and seed sections of `config` must equal those stored in the artifact's /config
 /// (data.root, where the files are, may differ).
 void CheckSameDataAsTraining(const SpanExperimentConfig& config, const std::string& artifact) {
-  const SpanExperimentConfig trained =
-      config::ExperimentConfigFromYaml<SpanExperimentConfig>(Artifact::Open(artifact, kSpanModelType).config_yaml(), artifact + ":/config");
+  const SpanExperimentConfig trained = config::ExperimentConfigFromYaml<SpanExperimentConfig>(
+      Artifact::Open(artifact, kSpanModelType).config_yaml(), artifact + ":/config");
   const auto tree = [](SpanExperimentConfig c) {
     c.data.root.clear();
     return config::ParseYaml(config::ToYaml(c), "resolved config");
@@ -140,11 +142,11 @@ std::string SpanEvalReport::ToJson(int num_samples) const {
   return os.str();
 }
 
-SpanEvalReport EvaluateSpanOn(const std::string& artifact, const WindowSet& train, const WindowSet& test,
-                              const SpanEvalConfig& ec) {
+SpanEvalReport EvaluateSpanOn(const std::string& artifact, const WindowSet& train,
+                              const WindowSet& test, const SpanEvalConfig& ec) {
   const SpanPredictor model = SpanPredictor::Load(artifact);
-  FS_THROW_UNLESS(model.observed() == test.observed, artifact, ": model observes ", model.observed(),
-                  " points but the test windows have ", test.observed);
+  FS_THROW_UNLESS(model.observed() == test.observed, artifact, ": model observes ",
+                  model.observed(), " points but the test windows have ", test.observed);
   FS_THROW_UNLESS(std::abs(model.seconds_per_step() - test.seconds_per_step) < 1e-9, artifact,
                   ": model was trained at ", model.seconds_per_step(), " s per step, data has ",
                   test.seconds_per_step);
@@ -159,7 +161,8 @@ SpanEvalReport EvaluateSpanOn(const std::string& artifact, const WindowSet& trai
   std::mt19937_64 rng(static_cast<std::uint64_t>(ec.sample_seed));
   std::normal_distribution<double> n01;
   std::vector<Eigen::Matrix2d> cv_chol(static_cast<std::size_t>(f));
-  for (int k = 0; k < f; ++k) cv_chol[static_cast<std::size_t>(k)] = cv.cov_ego[static_cast<std::size_t>(k)].llt().matrixL();
+  for (int k = 0; k < f; ++k)
+    cv_chol[static_cast<std::size_t>(k)] = cv.cov_ego[static_cast<std::size_t>(k)].llt().matrixL();
 
   SpanEvalReport rep;
   rep.windows = count;
@@ -174,7 +177,8 @@ SpanEvalReport EvaluateSpanOn(const std::string& artifact, const WindowSet& trai
       path.row(k) = dist.MeanPosition(times[k]).transpose();
       cv_path.row(k) = cv.Mean(test, n, k).transpose();
       nll -= dist.LogDensity(times[k], test.Future(n, k));
-      const Eigen::Matrix2d cov = frame.rotation * cv.cov_ego[static_cast<std::size_t>(k)] * frame.rotation.transpose();
+      const Eigen::Matrix2d cov =
+          frame.rotation * cv.cov_ego[static_cast<std::size_t>(k)] * frame.rotation.transpose();
       cv_nll -= LogGaussian2(test.Future(n, k), cv.Mean(test, n, k), cov);
     }
     rep.model.ade += Ade(path, test, n);
@@ -190,7 +194,9 @@ SpanEvalReport EvaluateSpanOn(const std::string& artifact, const WindowSet& trai
       best_fde = std::min(best_fde, Fde(path, test, n));
       const Eigen::Vector2d z(n01(rng), n01(rng));  // one draw per path: correlated over horizons
       for (int k = 0; k < f; ++k)
-        cv_path.row(k) = (cv.Mean(test, n, k) + frame.rotation * (cv_chol[static_cast<std::size_t>(k)] * z)).transpose();
+        cv_path.row(k) =
+            (cv.Mean(test, n, k) + frame.rotation * (cv_chol[static_cast<std::size_t>(k)] * z))
+                .transpose();
       cv_best_ade = std::min(cv_best_ade, Ade(cv_path, test, n));
       cv_best_fde = std::min(cv_best_fde, Fde(cv_path, test, n));
     }
@@ -215,7 +221,8 @@ SpanEvalReport EvaluateSpan(const SpanExperimentConfig& c, const std::string& ar
   const int length = c.windows.observed + c.windows.predicted;
   FS_THROW_UNLESS(test.size() > 0, "no test windows: no test track has windows.observed + ",
                   "windows.predicted = ", length, " points (",
-                  c.data.test_files.empty() ? "raise data.test_fraction" : "check data.test_files", ")");
+                  c.data.test_files.empty() ? "raise data.test_fraction" : "check data.test_files",
+                  ")");
   FS_THROW_UNLESS(train.size() > 0, "no training windows for the constant-velocity baseline: no ",
                   "training track has windows.observed + windows.predicted = ", length,
                   " points (data.train_files, data.val_fraction, data.test_fraction)");
@@ -231,9 +238,10 @@ SpanEvalReport EvaluateSpan(const SpanExperimentConfig& c, const std::string& ar
   std::ofstream(out_dir + "/eval.json") << rep.ToJson(c.eval.num_samples);
   if (c.eval.plot_tracks > 0)
     PlotSpanSamples(artifact, test, c.eval, out_dir + "/plots/samples.png");
-  log::Info("eval on ", rep.windows, " windows: ADE ", rep.model.ade, " FDE ", rep.model.fde, " NLL ",
-            rep.model.nll, " best-of-", c.eval.num_samples, " ", rep.model.best_of_n_ade, "/",
-            rep.model.best_of_n_fde, " | CV ADE ", rep.cv.ade, " FDE ", rep.cv.fde, " NLL ", rep.cv.nll);
+  log::Info("eval on ", rep.windows, " windows: ADE ", rep.model.ade, " FDE ", rep.model.fde,
+            " NLL ", rep.model.nll, " best-of-", c.eval.num_samples, " ", rep.model.best_of_n_ade,
+            "/", rep.model.best_of_n_fde, " | CV ADE ", rep.cv.ade, " FDE ", rep.cv.fde, " NLL ",
+            rep.cv.nll);
   return rep;
 }
 

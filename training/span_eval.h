@@ -10,8 +10,8 @@
 namespace foresight {
 
 struct SpanMetrics {
-  double ade = 0, fde = 0;            ///< of the mean prediction (m)
-  double nll = 0;                     ///< -log density per future point (positions, nats)
+  double ade = 0, fde = 0;  ///< of the mean prediction (m)
+  double nll = 0;           ///< -log density per future point (positions, nats)
   double best_of_n_ade = 0, best_of_n_fde = 0;
 };
 

@@ -48,8 +48,10 @@ Normalisation FitNormalisation(const Eigen::MatrixXd& x) {
   // (non-finite losses on crowd data with many standing pedestrians).
   constexpr double kMinStd = 0.01;  // m
   for (Eigen::Index i = 0; i < n.std.size(); ++i) {
-    if (!(n.std[i] > 1e-6)) n.std[i] = 1.0;
-    else n.std[i] = std::max(n.std[i], kMinStd);
+    if (!(n.std[i] > 1e-6))
+      n.std[i] = 1.0;
+    else
+      n.std[i] = std::max(n.std[i], kMinStd);
   }
   return n;
 }
@@ -70,8 +72,12 @@ class SpanTask : public TrainingTask {
  public:
   SpanTask(SpanNet net, const HeadLayout& layout, torch::Tensor x_train, torch::Tensor w_train,
            torch::Tensor x_val, torch::Tensor w_val)
-      : net_(std::move(net)), layout_(layout), x_train_(std::move(x_train)), w_train_(std::move(w_train)),
-        x_val_(std::move(x_val)), w_val_(std::move(w_val)) {}
+      : net_(std::move(net)),
+        layout_(layout),
+        x_train_(std::move(x_train)),
+        w_train_(std::move(w_train)),
+        x_val_(std::move(x_val)),
+        w_val_(std::move(w_val)) {}
 
   torch::nn::Module& module() override { return *net_; }
   std::int64_t num_train() const override { return x_train_.size(0); }
@@ -88,7 +94,9 @@ class SpanTask : public TrainingTask {
     for (std::int64_t b = 0; b < n; b += 4096) {
       const std::int64_t len = std::min<std::int64_t>(4096, n - b);
       const auto raw = net_->forward(x_val_.narrow(0, b, len));
-      sum += MixtureNll(DecodeHead(raw, layout_), w_val_.narrow(0, b, len), layout_).sum().item<double>();
+      sum += MixtureNll(DecodeHead(raw, layout_), w_val_.narrow(0, b, len), layout_)
+                 .sum()
+                 .item<double>();
     }
     return sum / static_cast<double>(n);
   }
@@ -104,17 +112,21 @@ class SpanTask : public TrainingTask {
 TrainingSummary TrainSpan(const SpanExperimentConfig& c, const std::string& run_dir, bool resume,
                           const TrainHooks& hooks) {
   StartRunDirectory(run_dir, config::ToYaml(c), resume, kSpanRunRules);
-  log::Info(resume ? "resuming" : "training", " span_predictor in ", run_dir, " (seed ", c.seed, ")");
+  log::Info(resume ? "resuming" : "training", " span_predictor in ", run_dir, " (seed ", c.seed,
+            ")");
 
   const TrackSplit split = LoadPedestrianSplits(c.data, static_cast<std::uint64_t>(c.seed));
   const WindowSet train_w = MakeWindows(split.train, c.windows);
   const WindowSet val_w = MakeWindows(split.val, c.windows);
   log::Info("windows: ", train_w.size(), " train, ", val_w.size(), " val");
   const int length = c.windows.observed + c.windows.predicted;
-  FS_THROW_UNLESS(train_w.size() > 0, "no training windows of ", length, " points in the training tracks");
+  FS_THROW_UNLESS(train_w.size() > 0, "no training windows of ", length,
+                  " points in the training tracks");
   // The validation loss chooses the best checkpoint and drives early stopping (train.patience).
-  FS_THROW_UNLESS(val_w.size() > 0, "no validation windows: no validation track has windows.observed + "
-                  "windows.predicted = ", length, " points (",
+  FS_THROW_UNLESS(val_w.size() > 0,
+                  "no validation windows: no validation track has windows.observed + "
+                  "windows.predicted = ",
+                  length, " points (",
                   c.data.val_files.empty() ? "raise data.val_fraction" : "check data.val_files",
                   "); the validation loss chooses the best checkpoint and drives early stopping");
   const TimeBasis basis = MakeFutureBasis(c.basis, c.windows.predicted, train_w.seconds_per_step);
@@ -124,7 +136,8 @@ TrainingSummary TrainSpan(const SpanExperimentConfig& c, const std::string& run_
                                             c.network.residual_to_constant_velocity);
 
   const std::string norm_path = run_dir + "/normalisation.h5";
-  const Normalisation norm = resume ? ReadNormalisation(norm_path) : FitNormalisation(train_s.inputs);
+  const Normalisation norm =
+      resume ? ReadNormalisation(norm_path) : FitNormalisation(train_s.inputs);
   if (!resume) WriteNormalisation(norm_path, norm);
 
   const HeadLayout layout = LayoutOf(c);
@@ -135,7 +148,8 @@ TrainingSummary TrainSpan(const SpanExperimentConfig& c, const std::string& run_
   auto w_val = ToTensor(val_s.targets).view({val_s.targets.rows(), m, 2});
   SpanTask task(net, layout, ToTensor(norm.Apply(train_s.inputs)), w_train,
                 ToTensor(norm.Apply(val_s.inputs)), w_val);
-  return Train(&task, c.train, RunPaths{run_dir}, static_cast<std::uint64_t>(c.seed), resume, hooks);
+  return Train(&task, c.train, RunPaths{run_dir}, static_cast<std::uint64_t>(c.seed), resume,
+               hooks);
 }
 
 namespace {
@@ -147,8 +161,9 @@ Mlp ToEngineMlp(torch::nn::Module& net, const std::vector<std::string>& names) {
     const torch::Tensor w = params[name + ".weight"].detach().contiguous().to(torch::kFloat32);
     const torch::Tensor b = params[name + ".bias"].detach().contiguous().to(torch::kFloat32);
     DenseLayer l;
-    l.weight = Eigen::Map<const Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
-        w.data_ptr<float>(), w.size(0), w.size(1));
+    l.weight =
+        Eigen::Map<const Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
+            w.data_ptr<float>(), w.size(0), w.size(1));
     l.bias = Eigen::Map<const Eigen::VectorXf>(b.data_ptr<float>(), b.size(0));
     layers.push_back(std::move(l));
   }
@@ -183,9 +198,11 @@ void WriteSpanArtifact(const SpanExperimentConfig& c, const std::string& checkpo
 std::string ExportSpan(const std::string& run_dir) {
   const std::string config_path = run_dir + "/config.yaml";
   FS_THROW_UNLESS(fs::exists(config_path), run_dir, ": not a run directory (no config.yaml)");
-  const SpanExperimentConfig c = config::LoadExperimentConfig<SpanExperimentConfig>(config_path, {});
+  const SpanExperimentConfig c =
+      config::LoadExperimentConfig<SpanExperimentConfig>(config_path, {});
   RunPaths run{run_dir};
-  const std::string ckpt = fs::exists(run.BestCheckpoint()) ? run.BestCheckpoint() : run.Checkpoint();
+  const std::string ckpt =
+      fs::exists(run.BestCheckpoint()) ? run.BestCheckpoint() : run.Checkpoint();
   FS_THROW_UNLESS(fs::exists(ckpt), run_dir, ": no checkpoint to export (train first)");
   const std::string out = run_dir + "/model.h5";
   WriteSpanArtifact(c, ckpt, run_dir + "/normalisation.h5", out);

@@ -19,8 +19,8 @@ inline const RunDirectoryRules kSpanRunRules{{"checkpoints/", "model.h5", "eval.
 /// Trains (or resumes) into `run_dir`; writes the resolved config and the normalisation first.
 /// A fresh start (not `resume`) refuses a directory that already holds checkpoints, metrics.csv,
 /// model.h5 or eval.json. No training or validation windows is an Error naming the split keys.
-TrainingSummary TrainSpan(const SpanExperimentConfig& config, const std::string& run_dir, bool resume,
-                          const TrainHooks& hooks = {});
+TrainingSummary TrainSpan(const SpanExperimentConfig& config, const std::string& run_dir,
+                          bool resume, const TrainHooks& hooks = {});
 
 /// Writes `run_dir`/model.h5 from the best checkpoint. @return the artifact path.
 std::string ExportSpan(const std::string& run_dir);

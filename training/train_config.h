@@ -16,13 +16,13 @@ struct TrainConfig {
   double learning_rate = 1e-3;
   double weight_decay = 0.0;
   LrSchedule schedule = LrSchedule::kCosine;
-  int step_every = 50;         ///< epochs between step decays (schedule: step)
-  double step_factor = 0.5;    ///< lr multiplier per step (schedule: step)
-  double min_lr_ratio = 0.02;  ///< final lr / initial lr (schedule: cosine)
+  int step_every = 50;           ///< epochs between step decays (schedule: step)
+  double step_factor = 0.5;      ///< lr multiplier per step (schedule: step)
+  double min_lr_ratio = 0.02;    ///< final lr / initial lr (schedule: cosine)
   double grad_clip_norm = 10.0;  ///< 0 disables clipping
-  int patience = 25;           ///< epochs without validation improvement before stopping; 0 never
-  double min_delta = 1e-4;     ///< improvement smaller than this does not count
-  int threads = 1;             ///< intra-op threads of LibTorch (results are bit-identical per count)
+  int patience = 25;             ///< epochs without validation improvement before stopping; 0 never
+  double min_delta = 1e-4;       ///< improvement smaller than this does not count
+  int threads = 1;  ///< intra-op threads of LibTorch (results are bit-identical per count)
   ProgressStyle progress = ProgressStyle::kAuto;
 
   template <class A>

@@ -39,20 +39,25 @@ double LearningRateAt(const TrainConfig& c, int epoch) {
 
 const char* ToString(TerminationReason r) {
   switch (r) {
-    case TerminationReason::kMaxEpochs: return "max_epochs";
-    case TerminationReason::kEarlyStopped: return "early_stopped";
-    case TerminationReason::kNonFiniteLoss: return "non_finite_loss";
-    case TerminationReason::kInterrupted: return "interrupted";
-    case TerminationReason::kAlreadyComplete: return "already_complete";
+    case TerminationReason::kMaxEpochs:
+      return "max_epochs";
+    case TerminationReason::kEarlyStopped:
+      return "early_stopped";
+    case TerminationReason::kNonFiniteLoss:
+      return "non_finite_loss";
+    case TerminationReason::kInterrupted:
+      return "interrupted";
+    case TerminationReason::kAlreadyComplete:
+      return "already_complete";
   }
   return "";
 }
 
 std::string TrainingSummary::BriefReport() const {
   std::ostringstream os;
-  os << "training " << ToString(reason) << " after " << epochs_completed << " epochs; best val loss "
-     << best_val_loss << " at epoch " << best_epoch << "; " << seconds << " s, "
-     << std::lround(samples_per_second) << " samples/s";
+  os << "training " << ToString(reason) << " after " << epochs_completed
+     << " epochs; best val loss " << best_val_loss << " at epoch " << best_epoch << "; " << seconds
+     << " s, " << std::lround(samples_per_second) << " samples/s";
   return os.str();
 }
 
@@ -69,7 +74,8 @@ std::string TrainingSummary::ToJson() const {
   std::ostringstream os;
   os << "{\"reason\": \"" << ToString(reason) << "\", \"epochs_completed\": " << epochs_completed
      << ", \"best_epoch\": " << best_epoch << ", \"best_val_loss\": " << JsonNumber(best_val_loss)
-     << ", \"last_train_loss\": " << JsonNumber(last_train_loss) << ", \"seconds\": " << JsonNumber(seconds)
+     << ", \"last_train_loss\": " << JsonNumber(last_train_loss)
+     << ", \"seconds\": " << JsonNumber(seconds)
      << ", \"samples_per_second\": " << JsonNumber(samples_per_second) << "}\n";
   return os.str();
 }
@@ -94,7 +100,8 @@ const std::atomic<bool>* ScopedInterruptFlag::flag() const { return &g_interrupt
 
 namespace {
 
-constexpr const char* kMetricsHeader = "epoch,train_loss,val_loss,learning_rate,seconds,samples_per_second";
+constexpr const char* kMetricsHeader =
+    "epoch,train_loss,val_loss,learning_rate,seconds,samples_per_second";
 
 /// Flushes the file or directory `path` to disk; `required` failures are an Error.
 void Sync(const std::string& path, bool required) {
@@ -119,8 +126,8 @@ struct State {
   int bad_epochs = 0;
 };
 
-void SaveCheckpoint(const std::string& path, torch::nn::Module& module, torch::optim::Optimizer& opt,
-                    const State& s) {
+void SaveCheckpoint(const std::string& path, torch::nn::Module& module,
+                    torch::optim::Optimizer& opt, const State& s) {
   torch::serialize::OutputArchive archive;
   torch::serialize::OutputArchive model_archive, opt_archive;
   module.save(model_archive);
@@ -176,7 +183,8 @@ torch::Tensor ReadStateScalar(const std::string& path, torch::serialize::InputAr
   return t;
 }
 
-State LoadCheckpoint(const std::string& path, torch::nn::Module* module, torch::optim::Optimizer* opt) {
+State LoadCheckpoint(const std::string& path, torch::nn::Module* module,
+                     torch::optim::Optimizer* opt) {
   auto archive = OpenCheckpoint(path);
   ReadModel(path, archive, module);
   State s;
@@ -184,10 +192,13 @@ State LoadCheckpoint(const std::string& path, torch::nn::Module* module, torch::
     torch::serialize::InputArchive opt_archive;
     archive.read("optimizer", opt_archive);
     opt->load(opt_archive);
-    s.epoch = static_cast<int>(ReadStateScalar(path, archive, "state/epoch", torch::kInt64).item<int64_t>());
-    s.best_epoch = static_cast<int>(ReadStateScalar(path, archive, "state/best_epoch", torch::kInt64).item<int64_t>());
+    s.epoch = static_cast<int>(
+        ReadStateScalar(path, archive, "state/epoch", torch::kInt64).item<int64_t>());
+    s.best_epoch = static_cast<int>(
+        ReadStateScalar(path, archive, "state/best_epoch", torch::kInt64).item<int64_t>());
     s.best_val = ReadStateScalar(path, archive, "state/best_val", torch::kFloat64).item<double>();
-    s.bad_epochs = static_cast<int>(ReadStateScalar(path, archive, "state/bad_epochs", torch::kInt64).item<int64_t>());
+    s.bad_epochs = static_cast<int>(
+        ReadStateScalar(path, archive, "state/bad_epochs", torch::kInt64).item<int64_t>());
   } catch (const Error&) {
     throw;
   } catch (const std::exception& e) {
@@ -206,7 +217,8 @@ void TruncateMetrics(const std::string& path, int epoch) {
   for (int number = 1; std::getline(in, line); ++number) {
     if (number == 1 || line.empty()) continue;  // line 1 is the header (kept as kMetricsHeader)
     const auto row_epoch = ParseInteger(line.substr(0, line.find(',')));
-    FS_THROW_UNLESS(row_epoch.has_value(), path, ":", number, ": row does not start with an epoch number");
+    FS_THROW_UNLESS(row_epoch.has_value(), path, ":", number,
+                    ": row does not start with an epoch number");
     if (*row_epoch <= epoch) keep.push_back(line);
   }
   in.close();
@@ -296,7 +308,8 @@ TrainingSummary Train(TrainingTask* task, const TrainConfig& c, const RunPaths& 
         break;
       }
       loss.backward();
-      if (c.grad_clip_norm > 0) torch::nn::utils::clip_grad_norm_(module.parameters(), c.grad_clip_norm);
+      if (c.grad_clip_norm > 0)
+        torch::nn::utils::clip_grad_norm_(module.parameters(), c.grad_clip_norm);
       opt.step();
       loss_sum += value * static_cast<double>(len);
       seen += len;
@@ -326,13 +339,14 @@ TrainingSummary Train(TrainingTask* task, const TrainConfig& c, const RunPaths& 
       if (state.epoch == 0)
         log::Warn("non-finite loss in epoch 1; stopping before the first checkpoint");
       else
-        log::Warn("non-finite loss in epoch ", epoch + 1, "; stopping and keeping the checkpoint of epoch ",
-                  state.epoch);
+        log::Warn("non-finite loss in epoch ", epoch + 1,
+                  "; stopping and keeping the checkpoint of epoch ", state.epoch);
       if (fs::exists(run.Checkpoint())) LoadCheckpointModel(run.Checkpoint(), &module);
       break;
     }
     const double train_loss = loss_sum / static_cast<double>(seen);
-    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - e0).count();
+    const double secs =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - e0).count();
     state.epoch = epoch + 1;
     // The row goes first: a run killed before its checkpoint resumes from the previous epoch and
     // drops the row (TruncateMetrics), so no row is lost or duplicated.
@@ -350,8 +364,8 @@ TrainingSummary Train(TrainingTask* task, const TrainConfig& c, const RunPaths& 
     }
     SaveCheckpoint(run.Checkpoint(), module, opt, state);
     std::ostringstream line;
-    line << "train " << train_loss << " val " << val << (state.best_epoch == state.epoch ? " *" : "")
-         << " lr " << lr;
+    line << "train " << train_loss << " val " << val
+         << (state.best_epoch == state.epoch ? " *" : "") << " lr " << lr;
     progress.EndStep(epoch, line.str());
     summary.last_train_loss = train_loss;
     if (state.epoch >= c.epochs) {

@@ -25,7 +25,13 @@ class TrainingTask {
   virtual double ValidationLoss() = 0;
 };
 
-enum class TerminationReason { kMaxEpochs, kEarlyStopped, kNonFiniteLoss, kInterrupted, kAlreadyComplete };
+enum class TerminationReason {
+  kMaxEpochs,
+  kEarlyStopped,
+  kNonFiniteLoss,
+  kInterrupted,
+  kAlreadyComplete
+};
 const char* ToString(TerminationReason reason);
 
 /// Outcome of a training run (expected outcomes are values, not exceptions).
@@ -35,7 +41,7 @@ struct TrainingSummary {
   int best_epoch = -1;       ///< 1-based epoch of the best validation loss
   double best_val_loss = 0;
   double last_train_loss = 0;
-  double seconds = 0;        ///< wall time of this invocation
+  double seconds = 0;  ///< wall time of this invocation
   double samples_per_second = 0;
   std::string BriefReport() const;
   /// One JSON object (training_summary.json); non-finite numbers (no epoch completed) are null.

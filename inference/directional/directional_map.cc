@@ -12,30 +12,37 @@ const char* VariantName(DirectionalVariant v) {
   return v == DirectionalVariant::kSpatial ? "spatial" : "spatiotemporal";
 }
 
-DirectionalMap::DirectionalMap(DirectionalVariant variant, const DirectionalFeatureConfig& features, Lstm lstm,
-                               DirectionalHeads heads, double max_kappa)
-    : variant_(variant), features_(features), lstm_(std::move(lstm)), heads_(std::move(heads)),
+DirectionalMap::DirectionalMap(DirectionalVariant variant, const DirectionalFeatureConfig& features,
+                               Lstm lstm, DirectionalHeads heads, double max_kappa)
+    : variant_(variant),
+      features_(features),
+      lstm_(std::move(lstm)),
+      heads_(std::move(heads)),
       log_kappa_max_(std::log(max_kappa)) {
   Check();
 }
 
 void DirectionalMap::Check() const {
   const auto R = heads_.alpha_b.size();
-  const Eigen::Index d = variant_ == DirectionalVariant::kSpatial ? features_.spatial_size() : lstm_.hidden_size();
+  const Eigen::Index d =
+      variant_ == DirectionalVariant::kSpatial ? features_.spatial_size() : lstm_.hidden_size();
   FS_THROW_UNLESS(R >= 1 && heads_.mu_b.size() == R && heads_.kappa_b.size() == R,
-                  "directional map: heads have ", heads_.alpha_b.size(), ", ", heads_.mu_b.size(), ", ",
-                  heads_.kappa_b.size(), " outputs; expected R >= 1 each");
+                  "directional map: heads have ", heads_.alpha_b.size(), ", ", heads_.mu_b.size(),
+                  ", ", heads_.kappa_b.size(), " outputs; expected R >= 1 each");
   for (const Eigen::MatrixXf* w : {&heads_.alpha_w, &heads_.mu_w, &heads_.kappa_w})
-    FS_THROW_UNLESS(w->rows() == R && w->cols() == d, "directional map: a head weight is ", w->rows(), " x ",
-                    w->cols(), ", expected ", R, " x ", d, " (", VariantName(variant_), ")");
+    FS_THROW_UNLESS(w->rows() == R && w->cols() == d, "directional map: a head weight is ",
+                    w->rows(), " x ", w->cols(), ", expected ", R, " x ", d, " (",
+                    VariantName(variant_), ")");
   if (variant_ == DirectionalVariant::kSpatiotemporal)
-    FS_THROW_UNLESS(lstm_.input_size() == features_.spatial_size(), "directional map: the LSTM takes ",
-                    lstm_.input_size(), " inputs, the features have M_s = ", features_.spatial_size());
+    FS_THROW_UNLESS(lstm_.input_size() == features_.spatial_size(),
+                    "directional map: the LSTM takes ", lstm_.input_size(),
+                    " inputs, the features have M_s = ", features_.spatial_size());
   FS_THROW_UNLESS(std::isfinite(log_kappa_max_) && log_kappa_max_ > kDirectionalLogKappaMin,
-                  "directional map: max kappa ", std::exp(log_kappa_max_), " must be finite and above exp(",
-                  kDirectionalLogKappaMin, ")");
-  FS_THROW_UNLESS(heads_.alpha_w.allFinite() && heads_.mu_w.allFinite() && heads_.kappa_w.allFinite() &&
-                      heads_.alpha_b.allFinite() && heads_.mu_b.allFinite() && heads_.kappa_b.allFinite(),
+                  "directional map: max kappa ", std::exp(log_kappa_max_),
+                  " must be finite and above exp(", kDirectionalLogKappaMin, ")");
+  FS_THROW_UNLESS(heads_.alpha_w.allFinite() && heads_.mu_w.allFinite() &&
+                      heads_.kappa_w.allFinite() && heads_.alpha_b.allFinite() &&
+                      heads_.mu_b.allFinite() && heads_.kappa_b.allFinite(),
                   "directional map: non-finite head weights");
 }
 
@@ -44,9 +51,10 @@ DirectionalMap DirectionalMap::Load(const std::string& path) {
   const h5::File& f = art.file();
   DirectionalMap m;
   const std::string variant = f.GetStringAttr("/model", "variant");
-  FS_THROW_UNLESS(variant == "spatiotemporal" || variant == "spatial", path, ": unknown variant '", variant,
-                  "' (expected spatiotemporal or spatial)");
-  m.variant_ = variant == "spatial" ? DirectionalVariant::kSpatial : DirectionalVariant::kSpatiotemporal;
+  FS_THROW_UNLESS(variant == "spatiotemporal" || variant == "spatial", path, ": unknown variant '",
+                  variant, "' (expected spatiotemporal or spatial)");
+  m.variant_ =
+      variant == "spatial" ? DirectionalVariant::kSpatial : DirectionalVariant::kSpatiotemporal;
   DirectionalFeatureConfig fc;
   const std::string g = "/model/features";
   fc.x_min = art.DoubleAttr(g, "x_min", -1e12, 1e12);
@@ -63,7 +71,8 @@ DirectionalMap DirectionalMap::Load(const std::string& path) {
   fc.cutoff = art.DoubleAttr(g, "cutoff", -1e12, 1e12);
   FS_THROW_UNLESS(fc.cells_x >= 1 && fc.cells_y >= 1 && fc.time_points >= 1 &&
                       static_cast<double>(fc.cells_x) * fc.cells_y <= 1e7,
-                  path, ": implausible inducing grid ", fc.cells_x, " x ", fc.cells_y, " x ", fc.time_points);
+                  path, ": implausible inducing grid ", fc.cells_x, " x ", fc.cells_y, " x ",
+                  fc.time_points);
   try {
     m.features_ = DirectionalFeatures(fc);
   } catch (const Error& e) {
@@ -88,7 +97,8 @@ DirectionalMap DirectionalMap::Load(const std::string& path) {
   return m;
 }
 
-void DirectionalMap::Save(const std::string& path, const std::string& config_yaml, std::int64_t seed) const {
+void DirectionalMap::Save(const std::string& path, const std::string& config_yaml,
+                          std::int64_t seed) const {
   h5::WriteAtomically(path, [&](h5::File* f) {
     Artifact::WriteHeader(f, kDirectionalModelType, config_yaml, seed);
     const bool temporal = variant_ == DirectionalVariant::kSpatiotemporal;
@@ -144,13 +154,15 @@ DirectionalMap::Workspace DirectionalMap::MakeWorkspace() const {
 }
 
 void DirectionalMap::RawOutput(double x, double y, double t, Workspace* ws) const {
-  FS_THROW_UNLESS(std::isfinite(x) && std::isfinite(y) && std::isfinite(t), "directional map: query (", x, ", ",
-                  y, ", ", t, ") is not finite");
+  FS_THROW_UNLESS(std::isfinite(x) && std::isfinite(y) && std::isfinite(t),
+                  "directional map: query (", x, ", ", y, ", ", t, ") is not finite");
   const int R = components();
   const int cx = features_.config().cells_x;
   const DirectionalFeatures::Window w = features_.SpatialWindow(x, y);
   auto head = [&](int r, const Eigen::MatrixXf& W, const Eigen::VectorXf& b, int offset,
-                  const Eigen::Ref<const Eigen::VectorXf>& z) { ws->raw[offset + r] = W.row(r).dot(z) + b[r]; };
+                  const Eigen::Ref<const Eigen::VectorXf>& z) {
+    ws->raw[offset + r] = W.row(r).dot(z) + b[r];
+  };
   if (variant_ == DirectionalVariant::kSpatial) {
     // Heads on the sparse features: z = b + sum_j phi_j W[:, j].
     for (int r = 0; r < R; ++r) {
@@ -181,7 +193,8 @@ void DirectionalMap::RawOutput(double x, double y, double t, Workspace* ws) cons
     }
   features_.Temporal(t, ws->phi_t);
   lstm_.Reset(&ws->lstm);
-  for (int k = 0; k < features_.time_size(); ++k) lstm_.StepProjected(ws->proj, ws->phi_t[k], &ws->lstm);
+  for (int k = 0; k < features_.time_size(); ++k)
+    lstm_.StepProjected(ws->proj, ws->phi_t[k], &ws->lstm);
   for (int r = 0; r < R; ++r) {
     head(r, heads_.alpha_w, heads_.alpha_b, 0, ws->lstm.h);
     head(r, heads_.mu_w, heads_.mu_b, R, ws->lstm.h);
@@ -199,16 +212,17 @@ void DirectionalMap::QueryOne(double x, double y, double t, Workspace* ws) const
   ws->alpha /= norm;
   for (int r = 0; r < R; ++r) {
     ws->mu[r] = WrapAngle(static_cast<double>(ws->raw[R + r]));
-    ws->kappa[r] = std::exp(
-        std::clamp(static_cast<double>(ws->raw[2 * R + r]), kDirectionalLogKappaMin, log_kappa_max_));
+    ws->kappa[r] = std::exp(std::clamp(static_cast<double>(ws->raw[2 * R + r]),
+                                       kDirectionalLogKappaMin, log_kappa_max_));
   }
 }
 
-void DirectionalMap::Query(const Eigen::Ref<const Eigen::VectorXd>& x, const Eigen::Ref<const Eigen::VectorXd>& y,
+void DirectionalMap::Query(const Eigen::Ref<const Eigen::VectorXd>& x,
+                           const Eigen::Ref<const Eigen::VectorXd>& y,
                            const Eigen::Ref<const Eigen::VectorXd>& t, Workspace* ws,
                            VonMisesMixtureBatch* out) const {
-  FS_THROW_UNLESS(x.size() == y.size() && x.size() == t.size(), "directional map: query sizes x ", x.size(),
-                  ", y ", y.size(), ", t ", t.size(), " differ");
+  FS_THROW_UNLESS(x.size() == y.size() && x.size() == t.size(), "directional map: query sizes x ",
+                  x.size(), ", y ", y.size(), ", t ", t.size(), " differ");
   const int R = components();
   out->Resize(x.size(), R);
   for (Eigen::Index i = 0; i < x.size(); ++i) {
@@ -219,14 +233,15 @@ void DirectionalMap::Query(const Eigen::Ref<const Eigen::VectorXd>& x, const Eig
   }
 }
 
-void DirectionalMap::Density(const Eigen::Ref<const Eigen::VectorXd>& x, const Eigen::Ref<const Eigen::VectorXd>& y,
+void DirectionalMap::Density(const Eigen::Ref<const Eigen::VectorXd>& x,
+                             const Eigen::Ref<const Eigen::VectorXd>& y,
                              const Eigen::Ref<const Eigen::VectorXd>& t,
                              const Eigen::Ref<const Eigen::VectorXd>& theta, Workspace* ws,
                              Eigen::Ref<Eigen::VectorXd> density) const {
   FS_THROW_UNLESS(x.size() == y.size() && x.size() == t.size() && x.size() == theta.size() &&
                       density.size() == x.size(),
-                  "directional map: density sizes x ", x.size(), ", y ", y.size(), ", t ", t.size(), ", theta ",
-                  theta.size(), ", out ", density.size(), " differ");
+                  "directional map: density sizes x ", x.size(), ", y ", y.size(), ", t ", t.size(),
+                  ", theta ", theta.size(), ", out ", density.size(), " differ");
   for (Eigen::Index i = 0; i < x.size(); ++i) {
     FS_THROW_UNLESS(std::isfinite(theta[i]), "directional map: heading ", i, " is not finite");
     QueryOne(x[i], y[i], t[i], ws);

@@ -5,8 +5,10 @@
 ///   spatiotemporal:  phi_s(x) (x) phi_t(t) -> LSTM (sequence over the M_t temporal inducing
 ///                    points, last hidden state h) -> heads on h,
 ///   spatial:         phi_s(x) -> heads,
-///   heads:           alpha = softmax(W_a z + b_a), mu = W_m z + b_m, kappa = exp(clamp(W_k z + b_k)),
-///                    R von Mises components, p(theta | x, y, t) = sum_r alpha_r VM(theta; mu_r, kappa_r).
+///   heads:           alpha = softmax(W_a z + b_a), mu = W_m z + b_m, kappa = exp(clamp(W_k z +
+///   b_k)),
+///                    R von Mises components, p(theta | x, y, t) = sum_r alpha_r VM(theta; mu_r,
+///                    kappa_r).
 ///
 /// Features (and the behaviour outside the inducing grid and time range) are those of
 /// inference/directional/features.h: t is clamped to the time range; positions are not clamped and
@@ -29,9 +31,10 @@ inline constexpr const char* kDirectionalModelType = "directional_map";
 enum class DirectionalVariant { kSpatiotemporal, kSpatial };
 const char* VariantName(DirectionalVariant v);
 
-/// log kappa is clamped to [kDirectionalLogKappaMin, log max_kappa] in the head (training and engine
-/// alike); max_kappa is a model parameter (artifact attribute log_kappa_max), by default the cap of
-/// the directional grid maps (100), so that no method wins AL by spikes on repeated headings.
+/// log kappa is clamped to [kDirectionalLogKappaMin, log max_kappa] in the head (training and
+/// engine alike); max_kappa is a model parameter (artifact attribute log_kappa_max), by default the
+/// cap of the directional grid maps (100), so that no method wins AL by spikes on repeated
+/// headings.
 inline constexpr double kDirectionalLogKappaMin = -10.0;
 inline constexpr double kDirectionalDefaultMaxKappa = 100.0;
 
@@ -44,10 +47,10 @@ class DirectionalMap {
  public:
   struct Workspace {
     Lstm::Workspace lstm;
-    Eigen::VectorXf proj;    ///< [4H] W_ih phi_s
-    Eigen::VectorXf phi_s;   ///< [M_s] dense spatial features (spatial variant)
-    Eigen::VectorXf phi_t;   ///< [M_t]
-    Eigen::VectorXf raw;     ///< [3R] head outputs: logits, means, log kappa (before activations)
+    Eigen::VectorXf proj;   ///< [4H] W_ih phi_s
+    Eigen::VectorXf phi_s;  ///< [M_s] dense spatial features (spatial variant)
+    Eigen::VectorXf phi_t;  ///< [M_t]
+    Eigen::VectorXf raw;    ///< [3R] head outputs: logits, means, log kappa (before activations)
     Eigen::VectorXd alpha, mu, kappa;  ///< [R] decoded mixture of the last query
   };
 
@@ -77,11 +80,14 @@ class DirectionalMap {
   /// Mixtures at n queries (x, y [m], t [s], each [n]): row i of `out` (resized to n x R; no
   /// allocation when it already has that size).
   void Query(const Eigen::Ref<const Eigen::VectorXd>& x, const Eigen::Ref<const Eigen::VectorXd>& y,
-             const Eigen::Ref<const Eigen::VectorXd>& t, Workspace* ws, VonMisesMixtureBatch* out) const;
+             const Eigen::Ref<const Eigen::VectorXd>& t, Workspace* ws,
+             VonMisesMixtureBatch* out) const;
   /// Densities p(theta_i | x_i, y_i, t_i) (1/rad) for n queries into `density` [n].
-  void Density(const Eigen::Ref<const Eigen::VectorXd>& x, const Eigen::Ref<const Eigen::VectorXd>& y,
-               const Eigen::Ref<const Eigen::VectorXd>& t, const Eigen::Ref<const Eigen::VectorXd>& theta,
-               Workspace* ws, Eigen::Ref<Eigen::VectorXd> density) const;
+  void Density(const Eigen::Ref<const Eigen::VectorXd>& x,
+               const Eigen::Ref<const Eigen::VectorXd>& y,
+               const Eigen::Ref<const Eigen::VectorXd>& t,
+               const Eigen::Ref<const Eigen::VectorXd>& theta, Workspace* ws,
+               Eigen::Ref<Eigen::VectorXd> density) const;
 
  private:
   DirectionalMap() = default;

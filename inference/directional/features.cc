@@ -10,15 +10,16 @@ namespace foresight {
 DirectionalFeatures::DirectionalFeatures(const DirectionalFeatureConfig& c) : config_(c) {
   FS_THROW_UNLESS(std::isfinite(c.x_min) && std::isfinite(c.x_max) && c.x_max > c.x_min &&
                       std::isfinite(c.y_min) && std::isfinite(c.y_max) && c.y_max > c.y_min,
-                  "directional features: empty spatial extent x [", c.x_min, ", ", c.x_max, "], y [", c.y_min,
-                  ", ", c.y_max, "]");
+                  "directional features: empty spatial extent x [", c.x_min, ", ", c.x_max,
+                  "], y [", c.y_min, ", ", c.y_max, "]");
   FS_THROW_UNLESS(std::isfinite(c.t_min) && std::isfinite(c.t_max) && c.t_max >= c.t_min,
                   "directional features: bad time range [", c.t_min, ", ", c.t_max, "]");
-  FS_THROW_UNLESS(c.cells_x >= 1 && c.cells_y >= 1 && c.time_points >= 1, "directional features: ",
-                  c.cells_x, " x ", c.cells_y, " x ", c.time_points, " inducing points");
+  FS_THROW_UNLESS(c.cells_x >= 1 && c.cells_y >= 1 && c.time_points >= 1,
+                  "directional features: ", c.cells_x, " x ", c.cells_y, " x ", c.time_points,
+                  " inducing points");
   FS_THROW_UNLESS(c.length_scale > 0 && c.time_length_scale > 0 && c.cutoff > 0,
-                  "directional features: length scales and cutoff must be positive (got ", c.length_scale, ", ",
-                  c.time_length_scale, ", ", c.cutoff, ")");
+                  "directional features: length scales and cutoff must be positive (got ",
+                  c.length_scale, ", ", c.time_length_scale, ", ", c.cutoff, ")");
   dx_ = (c.x_max - c.x_min) / c.cells_x;
   dy_ = (c.y_max - c.y_min) / c.cells_y;
   inv_two_ls2_ = 1.0 / (2.0 * c.length_scale * c.length_scale);
@@ -37,7 +38,9 @@ double DirectionalFeatures::TimePoint(int k) const {
   return config_.t_min + (config_.t_max - config_.t_min) * k / (config_.time_points - 1);
 }
 
-double DirectionalFeatures::ClampTime(double t) const { return std::clamp(t, config_.t_min, config_.t_max); }
+double DirectionalFeatures::ClampTime(double t) const {
+  return std::clamp(t, config_.t_min, config_.t_max);
+}
 
 DirectionalFeatures::Window DirectionalFeatures::SpatialWindow(double x, double y) const {
   const double r = config_.cutoff * config_.length_scale;
@@ -87,24 +90,27 @@ void DirectionalFeatures::SpatialBatch(
     const Eigen::Ref<const Eigen::VectorXd>& x, const Eigen::Ref<const Eigen::VectorXd>& y,
     Eigen::Ref<Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> out) const {
   FS_THROW_UNLESS(x.size() == y.size() && out.rows() == x.size() && out.cols() == spatial_size(),
-                  "directional features: batch shapes x ", x.size(), ", y ", y.size(), ", out ", out.rows(), " x ",
-                  out.cols());
+                  "directional features: batch shapes x ", x.size(), ", y ", y.size(), ", out ",
+                  out.rows(), " x ", out.cols());
   for (Eigen::Index i = 0; i < x.size(); ++i) Spatial(x[i], y[i], out.row(i).transpose());
 }
 
 void DirectionalFeatures::TemporalBatch(
     const Eigen::Ref<const Eigen::VectorXd>& t,
     Eigen::Ref<Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> out) const {
-  FS_THROW_UNLESS(out.rows() == t.size() && out.cols() == time_size(), "directional features: batch shapes t ",
-                  t.size(), ", out ", out.rows(), " x ", out.cols());
+  FS_THROW_UNLESS(out.rows() == t.size() && out.cols() == time_size(),
+                  "directional features: batch shapes t ", t.size(), ", out ", out.rows(), " x ",
+                  out.cols());
   for (Eigen::Index i = 0; i < t.size(); ++i) Temporal(t[i], out.row(i).transpose());
 }
 
 void DirectionalFeatures::SpatialSparseBatch(const Eigen::Ref<const Eigen::VectorXd>& x,
                                              const Eigen::Ref<const Eigen::VectorXd>& y,
-                                             std::vector<std::int64_t>* index, std::vector<float>* value,
+                                             std::vector<std::int64_t>* index,
+                                             std::vector<float>* value,
                                              std::vector<std::int64_t>* offsets) const {
-  FS_THROW_UNLESS(x.size() == y.size(), "directional features: batch shapes x ", x.size(), ", y ", y.size());
+  FS_THROW_UNLESS(x.size() == y.size(), "directional features: batch shapes x ", x.size(), ", y ",
+                  y.size());
   index->clear();
   value->clear();
   offsets->assign(1, 0);
@@ -129,8 +135,8 @@ DirectionalFeatureConfig ResolveExtent(const DirectionalFeatureConfig& config,
   if (!c.auto_extent && !c.auto_time_range) return c;
   FS_THROW_UNLESS(x.size() > 0 && x.size() == y.size() && x.size() == t.size() && x.allFinite() &&
                       y.allFinite() && t.allFinite(),
-                  "directional features: auto_extent / auto_time_range need finite data (got ", x.size(),
-                  " samples)");
+                  "directional features: auto_extent / auto_time_range need finite data (got ",
+                  x.size(), " samples)");
   if (c.auto_extent) {
     c.x_min = x.minCoeff();
     c.x_max = x.maxCoeff();

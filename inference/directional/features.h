@@ -6,8 +6,8 @@
 ///   spatial   phi_s(x)_j = k_s(x, xbar_j) = exp(-||x - xbar_j||^2 / (2 l_s^2)),  j < M_s,
 ///   temporal  phi_t(t)_k = k_t(t, tbar_k) = exp(-(t - tbar_k)^2 / (2 l_t^2)),    k < M_t,
 ///   spatiotemporal phi = phi_s (x) phi_t, fed to the LSTM as a sequence over the temporal inducing
-///   points: step k is the vector phi_s(x) * phi_t(t)_k [M_s] (thesis: "outer product ... treated as
-///   a sequence"), k = 0 .. M_t - 1.
+///   points: step k is the vector phi_s(x) * phi_t(t)_k [M_s] (thesis: "outer product ... treated
+///   as a sequence"), k = 0 .. M_t - 1.
 ///
 /// Inducing points: spatial ones at the centres of a cells_x x cells_y grid over the extent (the
 /// same positions and count as the cells of a directional grid map at that resolution); temporal
@@ -46,14 +46,19 @@ struct DirectionalFeatureConfig {
     a->Visit("x_max", &x_max, Range::Any(), "spatial extent: x max (m)");
     a->Visit("y_min", &y_min, Range::Any(), "spatial extent: y min (m)");
     a->Visit("y_max", &y_max, Range::Any(), "spatial extent: y max (m)");
-    a->Visit("cells_x", &cells_x, Range::Closed(1, 10000), "spatial inducing points (and grid cells) along x");
-    a->Visit("cells_y", &cells_y, Range::Closed(1, 10000), "spatial inducing points (and grid cells) along y");
+    a->Visit("cells_x", &cells_x, Range::Closed(1, 10000),
+             "spatial inducing points (and grid cells) along x");
+    a->Visit("cells_y", &cells_y, Range::Closed(1, 10000),
+             "spatial inducing points (and grid cells) along y");
     a->Visit("length_scale", &length_scale, Range::Positive(), "spatial RBF length scale l_s (m)");
     a->Visit("t_min", &t_min, Range::Any(), "temporal range: start (s)");
     a->Visit("t_max", &t_max, Range::Any(), "temporal range: end (s)");
-    a->Visit("time_points", &time_points, Range::Closed(1, 1000), "temporal inducing points M_t (LSTM steps)");
-    a->Visit("time_length_scale", &time_length_scale, Range::Positive(), "temporal RBF length scale l_t (s)");
-    a->Visit("cutoff", &cutoff, Range::Closed(1, 100), "kernel support in length scales (beyond: exactly 0)");
+    a->Visit("time_points", &time_points, Range::Closed(1, 1000),
+             "temporal inducing points M_t (LSTM steps)");
+    a->Visit("time_length_scale", &time_length_scale, Range::Positive(),
+             "temporal RBF length scale l_t (s)");
+    a->Visit("cutoff", &cutoff, Range::Closed(1, 100),
+             "kernel support in length scales (beyond: exactly 0)");
     a->Visit("auto_extent", &auto_extent, Range::Any(),
              "use the data's bounding box as spatial extent (keys x_min .. y_max ignored)");
     a->Visit("auto_time_range", &auto_time_range, Range::Any(),
@@ -71,7 +76,7 @@ class DirectionalFeatures {
 
   const DirectionalFeatureConfig& config() const { return config_; }
   int spatial_size() const { return config_.cells_x * config_.cells_y; }  ///< M_s
-  int time_size() const { return config_.time_points; }                  ///< M_t
+  int time_size() const { return config_.time_points; }                   ///< M_t
   /// Inducing point j (row-major over x then y: j = iy * cells_x + ix).
   Eigen::Vector2d SpatialPoint(int j) const;
   double TimePoint(int k) const;
@@ -92,14 +97,17 @@ class DirectionalFeatures {
   /// phi_t(clamp(t)) [M_t]. `out` must have size M_t.
   void Temporal(double t, Eigen::Ref<Eigen::VectorXf> out) const;
   /// Batches: row i of `out` holds the features of sample i ([n x M_s] and [n x M_t]).
-  void SpatialBatch(const Eigen::Ref<const Eigen::VectorXd>& x, const Eigen::Ref<const Eigen::VectorXd>& y,
-                    Eigen::Ref<Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> out) const;
-  void TemporalBatch(const Eigen::Ref<const Eigen::VectorXd>& t,
-                     Eigen::Ref<Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> out) const;
+  void SpatialBatch(
+      const Eigen::Ref<const Eigen::VectorXd>& x, const Eigen::Ref<const Eigen::VectorXd>& y,
+      Eigen::Ref<Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> out) const;
+  void TemporalBatch(
+      const Eigen::Ref<const Eigen::VectorXd>& t,
+      Eigen::Ref<Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> out) const;
   /// Sparse spatial features of n samples (the non-zero entries only, the same float values as
   /// Spatial): sample i owns entries offsets[i] .. offsets[i + 1] - 1 of `index` (inducing point j)
   /// and `value`. `offsets` gets n + 1 entries. (Training uses this with an embedding bag.)
-  void SpatialSparseBatch(const Eigen::Ref<const Eigen::VectorXd>& x, const Eigen::Ref<const Eigen::VectorXd>& y,
+  void SpatialSparseBatch(const Eigen::Ref<const Eigen::VectorXd>& x,
+                          const Eigen::Ref<const Eigen::VectorXd>& y,
                           std::vector<std::int64_t>* index, std::vector<float>* value,
                           std::vector<std::int64_t>* offsets) const;
 

@@ -10,7 +10,8 @@ Artifact Artifact::Open(const std::string& path, const std::string& expected_mod
   Artifact a(h5::File::Open(path));
   const h5::File& f = a.file_;
   FS_THROW_UNLESS(f.HasAttr("/", "kind") && f.GetStringAttr("/", "kind") == kArtifactKind, path,
-                  ": not a foresight artifact (root attribute 'kind' is not '", kArtifactKind, "')");
+                  ": not a foresight artifact (root attribute 'kind' is not '", kArtifactKind,
+                  "')");
   const auto version = f.GetIntAttr("/", "format_version");
   FS_THROW_UNLESS(version == kArtifactFormatVersion, path, ": artifact format_version ", version,
                   " is not supported by this build (expected ", kArtifactFormatVersion, ")");
@@ -25,20 +26,21 @@ Artifact Artifact::Open(const std::string& path, const std::string& expected_mod
 
 int Artifact::IntAttr(const std::string& object, const std::string& name, int lo, int hi) const {
   const std::int64_t v = file_.GetIntAttr(object, name);
-  FS_THROW_UNLESS(v >= lo && v <= hi, file_.path(), ": attribute ", object, "/", name, " is ", v, "; expected ", lo,
-                  " to ", hi);
+  FS_THROW_UNLESS(v >= lo && v <= hi, file_.path(), ": attribute ", object, "/", name, " is ", v,
+                  "; expected ", lo, " to ", hi);
   return static_cast<int>(v);
 }
 
-double Artifact::DoubleAttr(const std::string& object, const std::string& name, double lo, double hi) const {
+double Artifact::DoubleAttr(const std::string& object, const std::string& name, double lo,
+                            double hi) const {
   const double v = file_.GetDoubleAttr(object, name);
-  FS_THROW_UNLESS(std::isfinite(v) && v >= lo && v <= hi, file_.path(), ": attribute ", object, "/", name, " is ", v,
-                  "; expected a finite number from ", lo, " to ", hi);
+  FS_THROW_UNLESS(std::isfinite(v) && v >= lo && v <= hi, file_.path(), ": attribute ", object, "/",
+                  name, " is ", v, "; expected a finite number from ", lo, " to ", hi);
   return v;
 }
 
-void Artifact::WriteHeader(h5::File* f, const std::string& model_type, const std::string& config_yaml,
-                           std::int64_t seed) {
+void Artifact::WriteHeader(h5::File* f, const std::string& model_type,
+                           const std::string& config_yaml, std::int64_t seed) {
   f->SetAttr("/", "kind", std::string(kArtifactKind));
   f->SetAttr("/", "format_version", kArtifactFormatVersion);
   f->SetAttr("/", "model_type", model_type);

@@ -33,8 +33,8 @@ class Artifact {
   double DoubleAttr(const std::string& object, const std::string& name, double lo, double hi) const;
 
   /// Writes the common header of a new artifact.
-  static void WriteHeader(h5::File* file, const std::string& model_type, const std::string& config_yaml,
-                          std::int64_t seed);
+  static void WriteHeader(h5::File* file, const std::string& model_type,
+                          const std::string& config_yaml, std::int64_t seed);
 
  private:
   explicit Artifact(h5::File f) : file_(std::move(f)) {}

@@ -18,7 +18,8 @@ Mlp::Mlp(std::vector<DenseLayer> layers) : layers_(std::move(layers)) {
   }
 }
 
-Mlp Mlp::Load(const h5::File& file, const std::string& prefix, const std::vector<std::string>& names) {
+Mlp Mlp::Load(const h5::File& file, const std::string& prefix,
+              const std::vector<std::string>& names) {
   std::vector<DenseLayer> layers;
   for (const auto& name : names) {
     DenseLayer l;
@@ -34,9 +35,10 @@ Mlp Mlp::Load(const h5::File& file, const std::string& prefix, const std::vector
   }
 }
 
-void Mlp::Save(h5::File* file, const std::string& prefix, const std::vector<std::string>& names) const {
-  FS_THROW_UNLESS(names.size() == layers_.size(), file->path(), ": ", names.size(), " layer names for ",
-                  layers_.size(), " layers");
+void Mlp::Save(h5::File* file, const std::string& prefix,
+               const std::vector<std::string>& names) const {
+  FS_THROW_UNLESS(names.size() == layers_.size(), file->path(), ": ", names.size(),
+                  " layer names for ", layers_.size(), " layers");
   for (std::size_t i = 0; i < layers_.size(); ++i) {
     file->WriteMatrix(prefix + names[i] + "/weight", layers_[i].weight);
     file->WriteMatrix(prefix + names[i] + "/bias", layers_[i].bias);

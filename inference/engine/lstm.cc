@@ -9,7 +9,8 @@ namespace foresight {
 Lstm::Lstm(LstmWeights weights) : w_(std::move(weights)) {
   const auto four_h = w_.weight_hh.rows();
   const auto h = w_.weight_hh.cols();
-  FS_THROW_UNLESS(h >= 1 && four_h == 4 * h, "Lstm: weight_hh is ", four_h, " x ", h, ", expected 4H x H");
+  FS_THROW_UNLESS(h >= 1 && four_h == 4 * h, "Lstm: weight_hh is ", four_h, " x ", h,
+                  ", expected 4H x H");
   FS_THROW_UNLESS(w_.weight_ih.rows() == four_h && w_.weight_ih.cols() >= 1, "Lstm: weight_ih is ",
                   w_.weight_ih.rows(), " x ", w_.weight_ih.cols(), ", expected ", four_h, " x I");
   FS_THROW_UNLESS(w_.bias_ih.size() == four_h && w_.bias_hh.size() == four_h, "Lstm: biases have ",
@@ -69,7 +70,8 @@ void Lstm::Step(const Eigen::Ref<const Eigen::VectorXf>& x, Workspace* ws) const
   Finish(ws);
 }
 
-void Lstm::StepProjected(const Eigen::Ref<const Eigen::VectorXf>& u, float scale, Workspace* ws) const {
+void Lstm::StepProjected(const Eigen::Ref<const Eigen::VectorXf>& u, float scale,
+                         Workspace* ws) const {
   ws->gates = scale * u + bias_;
   Finish(ws);
 }

@@ -23,8 +23,8 @@ struct LstmWeights {
 class Lstm {
  public:
   struct Workspace {
-    Eigen::VectorXf gates;  ///< [4H]
-    Eigen::VectorXf h, c;   ///< [H] state
+    Eigen::VectorXf gates;   ///< [4H]
+    Eigen::VectorXf h, c;    ///< [H] state
     bool zero_state = true;  ///< h = c = 0 (after Reset): the recurrent product is skipped
   };
 

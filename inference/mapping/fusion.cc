@@ -19,9 +19,10 @@ void RequireSameGrid(const HingeMap& a, const std::string& name_a, const HingeMa
                      const std::string& name_b) {
   FS_THROW_UNLESS(a.grid().SameFeatures(b.grid()), name_b, ": feature grid (", b.grid().Describe(),
                   ") differs from that of ", name_a, " (", a.grid().Describe(), ")");
-  FS_THROW_UNLESS(a.prior_mean() == b.prior_mean() && a.prior_variance() == b.prior_variance(), name_b,
-                  ": weight prior N(", b.prior_mean(), ", ", b.prior_variance(), ") differs from that of ",
-                  name_a, " N(", a.prior_mean(), ", ", a.prior_variance(), ")");
+  FS_THROW_UNLESS(a.prior_mean() == b.prior_mean() && a.prior_variance() == b.prior_variance(),
+                  name_b, ": weight prior N(", b.prior_mean(), ", ", b.prior_variance(),
+                  ") differs from that of ", name_a, " N(", a.prior_mean(), ", ",
+                  a.prior_variance(), ")");
 }
 
 }  // namespace
@@ -39,7 +40,8 @@ WeightEstimate IncrementOf(const HingeMap& local, const HingeMap& last_global) {
   const auto& s2_mn = local.weights().variance;
   const auto& mu_m = last_global.weights().mean;
   const auto& s2_m = last_global.weights().variance;
-  WeightEstimate inc{Eigen::VectorXd::Zero(mu_m.size()), Eigen::VectorXd::Constant(mu_m.size(), kInf)};
+  WeightEstimate inc{Eigen::VectorXd::Zero(mu_m.size()),
+                     Eigen::VectorXd::Constant(mu_m.size(), kInf)};
   for (Eigen::Index t = 0; t < mu_m.size(); ++t) {
     const double precision = 1.0 / s2_mn[t] - 1.0 / s2_m[t];
     if (!(s2_mn[t] < s2_m[t]) || !(precision > 0)) continue;  // learned nothing for this weight
@@ -61,8 +63,8 @@ HingeMap Conflate(const HingeGrid& grid, const std::vector<WeightEstimate>& esti
     info = base->weights().mean.cwiseProduct(precision);
   }
   for (const WeightEstimate& e : estimates) {
-    FS_THROW_UNLESS(e.mean.size() == t_size && e.variance.size() == t_size, "conflation: estimate of ",
-                    e.mean.size(), " weights for a grid of ", t_size);
+    FS_THROW_UNLESS(e.mean.size() == t_size && e.variance.size() == t_size,
+                    "conflation: estimate of ", e.mean.size(), " weights for a grid of ", t_size);
     for (Eigen::Index t = 0; t < t_size; ++t) {
       const double s2 = e.variance[t];
       if (!(s2 < options.variance_threshold) || !(s2 > 0)) continue;
@@ -88,7 +90,8 @@ HingeMap Conflate(const HingeGrid& grid, const std::vector<WeightEstimate>& esti
 HingeMap FuseMaps(const std::vector<const HingeMap*>& maps, const std::vector<std::string>& names,
                   const FusionOptions& options, const HingeMap* last_global) {
   FS_THROW_UNLESS(!maps.empty(), "fusion: no maps given");
-  FS_THROW_UNLESS(names.size() == maps.size(), "fusion: ", names.size(), " names for ", maps.size(), " maps");
+  FS_THROW_UNLESS(names.size() == maps.size(), "fusion: ", names.size(), " names for ", maps.size(),
+                  " maps");
   for (std::size_t i = 0; i < maps.size(); ++i) {
     RequireFastBhm(*maps[i], names[i]);
     RequireSameGrid(*maps[0], names[0], *maps[i], names[i]);

@@ -8,15 +8,14 @@
 /// `variance_threshold` learned (almost) nothing and is filtered out; a weight with no informative
 /// estimate keeps the prior.
 ///
-/// Repeated fusion: each robot keeps a copy of the last global map M and trains it further to M u N;
-/// its increment (spec/errata.md, ch 3)
+/// Repeated fusion: each robot keeps a copy of the last global map M and trains it further to M u
+/// N; its increment (spec/errata.md, ch 3)
 ///   1/s2_N = 1/s2_MuN - 1/s2_M,   mu_N = s2_N (mu_MuN / s2_MuN - mu_M / s2_M)
 /// is what it learned since; where s2_MuN >= s2_M it learned nothing and the increment is left
 /// out. The new global map is the conflation of M with all increments (M carries the shared,
 /// common information exactly once).
 
 #include <Eigen/Core>
-
 #include <string>
 #include <vector>
 
@@ -39,7 +38,8 @@ WeightEstimate EstimateOf(const HingeMap& map);
 WeightEstimate IncrementOf(const HingeMap& local, const HingeMap& last_global);
 
 /// Conflation of `estimates` (thresholded) and, when given, of `base` (taken whole): the global
-/// Fast-BHM on `grid`. Weights without any information keep the prior N(prior_mean, prior_variance).
+/// Fast-BHM on `grid`. Weights without any information keep the prior N(prior_mean,
+/// prior_variance).
 HingeMap Conflate(const HingeGrid& grid, const std::vector<WeightEstimate>& estimates,
                   const FusionOptions& options, double prior_mean, double prior_variance,
                   const HingeMap* base = nullptr);

@@ -22,8 +22,9 @@ GridMap::GridMap(GridGeometry geometry, Eigen::MatrixXf probability, CellType ce
                       std::isfinite(geometry_.x_min) && std::isfinite(geometry_.y_min),
                   "grid map: invalid geometry ", geometry_.nx, " x ", geometry_.ny, " cells of ",
                   geometry_.resolution, " m");
-  FS_THROW_UNLESS(cells_.rows() == geometry_.ny && cells_.cols() == geometry_.nx, "grid map: cells are ",
-                  cells_.rows(), " x ", cells_.cols(), ", expected ", geometry_.ny, " x ", geometry_.nx);
+  FS_THROW_UNLESS(cells_.rows() == geometry_.ny && cells_.cols() == geometry_.nx,
+                  "grid map: cells are ", cells_.rows(), " x ", cells_.cols(), ", expected ",
+                  geometry_.ny, " x ", geometry_.nx);
   for (Eigen::Index i = 0; i < cells_.size(); ++i) {
     float& p = cells_.data()[i];
     if (std::isnan(p)) continue;  // unknown: kept as NaN (stored as NaN / 255), answered as 0.5
@@ -64,7 +65,8 @@ Eigen::Vector4d GridMap::Extent() const {
   return {g.x_min, g.x_min + g.nx * g.resolution, g.y_min, g.y_min + g.ny * g.resolution};
 }
 
-void GridMap::Save(const std::string& path, const std::string& config_yaml, std::int64_t seed) const {
+void GridMap::Save(const std::string& path, const std::string& config_yaml,
+                   std::int64_t seed) const {
   h5::WriteAtomically(path, [&](h5::File* f) {
     Artifact::WriteHeader(f, kGridMapType, config_yaml, seed);
     f->SetAttr("/model", "x_min", geometry_.x_min);
@@ -79,7 +81,8 @@ void GridMap::Save(const std::string& path, const std::string& config_yaml, std:
       f->SetAttr("/model", "cell_type", std::string("uint8"));
       std::vector<std::uint8_t> bytes(cells_.size());
       for (int iy = 0; iy < geometry_.ny; ++iy)
-        for (int ix = 0; ix < geometry_.nx; ++ix) bytes[iy * geometry_.nx + ix] = EncodeCell(cells_(iy, ix));
+        for (int ix = 0; ix < geometry_.nx; ++ix)
+          bytes[iy * geometry_.nx + ix] = EncodeCell(cells_(iy, ix));
       f->Write("/cells", bytes.data(), shape);
     } else {
       f->SetAttr("/model", "cell_type", std::string("float32"));
@@ -95,8 +98,10 @@ GridMap GridMap::Load(const std::string& path) {
   g.x_min = a.DoubleAttr("/model", "x_min", -1e9, 1e9);
   g.y_min = a.DoubleAttr("/model", "y_min", -1e9, 1e9);
   g.resolution = a.DoubleAttr("/model", "resolution", 1e-9, 1e9);
-  const std::int64_t nx = a.IntAttr("/model", "nx", 1, 1 << 20), ny = a.IntAttr("/model", "ny", 1, 1 << 20);
-  FS_THROW_UNLESS(nx * ny <= (std::int64_t{1} << 30), path, ": grid of ", nx, " x ", ny, " cells is too large");
+  const std::int64_t nx = a.IntAttr("/model", "nx", 1, 1 << 20),
+                     ny = a.IntAttr("/model", "ny", 1, 1 << 20);
+  FS_THROW_UNLESS(nx * ny <= (std::int64_t{1} << 30), path, ": grid of ", nx, " x ", ny,
+                  " cells is too large");
   g.nx = static_cast<int>(nx);
   g.ny = static_cast<int>(ny);
   const std::string type = f.GetStringAttr("/model", "cell_type");
@@ -104,8 +109,7 @@ GridMap GridMap::Load(const std::string& path) {
     if (type == "uint8") {
       const h5::Array<std::uint8_t> bytes = f.ReadUint8("/cells");
       const std::vector<std::size_t> expected{std::size_t(ny), std::size_t(nx)};
-      FS_THROW_UNLESS(bytes.shape == expected,
-                      "/cells has the wrong shape");
+      FS_THROW_UNLESS(bytes.shape == expected, "/cells has the wrong shape");
       Eigen::MatrixXf p(ny, nx);
       for (int iy = 0; iy < g.ny; ++iy)
         for (int ix = 0; ix < g.nx; ++ix) {

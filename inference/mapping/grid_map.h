@@ -9,7 +9,6 @@
 /// (float32 or uint8; see docs/artifact_schema.md).
 
 #include <Eigen/Core>
-
 #include <cstdint>
 #include <string>
 

@@ -12,7 +12,8 @@ constexpr double kPiOver8 = M_PI / 8.0;
 
 double Sigmoid(double a) { return 1.0 / (1.0 + std::exp(-a)); }
 
-void WriteVector(h5::File* f, const std::string& name, const Eigen::VectorXd& v, StoredPrecision p) {
+void WriteVector(h5::File* f, const std::string& name, const Eigen::VectorXd& v,
+                 StoredPrecision p) {
   const std::vector<std::size_t> shape{static_cast<std::size_t>(v.size())};
   if (p == StoredPrecision::kFloat64) {
     f->Write(name, v.data(), shape);
@@ -31,9 +32,12 @@ Eigen::VectorXd ReadVector(const h5::File& f, const std::string& name, long size
 
 const char* ModelType(HingeMapKind kind) {
   switch (kind) {
-    case HingeMapKind::kHilbert: return kHilbertMapType;
-    case HingeMapKind::kFastBhm: return kFastBhmType;
-    case HingeMapKind::kBhm: return kBhmType;
+    case HingeMapKind::kHilbert:
+      return kHilbertMapType;
+    case HingeMapKind::kFastBhm:
+      return kFastBhmType;
+    case HingeMapKind::kBhm:
+      return kBhmType;
   }
   return "?";
 }
@@ -44,7 +48,10 @@ double PredictiveProbability(double latent_mean, double latent_variance) {
 
 HingeMap::HingeMap(HingeMapKind kind, HingeGrid grid, HingeWeights weights, double prior_mean,
                    double prior_variance)
-    : kind_(kind), grid_(std::move(grid)), weights_(std::move(weights)), prior_mean_(prior_mean),
+    : kind_(kind),
+      grid_(std::move(grid)),
+      weights_(std::move(weights)),
+      prior_mean_(prior_mean),
       prior_variance_(prior_variance) {
   const long t = grid_.size();
   FS_THROW_UNLESS(weights_.mean.size() == t, ModelType(kind_), ": ", weights_.mean.size(),
@@ -56,9 +63,9 @@ HingeMap::HingeMap(HingeMapKind kind, HingeGrid grid, HingeWeights weights, doub
     return;
   }
   if (kind_ == HingeMapKind::kBhm) {
-    FS_THROW_UNLESS(weights_.covariance.rows() == t && weights_.covariance.cols() == t, ModelType(kind_),
-                    ": covariance is ", weights_.covariance.rows(), " x ", weights_.covariance.cols(),
-                    ", expected ", t, " x ", t);
+    FS_THROW_UNLESS(weights_.covariance.rows() == t && weights_.covariance.cols() == t,
+                    ModelType(kind_), ": covariance is ", weights_.covariance.rows(), " x ",
+                    weights_.covariance.cols(), ", expected ", t, " x ", t);
     weights_.variance = weights_.covariance.diagonal();
   } else {
     weights_.covariance.resize(0, 0);
@@ -67,8 +74,9 @@ HingeMap::HingeMap(HingeMapKind kind, HingeGrid grid, HingeWeights weights, doub
                   " weight variances for a grid of ", t, " features");
   FS_THROW_UNLESS((weights_.variance.array() > 0).all() && weights_.variance.allFinite(),
                   ModelType(kind_), ": weight variances must be positive and finite");
-  FS_THROW_UNLESS(std::isfinite(prior_mean_) && prior_variance_ > 0 && std::isfinite(prior_variance_),
-                  ModelType(kind_), ": prior N(", prior_mean_, ", ", prior_variance_, ") is invalid");
+  FS_THROW_UNLESS(
+      std::isfinite(prior_mean_) && prior_variance_ > 0 && std::isfinite(prior_variance_),
+      ModelType(kind_), ": prior N(", prior_mean_, ", ", prior_variance_, ") is invalid");
 }
 
 MapWorkspace HingeMap::MakeWorkspace() const {
@@ -202,7 +210,8 @@ void HingeMap::Save(const std::string& path, const std::string& config_yaml, std
     f->SetAttr("/model", "prior_mean", prior_mean_);
     f->SetAttr("/model", "prior_variance", prior_variance_);
     WriteVector(f, "/weights/mean", weights_.mean, precision);
-    if (kind_ == HingeMapKind::kFastBhm) WriteVector(f, "/weights/variance", weights_.variance, precision);
+    if (kind_ == HingeMapKind::kFastBhm)
+      WriteVector(f, "/weights/variance", weights_.variance, precision);
     if (kind_ == HingeMapKind::kBhm) {
       if (precision == StoredPrecision::kFloat64) {
         f->WriteMatrix("/weights/covariance", weights_.covariance);
@@ -242,7 +251,8 @@ HingeMap HingeMap::Load(const std::string& path, const std::string& expected_typ
     w.mean = ReadVector(f, "/weights/mean", t);
     if (kind == HingeMapKind::kFastBhm) w.variance = ReadVector(f, "/weights/variance", t);
     if (kind == HingeMapKind::kBhm) w.covariance = f.ReadMatrixD("/weights/covariance", t, t);
-    return HingeMap(kind, std::move(grid), std::move(w), a.DoubleAttr("/model", "prior_mean", -1e12, 1e12),
+    return HingeMap(kind, std::move(grid), std::move(w),
+                    a.DoubleAttr("/model", "prior_mean", -1e12, 1e12),
                     a.DoubleAttr("/model", "prior_variance", 1e-300, 1e300));
   } catch (const Error& e) {
     const std::string what = e.what();

@@ -2,7 +2,8 @@
 /// Occupancy maps that are logistic regressions on hinge features (core/hinge_grid.h):
 ///   Hilbert map  f(x) = w' phi(x),            p = sigmoid(f)               (point weights)
 ///   Fast-BHM     w_t ~ N(mu_t, s2_t) independent (mean-field)              (thesis ch 3)
-///   BHM          w ~ N(mu, Sigma) with full covariance                     (Senanayake & Ramos 2017)
+///   BHM          w ~ N(mu, Sigma) with full covariance                     (Senanayake & Ramos
+///   2017)
 /// Bayesian maps predict with the probit approximation of the logistic-Gaussian integral
 /// (Bishop 2006, eq. 4.153):  p = sigmoid(mu_f / sqrt(1 + pi s2_f / 8)),
 ///   mu_f = mu' phi(x),  s2_f = phi' Sigma phi  (= sum_t phi_t^2 s2_t for Fast-BHM).
@@ -13,7 +14,6 @@
 /// (Bayesian), /weights/covariance [T x T] (BHM), stored as float32 or float64.
 
 #include <Eigen/Core>
-
 #include <cstdint>
 #include <string>
 

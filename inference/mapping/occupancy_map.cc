@@ -23,7 +23,8 @@ void OccupancyMap::ProbabilityBatch(const Eigen::Ref<const Eigen::Matrix2Xd>& po
                                     MapWorkspace* ws, Eigen::Ref<Eigen::VectorXd> out) const {
   FS_THROW_UNLESS(out.size() == points.cols(), "ProbabilityBatch: output has ", out.size(),
                   " entries for ", points.cols(), " points");
-  for (Eigen::Index i = 0; i < points.cols(); ++i) out[i] = Probability(points(0, i), points(1, i), ws);
+  for (Eigen::Index i = 0; i < points.cols(); ++i)
+    out[i] = Probability(points(0, i), points(1, i), ws);
 }
 
 std::unique_ptr<OccupancyMap> LoadOccupancyMap(const std::string& path) {

@@ -4,7 +4,6 @@
 /// caller owns a MapWorkspace, so one map serves many threads. Queries never allocate.
 
 #include <Eigen/Core>
-
 #include <memory>
 #include <string>
 #include <vector>
@@ -19,7 +18,7 @@ inline constexpr const char* kGridMapType = "occupancy.grid";
 
 /// One point's answer.
 struct OccupancyQuery {
-  double probability = 0.5;  ///< p(occupied | x)
+  double probability = 0.5;     ///< p(occupied | x)
   double dp_dx = 0, dp_dy = 0;  ///< gradient of the probability w.r.t. the query position (1/m)
   /// Posterior variance of the latent logit f(x) = w' phi(x) (Bayesian maps); 0 for maps without
   /// weight uncertainty. Where the map knows nothing (outside its extent) this is the prior

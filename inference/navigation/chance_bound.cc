@@ -6,8 +6,8 @@
 
 namespace foresight::nav {
 
-double CollisionProbabilityBound(const Eigen::Vector2d& x, const Eigen::Vector2d& mean, const Eigen::Matrix2d& cov,
-                                 double radius) {
+double CollisionProbabilityBound(const Eigen::Vector2d& x, const Eigen::Vector2d& mean,
+                                 const Eigen::Matrix2d& cov, double radius) {
   const Eigen::Vector2d d = x - mean;
   const double dist = d.norm();
   if (dist == 0.0) return 1.0;
@@ -43,11 +43,13 @@ double ErfInv(double y) {
 }
 
 ChanceThreshold::ChanceThreshold(double epsilon) : epsilon_(epsilon) {
-  FS_THROW_UNLESS(epsilon > 0.0 && epsilon < 1.0, "chance threshold epsilon = ", epsilon, ": expected 0 < epsilon < 1");
+  FS_THROW_UNLESS(epsilon > 0.0 && epsilon < 1.0, "chance threshold epsilon = ", epsilon,
+                  ": expected 0 < epsilon < 1");
   c_ = -ErfInv(2.0 * epsilon - 1.0);
 }
 
-bool ChanceThreshold::Exceeds(const Eigen::Vector2d& d, const Eigen::Matrix2d& cov, double radius) const {
+bool ChanceThreshold::Exceeds(const Eigen::Vector2d& d, const Eigen::Matrix2d& cov,
+                              double radius) const {
   const double dist2 = d.squaredNorm();
   if (dist2 == 0.0) return true;
   const double dist = std::sqrt(dist2);

@@ -22,7 +22,8 @@ namespace og = ompl::geometric;
 
 std::string ClRrtStarOptions::Problems() const {
   std::ostringstream e;
-  if (!(budget_s > 0) || !std::isfinite(budget_s)) e << "budget_s = " << budget_s << " must be > 0; ";
+  if (!(budget_s > 0) || !std::isfinite(budget_s))
+    e << "budget_s = " << budget_s << " must be > 0; ";
   if (max_iterations < 1) e << "max_iterations = " << max_iterations << " must be >= 1; ";
   if (!(range > 0)) e << "range = " << range << " must be > 0; ";
   if (!(goal_tolerance > 0)) e << "goal_tolerance must be > 0; ";
@@ -56,7 +57,8 @@ Control PurePursuit(const UnicycleState& robot, const Eigen::Matrix2Xd& path, do
   if (dist < 1e-6) return {0, 0};
   const double alpha = std::remainder(std::atan2(to.y(), to.x()) - robot.heading, 2.0 * M_PI);
   if (std::abs(alpha) > M_PI / 2) return {0.0, std::copysign(limits.omega_max, alpha)};
-  const double v = std::min(limits.v_max, limits.v_max * std::min(1.0, goal_dist / lookahead)) * std::cos(alpha);
+  const double v =
+      std::min(limits.v_max, limits.v_max * std::min(1.0, goal_dist / lookahead)) * std::cos(alpha);
   const double omega = 2.0 * std::max(v, 0.2) * std::sin(alpha) / std::max(dist, 1e-3);
   return limits.Clamp({v, omega});
 }
@@ -78,22 +80,26 @@ struct ClRrtStarController::Impl {
       if ((pedestrians.col(i) - Eigen::Vector2d(x, y)).squaredNorm() < r * r) return false;
     // The static check spares a small ball around the robot: a tracker that cut a corner into the
     // epsilon band would otherwise make every plan start invalid and freeze the robot for good.
-    if ((Eigen::Vector2d(x, y) - start).squaredNorm() < options.start_exemption * options.start_exemption) return true;
+    if ((Eigen::Vector2d(x, y) - start).squaredNorm() <
+        options.start_exemption * options.start_exemption)
+      return true;
     return !(field && field->Collides(x, y, options.epsilon, const_cast<MapWorkspace*>(&map_ws)));
   }
 };
 
-ClRrtStarController::ClRrtStarController(const StaticCollisionField* field, const Eigen::Vector4d& extent,
-                                         ClRrtStarOptions options, std::uint64_t seed)
+ClRrtStarController::ClRrtStarController(const StaticCollisionField* field,
+                                         const Eigen::Vector4d& extent, ClRrtStarOptions options,
+                                         std::uint64_t seed)
     : impl_(std::make_unique<Impl>()) {
   const std::string problems = options.Problems();
   FS_THROW_UNLESS(problems.empty(), "CL-RRT* options: ", problems);
-  FS_THROW_UNLESS(extent.allFinite() && extent[1] > extent[0] && extent[3] > extent[2], "CL-RRT*: planning extent [",
-                  extent.transpose(), "] is empty");
+  FS_THROW_UNLESS(extent.allFinite() && extent[1] > extent[0] && extent[3] > extent[2],
+                  "CL-RRT*: planning extent [", extent.transpose(), "] is empty");
   static std::once_flag once;
   std::call_once(once, [seed] {
     ompl::msg::setLogLevel(ompl::msg::LOG_NONE);
-    ompl::RNG::setSeed(seed + 1);  // OMPL seeds once per process; later planners draw from it in order
+    ompl::RNG::setSeed(seed +
+                       1);  // OMPL seeds once per process; later planners draw from it in order
   });
   impl_->options = options;
   impl_->field = field && !field->empty() ? field : nullptr;
@@ -108,8 +114,10 @@ ClRrtStarController::ClRrtStarController(const StaticCollisionField* field, cons
   impl_->setup = std::make_shared<og::SimpleSetup>(impl_->space);
   Impl* impl = impl_.get();
   impl_->setup->setStateValidityChecker([impl](const ob::State* s) { return impl->Valid(s); });
-  const double span = std::hypot(extent[1] - extent[0], extent[3] - extent[2]);  // OMPL: fraction of the diagonal
-  impl_->setup->getSpaceInformation()->setStateValidityCheckingResolution(options.check_resolution / span);
+  const double span =
+      std::hypot(extent[1] - extent[0], extent[3] - extent[2]);  // OMPL: fraction of the diagonal
+  impl_->setup->getSpaceInformation()->setStateValidityCheckingResolution(options.check_resolution /
+                                                                          span);
   impl_->setup->setOptimizationObjective(
       std::make_shared<ob::PathLengthOptimizationObjective>(impl_->setup->getSpaceInformation()));
 }
@@ -120,7 +128,8 @@ ControlOutcome ClRrtStarController::Compute(const NavigationInput& input) {
   ControlOutcome out;
   try {
     Eigen::MatrixXd clean;
-    const int n = input.past_rows ? CleanObservations(*input.past_rows, &clean, &impl_->pedestrians) : 0;
+    const int n =
+        input.past_rows ? CleanObservations(*input.past_rows, &clean, &impl_->pedestrians) : 0;
     impl_->pedestrians.conservativeResize(2, n);  // rows without any finite point were dropped
     impl_->start = input.robot.position();
     const auto& o = impl_->options;
@@ -142,7 +151,8 @@ ControlOutcome ClRrtStarController::Compute(const NavigationInput& input) {
     const int cap = o.max_iterations;
     const ob::PlannerTerminationCondition ptc = ob::plannerOrTerminationCondition(
         ob::timedPlannerTerminationCondition(o.budget_s),
-        ob::PlannerTerminationCondition([planner, cap] { return planner->numIterations() >= static_cast<unsigned>(cap); }));
+        ob::PlannerTerminationCondition(
+            [planner, cap] { return planner->numIterations() >= static_cast<unsigned>(cap); }));
     const ob::PlannerStatus status = ss.solve(ptc);
     out.evaluations = static_cast<int>(planner->numIterations());
     const bool exact = status == ob::PlannerStatus::EXACT_SOLUTION;
@@ -159,7 +169,8 @@ ControlOutcome ClRrtStarController::Compute(const NavigationInput& input) {
     // least `min_progress` closer; otherwise nothing useful was found and the robot stays put.
     const bool progress = path_.cols() > 0 && (approximate || exact) &&
                           (input.robot.position() - input.goal).norm() -
-                                  (path_.col(path_.cols() - 1) - input.goal).norm() >= o.min_progress;
+                                  (path_.col(path_.cols() - 1) - input.goal).norm() >=
+                              o.min_progress;
     if (!(exact || (approximate && progress))) {
       path_.resize(2, 0);
       out.status = ControlStatus::kNoPath;

@@ -17,11 +17,11 @@
 namespace foresight::nav {
 
 struct ClRrtStarOptions {
-  double budget_s = 0.1;          ///< planning time budget per cycle (wall clock)
-  int max_iterations = 1500;      ///< RRT* iteration cap per cycle
-  double range = 1.0;             ///< RRT* extension step (m)
-  double goal_tolerance = 0.3;    ///< goal region radius of the planner (m)
-  double lookahead = 0.8;         ///< pure-pursuit look-ahead distance (m)
+  double budget_s = 0.1;        ///< planning time budget per cycle (wall clock)
+  int max_iterations = 1500;    ///< RRT* iteration cap per cycle
+  double range = 1.0;           ///< RRT* extension step (m)
+  double goal_tolerance = 0.3;  ///< goal region radius of the planner (m)
+  double lookahead = 0.8;       ///< pure-pursuit look-ahead distance (m)
   /// A partial plan (no path reaches the goal region) is followed when its end is at least this
   /// much closer to the goal than the robot (m); otherwise the robot stays put.
   double min_progress = 0.3;
@@ -43,8 +43,8 @@ Control PurePursuit(const UnicycleState& robot, const Eigen::Matrix2Xd& path, do
 class ClRrtStarController final : public NavigationController {
  public:
   /// @param extent [x_min, x_max, y_min, y_max] of the planning space (m).
-  ClRrtStarController(const StaticCollisionField* field, const Eigen::Vector4d& extent, ClRrtStarOptions options,
-                      std::uint64_t seed);
+  ClRrtStarController(const StaticCollisionField* field, const Eigen::Vector4d& extent,
+                      ClRrtStarOptions options, std::uint64_t seed);
   ~ClRrtStarController() override;
   std::string name() const override { return "cl_rrt_star"; }
   ControlOutcome Compute(const NavigationInput& input) override;

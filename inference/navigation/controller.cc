@@ -4,10 +4,14 @@ namespace foresight::nav {
 
 const char* ToString(ControlStatus status) {
   switch (status) {
-    case ControlStatus::kSolved: return "solved";
-    case ControlStatus::kNoFinitePlan: return "no_finite_plan";
-    case ControlStatus::kNoPath: return "no_path";
-    case ControlStatus::kError: return "error";
+    case ControlStatus::kSolved:
+      return "solved";
+    case ControlStatus::kNoFinitePlan:
+      return "no_finite_plan";
+    case ControlStatus::kNoPath:
+      return "no_path";
+    case ControlStatus::kError:
+      return "error";
   }
   return "";
 }

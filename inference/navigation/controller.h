@@ -23,20 +23,20 @@ struct NavigationInput {
 
 /// How a control cycle ended (expected outcomes are values, not exceptions).
 enum class ControlStatus {
-  kSolved,          ///< a control was found
-  kNoFinitePlan,    ///< every candidate was infeasible or non-finite: stop
-  kNoPath,          ///< the planner found no path that makes progress: stay put
-  kError,           ///< the cycle failed (e.g. malformed observations): stop; see `message`
+  kSolved,        ///< a control was found
+  kNoFinitePlan,  ///< every candidate was infeasible or non-finite: stop
+  kNoPath,        ///< the planner found no path that makes progress: stay put
+  kError,         ///< the cycle failed (e.g. malformed observations): stop; see `message`
 };
 const char* ToString(ControlStatus status);
 
 struct ControlOutcome {
   Control command;
   ControlStatus status = ControlStatus::kSolved;  ///< not kSolved: the command stops the robot
-  std::string message;    ///< why a cycle was not solved (empty when solved)
-  int evaluations = 0;    ///< objective evaluations (SPAN, reactive) or planner iterations (CL-RRT*)
-  double tau = 0;         ///< time-to-collision of the chosen control (inf: none within the horizon)
-  double cost = 0;        ///< objective value of the chosen control
+  std::string message;  ///< why a cycle was not solved (empty when solved)
+  int evaluations = 0;  ///< objective evaluations (SPAN, reactive) or planner iterations (CL-RRT*)
+  double tau = 0;       ///< time-to-collision of the chosen control (inf: none within the horizon)
+  double cost = 0;      ///< objective value of the chosen control
   bool solved() const { return status == ControlStatus::kSolved; }
   /// A stop command with `status` and `message`.
   static ControlOutcome Stop(ControlStatus status, std::string message);

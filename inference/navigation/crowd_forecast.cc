@@ -22,9 +22,10 @@ void CrowdForecast::Reserve(int max_pedestrians, int steps, int components) {
   reach_.reserve(cells);
 }
 
-void CrowdForecast::FromPredictions(const std::vector<TrajectoryDistribution>& dists, int n, int steps, double dt) {
-  FS_THROW_UNLESS(n >= 0 && static_cast<std::size_t>(n) <= dists.size(), "CrowdForecast: ", n, " pedestrians but ",
-                  dists.size(), " predictions");
+void CrowdForecast::FromPredictions(const std::vector<TrajectoryDistribution>& dists, int n,
+                                    int steps, double dt) {
+  FS_THROW_UNLESS(n >= 0 && static_cast<std::size_t>(n) <= dists.size(), "CrowdForecast: ", n,
+                  " pedestrians but ", dists.size(), " predictions");
   n_ = n;
   steps_ = steps;
   r_ = n > 0 ? dists[0].components() : 1;
@@ -45,7 +46,8 @@ void CrowdForecast::FromPredictions(const std::vector<TrajectoryDistribution>& d
   }
 }
 
-void CrowdForecast::FromCurrentPositions(const Eigen::Ref<const Eigen::Matrix2Xd>& positions, int steps) {
+void CrowdForecast::FromCurrentPositions(const Eigen::Ref<const Eigen::Matrix2Xd>& positions,
+                                         int steps) {
   n_ = static_cast<int>(positions.cols());
   steps_ = steps;
   r_ = 1;
@@ -63,13 +65,15 @@ void CrowdForecast::FromCurrentPositions(const Eigen::Ref<const Eigen::Matrix2Xd
     }
 }
 
-bool CrowdForecast::Collides(int k, const Eigen::Vector2d& x, double radius, const ChanceThreshold& threshold) const {
+bool CrowdForecast::Collides(int k, const Eigen::Vector2d& x, double radius,
+                             const ChanceThreshold& threshold) const {
   const double c = threshold.c();
   for (int n = 0; n < n_; ++n) {
     if (r_ == 1) {
       const std::size_t j = Index(n, k, 0);
       const Eigen::Vector2d d = x - mean_[j];
-      // Quick reject: a' Sigma a <= lambda_max, so no collision when ||d|| >= radius + c sqrt(2 lambda_max).
+      // Quick reject: a' Sigma a <= lambda_max, so no collision when ||d|| >= radius + c sqrt(2
+      // lambda_max).
       const double outer = radius + std::max(0.0, c) * M_SQRT2 * reach_[j];
       if (d.squaredNorm() >= outer * outer) continue;
       if (threshold.Exceeds(d, cov_[j], radius)) return true;
@@ -81,7 +85,8 @@ bool CrowdForecast::Collides(int k, const Eigen::Vector2d& x, double radius, con
         // Components farther than radius + 6 sigma contribute < 1e-9: skipped.
         const double outer = radius + 6.0 * reach_[j];
         if (d.squaredNorm() >= outer * outer) continue;
-        bound += alpha_[static_cast<std::size_t>(n * r_ + r)] * CollisionProbabilityBound(x, mean_[j], cov_[j], radius);
+        bound += alpha_[static_cast<std::size_t>(n * r_ + r)] *
+                 CollisionProbabilityBound(x, mean_[j], cov_[j], radius);
       }
       if (bound > threshold.epsilon()) return true;
     }
@@ -95,7 +100,8 @@ double CrowdForecast::MaxBound(int k, const Eigen::Vector2d& x, double radius) c
     double bound = 0.0;
     for (int r = 0; r < r_; ++r) {
       const std::size_t j = Index(n, k, r);
-      bound += alpha_[static_cast<std::size_t>(n * r_ + r)] * CollisionProbabilityBound(x, mean_[j], cov_[j], radius);
+      bound += alpha_[static_cast<std::size_t>(n * r_ + r)] *
+               CollisionProbabilityBound(x, mean_[j], cov_[j], radius);
     }
     best = std::max(best, bound);
   }

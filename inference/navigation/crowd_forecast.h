@@ -18,8 +18,10 @@ class CrowdForecast {
   void Reserve(int max_pedestrians, int steps, int components);
 
   /// Tabulates the predictions `dists[0..n)` at times k * dt, k = 1..steps.
-  void FromPredictions(const std::vector<TrajectoryDistribution>& dists, int n, int steps, double dt);
-  /// Deterministic pedestrians standing still at `positions` [2 x n] (the reactive baseline's view).
+  void FromPredictions(const std::vector<TrajectoryDistribution>& dists, int n, int steps,
+                       double dt);
+  /// Deterministic pedestrians standing still at `positions` [2 x n] (the reactive baseline's
+  /// view).
   void FromCurrentPositions(const Eigen::Ref<const Eigen::Matrix2Xd>& positions, int steps);
 
   int pedestrians() const { return n_; }
@@ -29,7 +31,8 @@ class CrowdForecast {
   /// True when the probability bound of colliding with any pedestrian at step k (1-based) exceeds
   /// the threshold (eq. dynamicCheck). One component: the erf-free form of ChanceThreshold;
   /// mixtures: sum_r alpha_r bound_r > epsilon (a bound on the mixture probability).
-  bool Collides(int k, const Eigen::Vector2d& x, double radius, const ChanceThreshold& threshold) const;
+  bool Collides(int k, const Eigen::Vector2d& x, double radius,
+                const ChanceThreshold& threshold) const;
   /// Largest bound over the pedestrians at step k (for tests and plots).
   double MaxBound(int k, const Eigen::Vector2d& x, double radius) const;
 
@@ -42,10 +45,10 @@ class CrowdForecast {
     return (static_cast<std::size_t>(n) * steps_ + static_cast<std::size_t>(k - 1)) * r_ + r;
   }
   int n_ = 0, steps_ = 0, r_ = 1;
-  std::vector<double> alpha_;             ///< [N * R]
-  std::vector<Eigen::Vector2d> mean_;     ///< [N * K * R]
-  std::vector<Eigen::Matrix2d> cov_;      ///< [N * K * R]
-  std::vector<double> reach_;             ///< [N * K * R]: sqrt of the largest eigenvalue of cov
+  std::vector<double> alpha_;          ///< [N * R]
+  std::vector<Eigen::Vector2d> mean_;  ///< [N * K * R]
+  std::vector<Eigen::Matrix2d> cov_;   ///< [N * K * R]
+  std::vector<double> reach_;          ///< [N * K * R]: sqrt of the largest eigenvalue of cov
 };
 
 }  // namespace foresight::nav

@@ -18,19 +18,22 @@ namespace foresight::nav {
 class GoalDistanceField {
  public:
   GoalDistanceField() = default;
-  /// Free cells: swept occupancy <= epsilon. A goal on an occupied cell starts from the nearest free one.
+  /// Free cells: swept occupancy <= epsilon. A goal on an occupied cell starts from the nearest
+  /// free one.
   GoalDistanceField(const StaticCollisionField& field, const Eigen::Vector2d& goal, double epsilon,
                     double margin = 0.5, double margin_weight = 3.0);
 
   const Eigen::Vector2d& goal() const { return goal_; }
   bool empty() const { return distance_.size() == 0; }
-  /// Geodesic distance (m), bilinear between cells; outside the raster or on cells that cannot reach
-  /// the goal: the Euclidean distance plus `unreachable_penalty`.
+  /// Geodesic distance (m), bilinear between cells; outside the raster or on cells that cannot
+  /// reach the goal: the Euclidean distance plus `unreachable_penalty`.
   double Distance(const Eigen::Vector2d& x) const;
   double unreachable_penalty = 50.0;
   double margin_weight() const { return margin_weight_; }
   /// True when x lies on a cell that reaches the goal.
-  bool Reaches(const Eigen::Vector2d& x) const { return Distance(x) < (x - goal_).norm() + 0.5 * unreachable_penalty; }
+  bool Reaches(const Eigen::Vector2d& x) const {
+    return Distance(x) < (x - goal_).norm() + 0.5 * unreachable_penalty;
+  }
 
  private:
   Eigen::Vector2d goal_ = Eigen::Vector2d::Zero(), origin_ = Eigen::Vector2d::Zero();

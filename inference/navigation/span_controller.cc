@@ -1,11 +1,10 @@
 #include "inference/navigation/span_controller.h"
 
-#include <nlopt.hpp>
-
 #include <algorithm>
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <nlopt.hpp>
 #include <sstream>
 
 #include "core/error.h"
@@ -20,13 +19,14 @@ double WrapToPi(double a) { return std::remainder(a, 2.0 * M_PI); }
 
 /// Starts of the per-cycle COBYLA runs: the previous solution, a goal-directed turn, a fan, then
 /// quasi-random points of the control box (a fixed Halton sequence) up to `initialisations`.
-std::vector<Control> Starts(const SpanControllerOptions& o, const UnicycleState& robot, const Eigen::Vector2d& goal,
-                            const Control* previous) {
+std::vector<Control> Starts(const SpanControllerOptions& o, const UnicycleState& robot,
+                            const Eigen::Vector2d& goal, const Control* previous) {
   std::vector<Control> s;
   if (previous) s.push_back(*previous);
   const double bearing = std::atan2(goal.y() - robot.y, goal.x() - robot.x);
-  const double turn = std::clamp(WrapToPi(bearing - robot.heading) / std::max(o.horizon * 0.5, o.dt), -o.limits.omega_max,
-                                 o.limits.omega_max);
+  const double turn =
+      std::clamp(WrapToPi(bearing - robot.heading) / std::max(o.horizon * 0.5, o.dt),
+                 -o.limits.omega_max, o.limits.omega_max);
   s.push_back({o.limits.v_max, turn});
   for (double v : {o.limits.v_max, 0.5 * o.limits.v_max})
     for (double w : {0.0, -0.5, 0.5, -1.0, 1.0}) s.push_back({v, w * o.limits.omega_max});
@@ -55,15 +55,16 @@ double NloptCost(unsigned, const double* x, double*, void* data) {
 }
 
 /// (Re)builds the goal-distance field when the goal changed (geodesic goal term with a static map).
-void UpdateGoalField(const SpanControllerOptions& o, const StaticCollisionField* field, const Eigen::Vector2d& goal,
-                     GoalDistanceField* goal_field) {
+void UpdateGoalField(const SpanControllerOptions& o, const StaticCollisionField* field,
+                     const Eigen::Vector2d& goal, GoalDistanceField* goal_field) {
   if (o.geodesic_goal && field && (goal_field->empty() || goal_field->goal() != goal))
     *goal_field = GoalDistanceField(*field, goal, o.epsilon);
 }
 
 /// Runs COBYLA from each start; returns the best control and its cost. Never throws.
-std::pair<Control, double> MinimiseFromStarts(const SpanControllerOptions& o, const std::vector<Control>& starts,
-                                              int max_starts, double lower_bound, Problem* problem) {
+std::pair<Control, double> MinimiseFromStarts(const SpanControllerOptions& o,
+                                              const std::vector<Control>& starts, int max_starts,
+                                              double lower_bound, Problem* problem) {
   Control best{0.0, 0.0};
   double best_cost = kInf;
   nlopt::opt opt(nlopt::LN_COBYLA, 2);
@@ -100,7 +101,8 @@ std::string SpanControllerOptions::Problems() const {
   if (!(kappa >= 0) || !std::isfinite(kappa)) e << "kappa = " << kappa << " must be >= 0; ";
   if (!(epsilon > 0 && epsilon < 1)) e << "epsilon = " << epsilon << " must be in (0, 1); ";
   if (!(dt > 0) || !std::isfinite(dt)) e << "dt = " << dt << " must be > 0; ";
-  if (!(horizon >= dt) || !std::isfinite(horizon)) e << "horizon = " << horizon << " must be >= dt; ";
+  if (!(horizon >= dt) || !std::isfinite(horizon))
+    e << "horizon = " << horizon << " must be >= dt; ";
   if (!(robot_radius > 0) || !(pedestrian_radius >= 0)) e << "radii must be positive; ";
   if (!(limits.v_min <= 0 && limits.v_max > 0 && limits.omega_max > 0))
     e << "control limits need v_min <= 0 < v_max and omega_max > 0; ";
@@ -109,7 +111,8 @@ std::string SpanControllerOptions::Problems() const {
   return e.str();
 }
 
-int CleanObservations(const Eigen::MatrixXd& past_rows, Eigen::MatrixXd* clean, Eigen::Matrix2Xd* current) {
+int CleanObservations(const Eigen::MatrixXd& past_rows, Eigen::MatrixXd* clean,
+                      Eigen::Matrix2Xd* current) {
   const Eigen::Index p = past_rows.cols() / 2;
   clean->resize(past_rows.rows(), past_rows.cols());
   current->resize(2, past_rows.rows());
@@ -122,7 +125,8 @@ int CleanObservations(const Eigen::MatrixXd& past_rows, Eigen::MatrixXd* clean, 
     const bool all_finite = past_rows.row(n).allFinite();
     for (Eigen::Index i = 0; i < p; ++i) {
       clean->coeffRef(kept, 2 * i) = all_finite ? past_rows(n, 2 * i) : past_rows(n, 2 * last);
-      clean->coeffRef(kept, 2 * i + 1) = all_finite ? past_rows(n, 2 * i + 1) : past_rows(n, 2 * last + 1);
+      clean->coeffRef(kept, 2 * i + 1) =
+          all_finite ? past_rows(n, 2 * i + 1) : past_rows(n, 2 * last + 1);
     }
     current->col(kept) = Eigen::Vector2d(past_rows(n, 2 * last), past_rows(n, 2 * last + 1));
     ++kept;
@@ -147,7 +151,9 @@ SpanController::SpanController(const SpanPredictor* predictor, const StaticColli
   }
 }
 
-void SpanController::Prepare(const Eigen::Vector2d& goal) { UpdateGoalField(options_, field_, goal, &goal_field_); }
+void SpanController::Prepare(const Eigen::Vector2d& goal) {
+  UpdateGoalField(options_, field_, goal, &goal_field_);
+}
 
 void SpanController::Forecast(const NavigationInput& input) {
   const int n = input.past_rows ? CleanObservations(*input.past_rows, &clean_rows_, &current_) : 0;
@@ -155,15 +161,17 @@ void SpanController::Forecast(const NavigationInput& input) {
     forecast_.FromCurrentPositions(current_.leftCols(n), steps_);
     return;
   }
-  FS_THROW_UNLESS(clean_rows_.cols() == 2 * predictor_->observed(), "SPAN controller: observations hold ",
-                  clean_rows_.cols() / 2, " points per pedestrian, the predictor expects ", predictor_->observed());
-  while (predictions_.size() < static_cast<std::size_t>(n)) predictions_.push_back(predictor_->MakeDistribution());
+  FS_THROW_UNLESS(clean_rows_.cols() == 2 * predictor_->observed(),
+                  "SPAN controller: observations hold ", clean_rows_.cols() / 2,
+                  " points per pedestrian, the predictor expects ", predictor_->observed());
+  while (predictions_.size() < static_cast<std::size_t>(n))
+    predictions_.push_back(predictor_->MakeDistribution());
   predictor_->PredictBatch(clean_rows_.topRows(n), &predictor_ws_, &predictions_);
   forecast_.FromPredictions(predictions_, n, steps_, options_.dt);
 }
 
-double SpanController::Cost(const UnicycleState& robot, const Eigen::Vector2d& goal, const Control& u,
-                            double* tau) const {
+double SpanController::Cost(const UnicycleState& robot, const Eigen::Vector2d& goal,
+                            const Control& u, double* tau) const {
   const double r = options_.robot_radius + options_.pedestrian_radius;
   UnicycleState s = robot;
   double t_collide = kInf;
@@ -176,8 +184,9 @@ double SpanController::Cost(const UnicycleState& robot, const Eigen::Vector2d& g
       t_collide = k * options_.dt;
   }
   if (tau) *tau = t_collide;
-  const double distance = !goal_field_.empty() && goal_field_.goal() == goal ? goal_field_.Distance(s.position())
-                                                                            : (s.position() - goal).norm();
+  const double distance = !goal_field_.empty() && goal_field_.goal() == goal
+                              ? goal_field_.Distance(s.position())
+                              : (s.position() - goal).norm();
   return std::isfinite(t_collide) ? distance + options_.kappa / t_collide : distance;
 }
 
@@ -188,14 +197,16 @@ ControlOutcome SpanController::Compute(const NavigationInput& input) {
     Prepare(input.goal);
     Problem problem;
     problem.cost = [&](const Control& u) { return Cost(input.robot, input.goal, u, nullptr); };
-    const double here = goal_field_.empty() || goal_field_.goal() != input.goal ? (input.robot.position() - input.goal).norm()
-                                                                                : goal_field_.Distance(input.robot.position());
-    // The weighted geodesic distance can drop faster than v_max near walls (up to 1 + margin_weight).
+    const double here = goal_field_.empty() || goal_field_.goal() != input.goal
+                            ? (input.robot.position() - input.goal).norm()
+                            : goal_field_.Distance(input.robot.position());
+    // The weighted geodesic distance can drop faster than v_max near walls (up to 1 +
+    // margin_weight).
     const double rate = goal_field_.empty() ? 1.0 : 1.0 + goal_field_.margin_weight();
     const double lower = std::max(0.0, here - rate * options_.limits.v_max * options_.horizon);
-    const auto [best, cost] = MinimiseFromStarts(options_, Starts(options_, input.robot, input.goal,
-                                                                  has_previous_ ? &previous_ : nullptr),
-                                                 options_.initialisations, lower, &problem);
+    const auto [best, cost] = MinimiseFromStarts(
+        options_, Starts(options_, input.robot, input.goal, has_previous_ ? &previous_ : nullptr),
+        options_.initialisations, lower, &problem);
     out.evaluations = problem.evaluations;
     if (!std::isfinite(cost)) {
       out.status = ControlStatus::kNoFinitePlan;
@@ -217,9 +228,12 @@ ControlOutcome SpanController::Compute(const NavigationInput& input) {
 
 // ---- reactive ---------------------------------------------------------------------------------
 
-ReactiveController::ReactiveController(const StaticCollisionField* field, SpanControllerOptions options,
-                                       double heading_weight)
-    : field_(field), options_(std::move(options)), heading_weight_(heading_weight), threshold_(0.5) {
+ReactiveController::ReactiveController(const StaticCollisionField* field,
+                                       SpanControllerOptions options, double heading_weight)
+    : field_(field),
+      options_(std::move(options)),
+      heading_weight_(heading_weight),
+      threshold_(0.5) {
   const std::string problems = options_.Problems();
   FS_THROW_UNLESS(problems.empty(), "reactive controller options: ", problems);
   threshold_ = ChanceThreshold(options_.epsilon);
@@ -227,26 +241,32 @@ ReactiveController::ReactiveController(const StaticCollisionField* field, SpanCo
   if (field_) map_ws_ = field_->MakeWorkspace();
 }
 
-double ReactiveController::Cost(const UnicycleState& robot, const Eigen::Vector2d& goal, const Control& u,
-                                bool* collides) const {
+double ReactiveController::Cost(const UnicycleState& robot, const Eigen::Vector2d& goal,
+                                const Control& u, bool* collides) const {
   const UnicycleState s = EulerStep(robot, u, options_.dt);
   const Eigen::Vector2d p = s.position();
-  const bool hit = (field_ && field_->Collides(p.x(), p.y(), options_.epsilon, &map_ws_)) ||
-                   forecast_.Collides(1, p, options_.robot_radius + options_.pedestrian_radius, threshold_);
+  const bool hit =
+      (field_ && field_->Collides(p.x(), p.y(), options_.epsilon, &map_ws_)) ||
+      forecast_.Collides(1, p, options_.robot_radius + options_.pedestrian_radius, threshold_);
   if (collides) *collides = hit;
   double bearing = std::atan2(goal.y() - p.y(), goal.x() - p.x());
   double distance = (p - goal).norm();
   if (!goal_field_.empty() && goal_field_.goal() == goal) {
     distance = goal_field_.Distance(p);
     const double h = 0.1;  // steepest descent of the geodesic distance by central differences
-    const double gx = goal_field_.Distance(p + Eigen::Vector2d(h, 0)) - goal_field_.Distance(p - Eigen::Vector2d(h, 0));
-    const double gy = goal_field_.Distance(p + Eigen::Vector2d(0, h)) - goal_field_.Distance(p - Eigen::Vector2d(0, h));
+    const double gx = goal_field_.Distance(p + Eigen::Vector2d(h, 0)) -
+                      goal_field_.Distance(p - Eigen::Vector2d(h, 0));
+    const double gy = goal_field_.Distance(p + Eigen::Vector2d(0, h)) -
+                      goal_field_.Distance(p - Eigen::Vector2d(0, h));
     if (std::hypot(gx, gy) > 1e-9) bearing = std::atan2(-gy, -gx);
   }
-  return distance + heading_weight_ * std::abs(WrapToPi(bearing - s.heading)) + (hit ? options_.kappa : 0.0);
+  return distance + heading_weight_ * std::abs(WrapToPi(bearing - s.heading)) +
+         (hit ? options_.kappa : 0.0);
 }
 
-void ReactiveController::Prepare(const Eigen::Vector2d& goal) { UpdateGoalField(options_, field_, goal, &goal_field_); }
+void ReactiveController::Prepare(const Eigen::Vector2d& goal) {
+  UpdateGoalField(options_, field_, goal, &goal_field_);
+}
 
 ControlOutcome ReactiveController::Compute(const NavigationInput& input) {
   ControlOutcome out;
@@ -257,8 +277,9 @@ ControlOutcome ReactiveController::Compute(const NavigationInput& input) {
     Prepare(input.goal);
     Problem problem;
     problem.cost = [&](const Control& u) { return Cost(input.robot, input.goal, u, nullptr); };
-    const auto [best, cost] = MinimiseFromStarts(options_, Starts(options_, input.robot, input.goal, nullptr),
-                                                 options_.initialisations, 0.0, &problem);
+    const auto [best, cost] =
+        MinimiseFromStarts(options_, Starts(options_, input.robot, input.goal, nullptr),
+                           options_.initialisations, 0.0, &problem);
     out.evaluations = problem.evaluations;
     bool hit = true;
     if (std::isfinite(cost)) Cost(input.robot, input.goal, best, &hit);

@@ -1,6 +1,6 @@
 #pragma once
-/// SPAN: stochastic process anticipatory navigation (thesis ch 5, eqs. costOpt-costOptc, Algorithm 1).
-/// Each cycle: predict every observed pedestrian's future as a stochastic process with the SPAN
+/// SPAN: stochastic process anticipatory navigation (thesis ch 5, eqs. costOpt-costOptc, Algorithm
+/// 1). Each cycle: predict every observed pedestrian's future as a stochastic process with the SPAN
 /// engine, then minimise over constant controls u = (v, omega) on the horizon T
 ///   J(u) = ||x(T) - g|| + kappa / tau(x_0, u, o, f_m)
 /// with COBYLA (NLopt) from several initialisations. tau is the first Euler step k dt at which the
@@ -29,10 +29,10 @@ struct SpanControllerOptions {
   double robot_radius = 0.4;       ///< m
   double pedestrian_radius = 0.4;  ///< m
   ControlLimits limits;
-  int initialisations = 12;        ///< COBYLA starts per cycle (the previous solution first)
-  int max_evaluations = 40;        ///< per start
-  double xtol = 1e-3;              ///< COBYLA tolerance on u
-  double initial_step = 0.4;       ///< COBYLA initial trust radius on u
+  int initialisations = 12;   ///< COBYLA starts per cycle (the previous solution first)
+  int max_evaluations = 40;   ///< per start
+  double xtol = 1e-3;         ///< COBYLA tolerance on u
+  double initial_step = 0.4;  ///< COBYLA initial trust radius on u
   /// With a static map: measure the goal term as the geodesic distance around obstacles
   /// (GoalDistanceField) instead of ||x(T) - g||; identical where the way to the goal is free.
   bool geodesic_goal = true;
@@ -43,14 +43,18 @@ struct SpanControllerOptions {
 class SpanController final : public NavigationController {
  public:
   /// @param predictor SPAN engine (null: no pedestrian prediction; pedestrians stand still).
-  /// @param field swept static map (null or empty: no static obstacles). Both must outlive the controller.
-  SpanController(const SpanPredictor* predictor, const StaticCollisionField* field, SpanControllerOptions options);
+  /// @param field swept static map (null or empty: no static obstacles). Both must outlive the
+  /// controller.
+  SpanController(const SpanPredictor* predictor, const StaticCollisionField* field,
+                 SpanControllerOptions options);
   std::string name() const override { return "span"; }
   void Prepare(const Eigen::Vector2d& goal) override;
   ControlOutcome Compute(const NavigationInput& input) override;
 
-  /// J(u) from `robot` towards `goal` against the current forecast; `tau` receives the TTC (inf: none).
-  double Cost(const UnicycleState& robot, const Eigen::Vector2d& goal, const Control& u, double* tau) const;
+  /// J(u) from `robot` towards `goal` against the current forecast; `tau` receives the TTC (inf:
+  /// none).
+  double Cost(const UnicycleState& robot, const Eigen::Vector2d& goal, const Control& u,
+              double* tau) const;
   /// Fills the forecast from observations (done by Compute; exposed for tests and drawing).
   void Forecast(const NavigationInput& input);
   const CrowdForecast& forecast() const { return forecast_; }
@@ -87,11 +91,13 @@ class SpanController final : public NavigationController {
 /// baselines differ only in anticipation).
 class ReactiveController final : public NavigationController {
  public:
-  ReactiveController(const StaticCollisionField* field, SpanControllerOptions options, double heading_weight = 0.5);
+  ReactiveController(const StaticCollisionField* field, SpanControllerOptions options,
+                     double heading_weight = 0.5);
   std::string name() const override { return "reactive"; }
   void Prepare(const Eigen::Vector2d& goal) override;
   ControlOutcome Compute(const NavigationInput& input) override;
-  double Cost(const UnicycleState& robot, const Eigen::Vector2d& goal, const Control& u, bool* collides) const;
+  double Cost(const UnicycleState& robot, const Eigen::Vector2d& goal, const Control& u,
+              bool* collides) const;
 
  private:
   const StaticCollisionField* field_;
@@ -107,6 +113,7 @@ class ReactiveController final : public NavigationController {
 /// Last finite position of each row of `past_rows` into `current` [2 x n]; rows without any finite
 /// point are dropped. @return number of pedestrians kept. Rows with some non-finite points are
 /// rewritten in `clean` as a pedestrian standing at its last finite point.
-int CleanObservations(const Eigen::MatrixXd& past_rows, Eigen::MatrixXd* clean, Eigen::Matrix2Xd* current);
+int CleanObservations(const Eigen::MatrixXd& past_rows, Eigen::MatrixXd* clean,
+                      Eigen::Matrix2Xd* current);
 
 }  // namespace foresight::nav

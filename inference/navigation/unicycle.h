@@ -9,8 +9,8 @@
 namespace foresight::nav {
 
 struct UnicycleState {
-  double x = 0, y = 0;   ///< position (m, world frame)
-  double heading = 0;    ///< rad, counter-clockwise from +x
+  double x = 0, y = 0;  ///< position (m, world frame)
+  double heading = 0;   ///< rad, counter-clockwise from +x
   Eigen::Vector2d position() const { return {x, y}; }
 };
 
@@ -29,7 +29,8 @@ struct ControlLimits {
 
 /// One Euler step: x += v cos(h) dt, y += v sin(h) dt, h += omega dt.
 inline UnicycleState EulerStep(const UnicycleState& s, const Control& u, double dt) {
-  return {s.x + u.v * std::cos(s.heading) * dt, s.y + u.v * std::sin(s.heading) * dt, s.heading + u.omega * dt};
+  return {s.x + u.v * std::cos(s.heading) * dt, s.y + u.v * std::sin(s.heading) * dt,
+          s.heading + u.omega * dt};
 }
 
 }  // namespace foresight::nav

@@ -29,7 +29,8 @@ MatrixNormal TrajectoryDistribution::Component(int r) const {
   return MatrixNormal{mean(r), chol_u(r), chol_v(r)};
 }
 
-void TrajectoryDistribution::Position(double t, int r, Eigen::Vector2d* mu, Eigen::Matrix2d* cov) const {
+void TrajectoryDistribution::Position(double t, int r, Eigen::Vector2d* mu,
+                                      Eigen::Matrix2d* cov) const {
   basis_.Evaluate(t, phi_);
   const auto k = static_cast<std::size_t>(r);
   *mu = origin_ + t * velocity_;
@@ -72,9 +73,9 @@ double TrajectoryDistribution::LogDensity(double t, const Eigen::Vector2d& x) co
   return mx + std::log(sum);
 }
 
-void TrajectoryDistribution::SamplePath(const Eigen::Ref<const Eigen::VectorXd>& times,
-                                        std::mt19937_64* rng,
-                                        Eigen::Ref<Eigen::Matrix<double, Eigen::Dynamic, 2>> path) const {
+void TrajectoryDistribution::SamplePath(
+    const Eigen::Ref<const Eigen::VectorXd>& times, std::mt19937_64* rng,
+    Eigen::Ref<Eigen::Matrix<double, Eigen::Dynamic, 2>> path) const {
   // Pick a component, then W = M + L_U Z L_V' with Z standard normal.
   std::uniform_real_distribution<double> u01(0.0, 1.0);
   std::normal_distribution<double> n01(0.0, 1.0);
@@ -89,7 +90,8 @@ void TrajectoryDistribution::SamplePath(const Eigen::Ref<const Eigen::VectorXd>&
   for (int i = 0; i < m; ++i) z_(i, 0) = n01(*rng), z_(i, 1) = n01(*rng);
   for (int i = 0; i < m; ++i) {
     double a0 = 0.0, a1 = 0.0;  // (L_U Z)_i
-    for (int j = 0; j <= i; ++j) a0 += chol_u_[k](i, j) * z_(j, 0), a1 += chol_u_[k](i, j) * z_(j, 1);
+    for (int j = 0; j <= i; ++j)
+      a0 += chol_u_[k](i, j) * z_(j, 0), a1 += chol_u_[k](i, j) * z_(j, 1);
     const Eigen::Matrix2d& l = chol_v_[k];
     w_(i, 0) = mean_[k](i, 0) + a0 * l(0, 0);
     w_(i, 1) = mean_[k](i, 1) + a0 * l(1, 0) + a1 * l(1, 1);
@@ -142,7 +144,8 @@ SpanPredictor SpanPredictor::Load(const std::string& path) {
     std::size_t start = 0;
     while (start <= joined.size()) {
       const auto comma = joined.find(',', start);
-      names.push_back(joined.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+      names.push_back(
+          joined.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
       if (comma == std::string::npos) break;
       start = comma + 1;
     }
@@ -157,15 +160,16 @@ SpanPredictor SpanPredictor::Load(const std::string& path) {
   return p;
 }
 
-void SpanPredictor::Save(const std::string& path, const SpanPredictorWeights& w, const std::string& config_yaml,
-                         std::int64_t seed) {
+void SpanPredictor::Save(const std::string& path, const SpanPredictorWeights& w,
+                         const std::string& config_yaml, std::int64_t seed) {
   h5::WriteAtomically(path, [&](h5::File* f) {
     Artifact::WriteHeader(f, kSpanModelType, config_yaml, seed);
     f->SetAttr("/model", "observed", static_cast<std::int64_t>(w.observed));
     f->SetAttr("/model", "predicted", static_cast<std::int64_t>(w.predicted));
     f->SetAttr("/model", "seconds_per_step", w.seconds_per_step);
     f->SetAttr("/model", "rotate_to_heading", static_cast<std::int64_t>(w.rotate_to_heading));
-    f->SetAttr("/model", "residual_to_constant_velocity", static_cast<std::int64_t>(w.residual_to_constant_velocity));
+    f->SetAttr("/model", "residual_to_constant_velocity",
+               static_cast<std::int64_t>(w.residual_to_constant_velocity));
     f->SetAttr("/model", "basis_size", static_cast<std::int64_t>(w.layout.basis));
     f->SetAttr("/model", "components", static_cast<std::int64_t>(w.layout.components));
     f->SetAttr("/model", "u_param", std::string(UParamName(w.layout.u_param)));
@@ -194,19 +198,21 @@ namespace {
 /// `out` must come from MakeDistribution() of a model with this layout (Predict writes in place).
 void CheckOutput(const TrajectoryDistribution& out, const HeadLayout& layout) {
   FS_THROW_UNLESS(out.components() == layout.components && out.basis_size() == layout.basis,
-                  "SpanPredictor: the output distribution has ", out.components(), " components over ",
-                  out.basis_size(), " basis functions, the model predicts ", layout.components, " over ",
-                  layout.basis, " (make it with MakeDistribution())");
+                  "SpanPredictor: the output distribution has ", out.components(),
+                  " components over ", out.basis_size(), " basis functions, the model predicts ",
+                  layout.components, " over ", layout.basis, " (make it with MakeDistribution())");
 }
 
-EgoFrame FrameOf(const Eigen::Ref<const Eigen::Matrix<double, Eigen::Dynamic, 2>>& past, bool rotate) {
-  return EgoFrame::FromPast(static_cast<int>(past.rows()),
-                            [&](int i) { return Eigen::Vector2d(past(i, 0), past(i, 1)); }, rotate);
+EgoFrame FrameOf(const Eigen::Ref<const Eigen::Matrix<double, Eigen::Dynamic, 2>>& past,
+                 bool rotate) {
+  return EgoFrame::FromPast(
+      static_cast<int>(past.rows()), [&](int i) { return Eigen::Vector2d(past(i, 0), past(i, 1)); },
+      rotate);
 }
 }  // namespace
 
-void SpanPredictor::RawOutput(const Eigen::Ref<const Eigen::Matrix<double, Eigen::Dynamic, 2>>& past,
-                              Workspace* ws) const {
+void SpanPredictor::RawOutput(
+    const Eigen::Ref<const Eigen::Matrix<double, Eigen::Dynamic, 2>>& past, Workspace* ws) const {
   FS_THROW_UNLESS(past.rows() == observed_, "SpanPredictor: expected ", observed_,
                   " observed points, got ", past.rows());
   FS_THROW_UNLESS(past.allFinite(), "SpanPredictor: observed track contains NaN or inf");
@@ -214,7 +220,8 @@ void SpanPredictor::RawOutput(const Eigen::Ref<const Eigen::Matrix<double, Eigen
   for (int i = 0; i < observed_; ++i) {
     const Eigen::Vector2d q = frame.ToEgo(Eigen::Vector2d(past(i, 0), past(i, 1)));
     ws->input[2 * i] = static_cast<float>((q.x() - input_mean_[2 * i]) / input_std_[2 * i]);
-    ws->input[2 * i + 1] = static_cast<float>((q.y() - input_mean_[2 * i + 1]) / input_std_[2 * i + 1]);
+    ws->input[2 * i + 1] =
+        static_cast<float>((q.y() - input_mean_[2 * i + 1]) / input_std_[2 * i + 1]);
   }
   const auto out = mlp_.Forward(ws->input, &ws->mlp);
   ws->raw = out.cast<double>();
@@ -234,15 +241,17 @@ void SpanPredictor::Predict(const Eigen::Ref<const Eigen::Matrix<double, Eigen::
   out->origin_ = frame.origin;
   if (residual_cv_) {
     const int p = observed_;
-    out->velocity_ = Eigen::Vector2d(past(p - 1, 0) - past(p - 2, 0), past(p - 1, 1) - past(p - 2, 1)) /
-                     seconds_per_step_;
+    out->velocity_ =
+        Eigen::Vector2d(past(p - 1, 0) - past(p - 2, 0), past(p - 1, 1) - past(p - 2, 1)) /
+        seconds_per_step_;
   } else {
     out->velocity_.setZero();
   }
   double max_logit = -INFINITY;
   for (int r = 0; r < R; ++r) max_logit = std::max(max_logit, z[layout_.AlphaOffset(r)]);
   double norm = 0.0;
-  for (int r = 0; r < R; ++r) norm += out->alpha_[r] = std::exp(z[layout_.AlphaOffset(r)] - max_logit);
+  for (int r = 0; r < R; ++r)
+    norm += out->alpha_[r] = std::exp(z[layout_.AlphaOffset(r)] - max_logit);
   out->alpha_ /= norm;
   for (int r = 0; r < R; ++r) {
     const auto k = static_cast<std::size_t>(r);

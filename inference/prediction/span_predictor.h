@@ -5,7 +5,8 @@
 ///   auto ws = model.MakeWorkspace();                           // one per caller
 ///   auto out = model.MakeDistribution();                        // preallocated output
 ///   model.Predict(past, &ws, &out);                             // no allocation
-///   out.Position(t, &mean, &cov);                                // o(t) ~ N(M' phi, (phi' U phi) V)
+///   out.Position(t, &mean, &cov);                                // o(t) ~ N(M' phi, (phi' U phi)
+///   V)
 
 #include <Eigen/Core>
 #include <random>
@@ -70,10 +71,11 @@ struct SpanPredictorWeights {
   double seconds_per_step = 0;      ///< s between points
   bool rotate_to_heading = true, residual_to_constant_velocity = false;
   HeadLayout layout;
-  Eigen::VectorXd basis_centres;    ///< [basis] s
+  Eigen::VectorXd basis_centres;  ///< [basis] s
   double basis_gamma = 0;
   Eigen::VectorXd input_mean, input_std;  ///< [2 observed]
-  std::vector<std::string> layer_names;   ///< module paths of the dense layers ("mlp.0", ..., "head")
+  std::vector<std::string>
+      layer_names;  ///< module paths of the dense layers ("mlp.0", ..., "head")
   Mlp mlp;
 };
 
@@ -89,8 +91,8 @@ class SpanPredictor {
   /// Loads an artifact written by `foresight export` (model_type "span_predictor").
   static SpanPredictor Load(const std::string& path);
   /// Writes an artifact that Load reads (to path.tmp, then renamed into place).
-  static void Save(const std::string& path, const SpanPredictorWeights& weights, const std::string& config_yaml,
-                   std::int64_t seed);
+  static void Save(const std::string& path, const SpanPredictorWeights& weights,
+                   const std::string& config_yaml, std::int64_t seed);
 
   int observed() const { return observed_; }
   double seconds_per_step() const { return seconds_per_step_; }

@@ -6,13 +6,15 @@
 
 namespace foresight {
 
-DirectionalNetImpl::DirectionalNetImpl(DirectionalVariant variant, int spatial_size, int components, int hidden,
-                                       double max_kappa)
+DirectionalNetImpl::DirectionalNetImpl(DirectionalVariant variant, int spatial_size, int components,
+                                       int hidden, double max_kappa)
     : variant_(variant), components_(components), hidden_(hidden), max_kappa_(max_kappa) {
   FS_THROW_UNLESS(std::isfinite(max_kappa) && max_kappa > std::exp(kDirectionalLogKappaMin),
                   "DirectionalNet: max_kappa ", max_kappa);
-  FS_THROW_UNLESS(spatial_size >= 1 && components >= 1 && (variant == DirectionalVariant::kSpatial || hidden >= 1),
-                  "DirectionalNet: spatial_size ", spatial_size, ", components ", components, ", hidden ", hidden);
+  FS_THROW_UNLESS(spatial_size >= 1 && components >= 1 &&
+                      (variant == DirectionalVariant::kSpatial || hidden >= 1),
+                  "DirectionalNet: spatial_size ", spatial_size, ", components ", components,
+                  ", hidden ", hidden);
   int width = spatial_size;
   if (variant == DirectionalVariant::kSpatiotemporal) {
     // PyTorch's LSTM parameters and initialisation: U(-1/sqrt(H), 1/sqrt(H)).
@@ -48,7 +50,8 @@ torch::Tensor DirectionalNetImpl::Recur(const torch::Tensor& proj, const torch::
     auto gates = proj * phi_t.narrow(1, k, 1) + bias;
     if (k > 0) gates = gates + torch::matmul(h, weight_hh_.t());  // h = 0 before the first step
     const auto g = gates.chunk(4, 1);
-    const auto i = torch::sigmoid(g[0]), f = torch::sigmoid(g[1]), cand = torch::tanh(g[2]), o = torch::sigmoid(g[3]);
+    const auto i = torch::sigmoid(g[0]), f = torch::sigmoid(g[1]), cand = torch::tanh(g[2]),
+               o = torch::sigmoid(g[3]);
     c = k > 0 ? f * c + i * cand : i * cand;
     h = o * torch::tanh(c);
   }
@@ -60,12 +63,17 @@ torch::Tensor DirectionalNetImpl::forward(const torch::Tensor& phi_s, const torc
   return Heads(Recur(torch::matmul(phi_s, weight_ih_.t()), phi_t));
 }
 
-torch::Tensor DirectionalNetImpl::forward_sparse(const torch::Tensor& index, const torch::Tensor& value,
-                                                 const torch::Tensor& offsets, const torch::Tensor& phi_t) {
+torch::Tensor DirectionalNetImpl::forward_sparse(const torch::Tensor& index,
+                                                 const torch::Tensor& value,
+                                                 const torch::Tensor& offsets,
+                                                 const torch::Tensor& phi_t) {
   namespace F = torch::nn::functional;
   auto bag = [&](const torch::Tensor& weight_t) {  // sum_j value_j weight_t[index_j] per sample
     return F::embedding_bag(index, weight_t,
-                            F::EmbeddingBagFuncOptions().offsets(offsets).mode(torch::kSum).per_sample_weights(value)
+                            F::EmbeddingBagFuncOptions()
+                                .offsets(offsets)
+                                .mode(torch::kSum)
+                                .per_sample_weights(value)
                                 .include_last_offset(true));
   };
   if (variant_ == DirectionalVariant::kSpatial) {
@@ -79,30 +87,38 @@ VonMisesMixtureTensors DecodeDirectionalHead(const torch::Tensor& raw, int R, do
   VonMisesMixtureTensors p;
   p.log_alpha = torch::log_softmax(raw.narrow(1, 0, R), 1);
   p.mu = raw.narrow(1, R, R);
-  p.kappa = torch::exp(torch::clamp(raw.narrow(1, 2 * R, R), kDirectionalLogKappaMin, std::log(max_kappa)));
+  p.kappa = torch::exp(
+      torch::clamp(raw.narrow(1, 2 * R, R), kDirectionalLogKappaMin, std::log(max_kappa)));
   return p;
 }
 
-torch::Tensor LogBesselI0(const torch::Tensor& kappa) { return torch::log(torch::special::i0e(kappa)) + kappa; }
+torch::Tensor LogBesselI0(const torch::Tensor& kappa) {
+  return torch::log(torch::special::i0e(kappa)) + kappa;
+}
 
 torch::Tensor VonMisesMixtureNll(const VonMisesMixtureTensors& p, const torch::Tensor& theta) {
-  const auto log_vm = p.kappa * torch::cos(theta.unsqueeze(1) - p.mu) - std::log(2.0 * M_PI) - LogBesselI0(p.kappa);
+  const auto log_vm =
+      p.kappa * torch::cos(theta.unsqueeze(1) - p.mu) - std::log(2.0 * M_PI) - LogBesselI0(p.kappa);
   return -torch::logsumexp(p.log_alpha + log_vm, 1);
 }
 
 torch::Tensor HeadPenalty(DirectionalNetImpl& net, const DirectionalPenalty& c) {
-  return c.lambda_alpha * net.alpha_head()->weight.square().sum() + c.lambda_mu * net.mu_head()->weight.square().sum() +
+  return c.lambda_alpha * net.alpha_head()->weight.square().sum() +
+         c.lambda_mu * net.mu_head()->weight.square().sum() +
          c.lambda_kappa * net.kappa_head()->weight.square().sum();
 }
 
-torch::Tensor DirectionalLossFromRaw(DirectionalNetImpl& net, const torch::Tensor& raw, const torch::Tensor& theta,
+torch::Tensor DirectionalLossFromRaw(DirectionalNetImpl& net, const torch::Tensor& raw,
+                                     const torch::Tensor& theta,
                                      const DirectionalPenalty& penalty) {
-  return VonMisesMixtureNll(DecodeDirectionalHead(raw, net.components(), net.max_kappa()), theta).mean() +
+  return VonMisesMixtureNll(DecodeDirectionalHead(raw, net.components(), net.max_kappa()), theta)
+             .mean() +
          HeadPenalty(net, penalty);
 }
 
-torch::Tensor DirectionalLoss(DirectionalNetImpl& net, const torch::Tensor& phi_s, const torch::Tensor& phi_t,
-                              const torch::Tensor& theta, const DirectionalPenalty& penalty) {
+torch::Tensor DirectionalLoss(DirectionalNetImpl& net, const torch::Tensor& phi_s,
+                              const torch::Tensor& phi_t, const torch::Tensor& theta,
+                              const DirectionalPenalty& penalty) {
   return DirectionalLossFromRaw(net, net.forward(phi_s, phi_t), theta, penalty);
 }
 

@@ -27,8 +27,8 @@ class DirectionalNetImpl : public torch::nn::Module {
   torch::Tensor forward(const torch::Tensor& phi_s, const torch::Tensor& phi_t);
   /// The same from sparse spatial features (DirectionalFeatures::SpatialSparseBatch): `index` and
   /// `value` [nnz], `offsets` [B + 1] (int64, last = nnz).
-  torch::Tensor forward_sparse(const torch::Tensor& index, const torch::Tensor& value, const torch::Tensor& offsets,
-                               const torch::Tensor& phi_t);
+  torch::Tensor forward_sparse(const torch::Tensor& index, const torch::Tensor& value,
+                               const torch::Tensor& offsets, const torch::Tensor& phi_t);
 
   DirectionalVariant variant() const { return variant_; }
   int components() const { return components_; }
@@ -70,13 +70,15 @@ torch::Tensor VonMisesMixtureNll(const VonMisesMixtureTensors& p, const torch::T
 struct DirectionalPenalty {
   double lambda_alpha = 0.001, lambda_mu = 0.0, lambda_kappa = 0.001;
 };
-/// lambda_a ||W_a||^2 + lambda_m ||W_m||^2 + lambda_k ||W_k||^2 (added to the loss, spec/errata.md).
+/// lambda_a ||W_a||^2 + lambda_m ||W_m||^2 + lambda_k ||W_k||^2 (added to the loss,
+/// spec/errata.md).
 torch::Tensor HeadPenalty(DirectionalNetImpl& net, const DirectionalPenalty& penalty);
 /// Thesis L_reg = mean NLL + HeadPenalty (the penalty added; spec/errata.md ch 4).
-torch::Tensor DirectionalLoss(DirectionalNetImpl& net, const torch::Tensor& phi_s, const torch::Tensor& phi_t,
-                              const torch::Tensor& theta, const DirectionalPenalty& penalty);
+torch::Tensor DirectionalLoss(DirectionalNetImpl& net, const torch::Tensor& phi_s,
+                              const torch::Tensor& phi_t, const torch::Tensor& theta,
+                              const DirectionalPenalty& penalty);
 /// The same from raw head outputs [B, 3R] of `net`.
-torch::Tensor DirectionalLossFromRaw(DirectionalNetImpl& net, const torch::Tensor& raw, const torch::Tensor& theta,
-                                     const DirectionalPenalty& penalty);
+torch::Tensor DirectionalLossFromRaw(DirectionalNetImpl& net, const torch::Tensor& raw,
+                                     const torch::Tensor& theta, const DirectionalPenalty& penalty);
 
 }  // namespace foresight

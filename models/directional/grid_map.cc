@@ -43,14 +43,16 @@ double MixtureLogLikelihood(const std::vector<double>& theta, const Mixture& m,
     ll += top + std::log(sum);
     if (resp)
       for (std::size_t k = 0; k < r; ++k)
-        (*resp)(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(k)) = std::exp(lp[k] - top) / sum;
+        (*resp)(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(k)) =
+            std::exp(lp[k] - top) / sum;
   }
   return ll;
 }
 
 /// Spherical k-means of the headings into at most `r` clusters (k-means++ seeding); empty
 /// clusters are dropped. Returns each cluster's share and ML von Mises as the initial mixture.
-Mixture KMeansOnCircle(const std::vector<double>& theta, int r, double max_kappa, std::mt19937_64* rng) {
+Mixture KMeansOnCircle(const std::vector<double>& theta, int r, double max_kappa,
+                       std::mt19937_64* rng) {
   const std::size_t n = theta.size();
   std::vector<double> centre;
   centre.push_back(theta[static_cast<std::size_t>((*rng)() % n)]);
@@ -99,7 +101,8 @@ Mixture KMeansOnCircle(const std::vector<double>& theta, int r, double max_kappa
       count[k] += 1;
     }
     for (std::size_t k = 0; k < centre.size(); ++k)
-      if (count[k] > 0 && std::hypot(c_sum[k], s_sum[k]) > 0) centre[k] = std::atan2(s_sum[k], c_sum[k]);
+      if (count[k] > 0 && std::hypot(c_sum[k], s_sum[k]) > 0)
+        centre[k] = std::atan2(s_sum[k], c_sum[k]);
     if (!changed) break;
   }
   Mixture m;
@@ -107,7 +110,8 @@ Mixture KMeansOnCircle(const std::vector<double>& theta, int r, double max_kappa
     if (count[k] == 0) continue;
     m.alpha.push_back(count[k] / static_cast<double>(n));
     m.mu.push_back(WrapAngle(centre[k]));
-    m.kappa.push_back(std::min(max_kappa, InverseA1(std::min(1.0, std::hypot(c_sum[k], s_sum[k]) / count[k]))));
+    m.kappa.push_back(
+        std::min(max_kappa, InverseA1(std::min(1.0, std::hypot(c_sum[k], s_sum[k]) / count[k]))));
   }
   return m;
 }
@@ -117,8 +121,8 @@ Mixture KMeansOnCircle(const std::vector<double>& theta, int r, double max_kappa
 /// eps-connected components of core points plus the border points they reach first). Returns
 /// the initial mixture of the `max_clusters` largest clusters (alphas renormalised); empty when
 /// every point is noise.
-Mixture DbscanOnCircle(const std::vector<double>& theta, double eps, int min_samples, int max_clusters,
-                       double max_kappa) {
+Mixture DbscanOnCircle(const std::vector<double>& theta, double eps, int min_samples,
+                       int max_clusters, double max_kappa) {
   const std::size_t n = theta.size();
   std::vector<double> c(n), s(n);
   for (std::size_t i = 0; i < n; ++i) c[i] = std::cos(theta[i]), s[i] = std::sin(theta[i]);
@@ -158,15 +162,18 @@ Mixture DbscanOnCircle(const std::vector<double>& theta, double eps, int min_sam
     Cluster& k = sums[static_cast<std::size_t>(label[i])];
     k.c += c[i], k.s += s[i], k.count += 1;
   }
-  std::stable_sort(sums.begin(), sums.end(), [](const Cluster& a, const Cluster& b) { return a.count > b.count; });
-  if (static_cast<int>(sums.size()) > max_clusters) sums.resize(static_cast<std::size_t>(max_clusters));
+  std::stable_sort(sums.begin(), sums.end(),
+                   [](const Cluster& a, const Cluster& b) { return a.count > b.count; });
+  if (static_cast<int>(sums.size()) > max_clusters)
+    sums.resize(static_cast<std::size_t>(max_clusters));
   double total = 0;
   for (const Cluster& k : sums) total += k.count;
   Mixture m;
   for (const Cluster& k : sums) {
     m.alpha.push_back(k.count / total);
     m.mu.push_back(WrapAngle(std::atan2(k.s, k.c)));
-    m.kappa.push_back(std::min(max_kappa, InverseA1(std::min(1.0, std::hypot(k.c, k.s) / k.count))));
+    m.kappa.push_back(
+        std::min(max_kappa, InverseA1(std::min(1.0, std::hypot(k.c, k.s) / k.count))));
   }
   return m;
 }
@@ -197,8 +204,8 @@ double RefineByEm(const std::vector<double>& theta, int iterations, double max_k
 }
 
 /// Fits one cell's row of `cells` from its headings (see the header for the rules).
-void FitCell(const std::vector<double>& theta, const DirectionalGridConfig& c, std::uint64_t cell_seed,
-             VonMisesMixtureBatch* cells, Eigen::Index row) {
+void FitCell(const std::vector<double>& theta, const DirectionalGridConfig& c,
+             std::uint64_t cell_seed, VonMisesMixtureBatch* cells, Eigen::Index row) {
   cells->alpha.row(row).setZero();
   cells->mu.row(row).setZero();
   cells->kappa.row(row).setZero();
@@ -216,7 +223,8 @@ void FitCell(const std::vector<double>& theta, const DirectionalGridConfig& c, s
     return;
   }
   if (c.mixture_init == GridMixtureInit::kDbscan) {
-    Mixture m = DbscanOnCircle(theta, c.dbscan_eps, c.dbscan_min_samples, c.components, c.max_kappa);
+    Mixture m =
+        DbscanOnCircle(theta, c.dbscan_eps, c.dbscan_min_samples, c.components, c.max_kappa);
     if (m.size() == 0) {  // all noise: one component from every heading
       const VonMisesFit fit =
           FitVonMises(Eigen::Map<const Eigen::VectorXd>(theta.data(), n), Eigen::VectorXd::Ones(n));
@@ -241,7 +249,8 @@ void FitCell(const std::vector<double>& theta, const DirectionalGridConfig& c, s
     std::mt19937_64 rng(cell_seed ^ (0x9E3779B97F4A7C15ull * static_cast<std::uint64_t>(r)));
     Mixture m = KMeansOnCircle(theta, r, c.max_kappa, &rng);
     const double ll = RefineByEm(theta, c.em_iterations, c.max_kappa, &m);
-    const double bic = -2.0 * ll + (3.0 * static_cast<double>(m.size()) - 1.0) * std::log(static_cast<double>(n));
+    const double bic =
+        -2.0 * ll + (3.0 * static_cast<double>(m.size()) - 1.0) * std::log(static_cast<double>(n));
     if (bic < best_bic) best_bic = bic, best = std::move(m);
   }
   for (std::size_t k = 0; k < best.size(); ++k) {
@@ -254,23 +263,27 @@ void FitCell(const std::vector<double>& theta, const DirectionalGridConfig& c, s
 
 }  // namespace
 
-DirectionalGridMap DirectionalGridMap::Fit(const DirectionalSamples& train, const DirectionalGridConfig& config) {
+DirectionalGridMap DirectionalGridMap::Fit(const DirectionalSamples& train,
+                                           const DirectionalGridConfig& config) {
   const auto& c = config;
-  FS_THROW_UNLESS(c.cells_x >= 1 && c.cells_y >= 1 &&
-                      static_cast<double>(c.cells_x) * c.cells_y <= 16777216.0,
-                  "directional grid map: cells_x ", c.cells_x, " and cells_y ", c.cells_y,
-                  " must be >= 1 (at most 2^24 cells)");
+  FS_THROW_UNLESS(
+      c.cells_x >= 1 && c.cells_y >= 1 && static_cast<double>(c.cells_x) * c.cells_y <= 16777216.0,
+      "directional grid map: cells_x ", c.cells_x, " and cells_y ", c.cells_y,
+      " must be >= 1 (at most 2^24 cells)");
   FS_THROW_UNLESS(c.extent.allFinite() && c.extent[1] > c.extent[0] && c.extent[3] > c.extent[2],
-                  "directional grid map: extent (x_min, x_max, y_min, y_max) = (", c.extent[0], ", ",
-                  c.extent[1], ", ", c.extent[2], ", ", c.extent[3], ") is empty or not finite");
+                  "directional grid map: extent (x_min, x_max, y_min, y_max) = (", c.extent[0],
+                  ", ", c.extent[1], ", ", c.extent[2], ", ", c.extent[3],
+                  ") is empty or not finite");
   FS_THROW_UNLESS(c.components >= 1 && c.components <= 64, "directional grid map: components ",
                   c.components, " must be in [1, 64]");
-  FS_THROW_UNLESS(c.length_scale > 0 && std::isfinite(c.length_scale), "directional grid map: length_scale ",
-                  c.length_scale, " must be positive");
-  FS_THROW_UNLESS(c.max_kappa > 0 && c.em_iterations >= 0, "directional grid map: max_kappa ", c.max_kappa,
-                  " must be positive and em_iterations ", c.em_iterations, " non-negative");
-  FS_THROW_UNLESS(c.dbscan_eps > 0 && c.dbscan_min_samples >= 1, "directional grid map: dbscan_eps ",
-                  c.dbscan_eps, " must be positive and dbscan_min_samples ", c.dbscan_min_samples, " >= 1");
+  FS_THROW_UNLESS(c.length_scale > 0 && std::isfinite(c.length_scale),
+                  "directional grid map: length_scale ", c.length_scale, " must be positive");
+  FS_THROW_UNLESS(c.max_kappa > 0 && c.em_iterations >= 0, "directional grid map: max_kappa ",
+                  c.max_kappa, " must be positive and em_iterations ", c.em_iterations,
+                  " non-negative");
+  FS_THROW_UNLESS(c.dbscan_eps > 0 && c.dbscan_min_samples >= 1,
+                  "directional grid map: dbscan_eps ", c.dbscan_eps,
+                  " must be positive and dbscan_min_samples ", c.dbscan_min_samples, " >= 1");
   train.Validate("directional grid map training data");
 
   DirectionalGridMap map;
@@ -305,12 +318,15 @@ DirectionalGridMap DirectionalGridMap::Fit(const DirectionalSamples& train, cons
       continue;
     }
     const int ix = home % c.cells_x, iy = home / c.cells_x;
-    for (int jy = std::max(0, iy - map.window_y_); jy <= std::min(c.cells_y - 1, iy + map.window_y_); ++jy) {
-      for (int jx = std::max(0, ix - map.window_x_); jx <= std::min(c.cells_x - 1, ix + map.window_x_); ++jx) {
+    for (int jy = std::max(0, iy - map.window_y_);
+         jy <= std::min(c.cells_y - 1, iy + map.window_y_); ++jy) {
+      for (int jx = std::max(0, ix - map.window_x_);
+           jx <= std::min(c.cells_x - 1, ix + map.window_x_); ++jx) {
         const int cell = jy * c.cells_x + jx;
         const Eigen::Vector2d centre = map.CellCentre(cell);
         const double dx = px - centre.x(), dy = py - centre.y();
-        if (dx * dx + dy * dy <= r2) theta[static_cast<std::size_t>(cell)].push_back(train.theta[i]);
+        if (dx * dx + dy * dy <= r2)
+          theta[static_cast<std::size_t>(cell)].push_back(train.theta[i]);
       }
     }
   }
@@ -319,17 +335,19 @@ DirectionalGridMap DirectionalGridMap::Fit(const DirectionalSamples& train, cons
     const auto& t = theta[static_cast<std::size_t>(cell)];
     map.counts_[static_cast<std::size_t>(cell)] = static_cast<int>(t.size());
     empty += t.empty();
-    FitCell(t, c, c.seed ^ (0xD1B54A32D192ED03ull * (static_cast<std::uint64_t>(cell) + 1)), &map.cells_, cell);
+    FitCell(t, c, c.seed ^ (0xD1B54A32D192ED03ull * (static_cast<std::uint64_t>(cell) + 1)),
+            &map.cells_, cell);
   }
   log::Debug("directional grid map: ", c.cells_x, " x ", c.cells_y, " cells (", empty, " empty), ",
-             c.kind == GridDirectionalKind::kUnimodal ? "UM" : "MM", c.dense ? " dense" : "", " from ",
-             train.size(), " samples");
+             c.kind == GridDirectionalKind::kUnimodal ? "UM" : "MM", c.dense ? " dense" : "",
+             " from ", train.size(), " samples");
   return map;
 }
 
 int DirectionalGridMap::CellIndex(double x, double y) const {
   const auto& c = config_;
-  const double fx = std::floor((x - c.extent[0]) / cell_w_), fy = std::floor((y - c.extent[2]) / cell_h_);
+  const double fx = std::floor((x - c.extent[0]) / cell_w_),
+               fy = std::floor((y - c.extent[2]) / cell_h_);
   const int ix = static_cast<int>(std::clamp(fx, 0.0, static_cast<double>(c.cells_x - 1)));
   const int iy = static_cast<int>(std::clamp(fy, 0.0, static_cast<double>(c.cells_y - 1)));
   return iy * c.cells_x + ix;
@@ -340,19 +358,22 @@ Eigen::Vector2d DirectionalGridMap::CellCentre(int cell) const {
   return {config_.extent[0] + (ix + 0.5) * cell_w_, config_.extent[2] + (iy + 0.5) * cell_h_};
 }
 
-void DirectionalGridMap::Query(const Eigen::Ref<const Eigen::VectorXd>& x, const Eigen::Ref<const Eigen::VectorXd>& y,
+void DirectionalGridMap::Query(const Eigen::Ref<const Eigen::VectorXd>& x,
+                               const Eigen::Ref<const Eigen::VectorXd>& y,
                                VonMisesMixtureBatch* out) const {
-  FS_THROW_UNLESS(x.size() == y.size(), "directional grid map query: x [", x.size(), "] and y [", y.size(),
-                  "] differ in size");
+  FS_THROW_UNLESS(x.size() == y.size(), "directional grid map query: x [", x.size(), "] and y [",
+                  y.size(), "] differ in size");
   const Eigen::Index n = x.size();
   const int r = cell_components();
   if (out->alpha.rows() != n || out->alpha.cols() != output_components() || out->mu.rows() != n ||
-      out->mu.cols() != output_components() || out->kappa.rows() != n || out->kappa.cols() != output_components())
+      out->mu.cols() != output_components() || out->kappa.rows() != n ||
+      out->kappa.cols() != output_components())
     out->Resize(n, output_components());
   const auto& c = config_;
   for (Eigen::Index i = 0; i < n; ++i) {
-    FS_THROW_UNLESS(std::isfinite(x[i]) && std::isfinite(y[i]), "directional grid map query: point ", i, " (",
-                    x[i], ", ", y[i], ") is not finite");
+    FS_THROW_UNLESS(std::isfinite(x[i]) && std::isfinite(y[i]),
+                    "directional grid map query: point ", i, " (", x[i], ", ", y[i],
+                    ") is not finite");
     const int home = CellIndex(x[i], y[i]);
     if (!c.dense) {
       out->alpha.row(i) = cells_.alpha.row(home);
@@ -379,7 +400,8 @@ void DirectionalGridMap::Query(const Eigen::Ref<const Eigen::VectorXd>& x, const
       for (int jx = x0; jx <= x1; ++jx) {
         const int cell = jy * c.cells_x + jx;
         const double d2 = dist2(cell);
-        if (counts_[static_cast<std::size_t>(cell)] > 0 && d2 <= radius_ * radius_) d2_min = std::min(d2_min, d2);
+        if (counts_[static_cast<std::size_t>(cell)] > 0 && d2 <= radius_ * radius_)
+          d2_min = std::min(d2_min, d2);
       }
     if (!std::isfinite(d2_min)) {
       out->alpha(i, 0) = 1.0;  // no data in reach: uniform

@@ -11,7 +11,8 @@
 ///
 /// Fitting one cell from its headings theta_1..n (n = 0: uniform, alpha = (1, 0, ..), kappa = 0):
 /// - UM: (mu, kappa) = FitVonMises (maximum likelihood), kappa capped at max_kappa.
-/// - MM: an initial mixture from clustering, each cluster's share and ML von Mises, then EM (at most
+/// - MM: an initial mixture from clustering, each cluster's share and ML von Mises, then EM (at
+/// most
 ///   em_iterations, until the log-likelihood gains less than 1e-9 n); components whose
 ///   responsibilities vanish are dropped. The clustering (`mixture_init`):
 ///   * kDbscan (default, as the reference code of Senanayake and Ramos, see the dataset README):
@@ -58,20 +59,21 @@ struct DirectionalGridConfig {
   std::uint64_t seed = 0;     ///< clustering initialisation
   double max_kappa = 100.0;   ///< cap on every fitted concentration (see above)
   GridMixtureInit mixture_init = GridMixtureInit::kDbscan;  ///< MM initialisation
-  double dbscan_eps = 0.5;      ///< MM kDbscan: neighbourhood radius, chord between unit vectors
-  int dbscan_min_samples = 5;   ///< MM kDbscan: neighbours (self included) of a core point
-  int em_iterations = 20;       ///< MM: EM iterations (the reference code's max_iter)
+  double dbscan_eps = 0.5;     ///< MM kDbscan: neighbourhood radius, chord between unit vectors
+  int dbscan_min_samples = 5;  ///< MM kDbscan: neighbours (self included) of a core point
+  int em_iterations = 20;      ///< MM: EM iterations (the reference code's max_iter)
 };
 
 class DirectionalGridMap {
  public:
   /// Fits every cell; cells without data answer the uniform distribution on the circle (kappa 0).
-  static DirectionalGridMap Fit(const DirectionalSamples& train, const DirectionalGridConfig& config);
+  static DirectionalGridMap Fit(const DirectionalSamples& train,
+                                const DirectionalGridConfig& config);
   const DirectionalGridConfig& config() const { return config_; }
-  /// Mixture at each (x, y) [n]: fills `out` (Resize'd to n x components; unused components alpha 0).
-  /// Queries outside the extent use the nearest cell.
-  /// The number of columns is output_components(). Does not allocate when `out` already has that
-  /// shape. Sizes of x and y differ or a non-finite coordinate: Error.
+  /// Mixture at each (x, y) [n]: fills `out` (Resize'd to n x components; unused components alpha
+  /// 0). Queries outside the extent use the nearest cell. The number of columns is
+  /// output_components(). Does not allocate when `out` already has that shape. Sizes of x and y
+  /// differ or a non-finite coordinate: Error.
   void Query(const Eigen::Ref<const Eigen::VectorXd>& x, const Eigen::Ref<const Eigen::VectorXd>& y,
              VonMisesMixtureBatch* out) const;
 

@@ -1,7 +1,6 @@
 #include "models/occupancy/bhm.h"
 
 #include <Eigen/Cholesky>
-
 #include <cmath>
 
 #include "core/error.h"
@@ -32,7 +31,8 @@ void BhmLearner::Bounds() {
   }
 }
 
-void BhmLearner::Update(const Eigen::Ref<const Eigen::Matrix2Xd>& xy, const std::uint8_t* occupied) {
+void BhmLearner::Update(const Eigen::Ref<const Eigen::Matrix2Xd>& xy,
+                        const std::uint8_t* occupied) {
   const auto n = static_cast<std::size_t>(xy.cols());
   if (n == 0) return;
   features_.Compute(grid_, xy);
@@ -56,11 +56,13 @@ void BhmLearner::Update(const Eigen::Ref<const Eigen::Matrix2Xd>& xy, const std:
       const double target = occupied[p] ? 0.5 : -0.5;
       for (int i = 0; i < f.count[p]; ++i) {
         info[idx[i]] += target * phi[i];
-        for (int j = 0; j < f.count[p]; ++j) precision_(idx[i], idx[j]) += two_lambda * phi[i] * phi[j];
+        for (int j = 0; j < f.count[p]; ++j)
+          precision_(idx[i], idx[j]) += two_lambda * phi[i] * phi[j];
       }
     }
     const Eigen::LLT<Eigen::MatrixXd> llt(precision_);
-    FS_THROW_UNLESS(llt.info() == Eigen::Success, "full BHM: posterior precision is not positive definite");
+    FS_THROW_UNLESS(llt.info() == Eigen::Success,
+                    "full BHM: posterior precision is not positive definite");
     mean_ = llt.solve(info);
     covariance_ = llt.solve(Eigen::MatrixXd::Identity(grid_.size(), grid_.size()));
   }
@@ -70,7 +72,8 @@ HingeMap BhmLearner::ToMap() const {
   HingeWeights w;
   w.mean = mean_;
   w.covariance = covariance_;
-  return HingeMap(HingeMapKind::kBhm, grid_, std::move(w), config_.prior_mean, config_.prior_variance);
+  return HingeMap(HingeMapKind::kBhm, grid_, std::move(w), config_.prior_mean,
+                  config_.prior_variance);
 }
 
 }  // namespace foresight

@@ -36,8 +36,9 @@ FastBhmLearner::FastBhmLearner(HingeGrid grid, const FastBhmConfig& config)
 
 FastBhmLearner::FastBhmLearner(const HingeMap& start, const FastBhmConfig& config)
     : FastBhmLearner(start.grid(), config) {
-  FS_THROW_UNLESS(start.kind() == HingeMapKind::kFastBhm, "Fast-BHM training can only continue from a ",
-                  kFastBhmType, " map, not ", start.model_type());
+  FS_THROW_UNLESS(start.kind() == HingeMapKind::kFastBhm,
+                  "Fast-BHM training can only continue from a ", kFastBhmType, " map, not ",
+                  start.model_type());
   mean_ = start.weights().mean;
   variance_ = start.weights().variance;
 }
@@ -59,7 +60,8 @@ void FastBhmLearner::BoundsFromPosterior(const SparseFeatures& f) {
   }
 }
 
-void FastBhmLearner::Update(const Eigen::Ref<const Eigen::Matrix2Xd>& xy, const std::uint8_t* occupied) {
+void FastBhmLearner::Update(const Eigen::Ref<const Eigen::Matrix2Xd>& xy,
+                            const std::uint8_t* occupied) {
   const auto n = static_cast<std::size_t>(xy.cols());
   if (n == 0) return;
   features_.Compute(grid_, xy);
@@ -115,7 +117,8 @@ HingeMap FastBhmLearner::ToMap() const {
   HingeWeights w;
   w.mean = mean_;
   w.variance = variance_;
-  return HingeMap(HingeMapKind::kFastBhm, grid_, std::move(w), config_.prior_mean, config_.prior_variance);
+  return HingeMap(HingeMapKind::kFastBhm, grid_, std::move(w), config_.prior_mean,
+                  config_.prior_variance);
 }
 
 }  // namespace foresight

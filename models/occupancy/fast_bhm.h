@@ -13,7 +13,6 @@
 /// Cost per scan is linear in its points times the features within the cut-off radius.
 
 #include <Eigen/Core>
-
 #include <cstdint>
 #include <vector>
 
@@ -43,13 +42,17 @@ struct FastBhmConfig {
   template <class A>
   void Serialize(A* a) {
     a->Visit("prior_mean", &prior_mean, config::Range::Any(), "mean of the weight prior");
-    a->Visit("prior_variance", &prior_variance, config::Range::Positive(), "variance of the weight prior");
-    a->Visit("em_iterations", &em_iterations, config::Range::Closed(1, 100), "EM iterations per scan");
-    a->VisitEnum("bound_init", &bound_init,
-                 config::EnumNames<BoundInit>{{BoundInit::kPrior, "prior"}, {BoundInit::kOne, "one"}},
-                 "starting variational parameter z of each scan");
+    a->Visit("prior_variance", &prior_variance, config::Range::Positive(),
+             "variance of the weight prior");
+    a->Visit("em_iterations", &em_iterations, config::Range::Closed(1, 100),
+             "EM iterations per scan");
+    a->VisitEnum(
+        "bound_init", &bound_init,
+        config::EnumNames<BoundInit>{{BoundInit::kPrior, "prior"}, {BoundInit::kOne, "one"}},
+        "starting variational parameter z of each scan");
     a->VisitEnum("m_step", &m_step,
-                 config::EnumNames<MStepForm>{{MStepForm::kExact, "exact"}, {MStepForm::kPrinted, "printed"}},
+                 config::EnumNames<MStepForm>{{MStepForm::kExact, "exact"},
+                                              {MStepForm::kPrinted, "printed"}},
                  "M-step form (exact expectation, or as printed in the thesis)");
   }
 };
@@ -59,10 +62,10 @@ double JaakkolaLambda(double z);
 
 /// Sparse features of a batch of points, computed once and reused by the EM iterations.
 struct SparseFeatures {
-  int stride = 0;                 ///< max features per point
-  std::vector<int> count;         ///< [n]
-  std::vector<int> index;         ///< [n * stride]
-  std::vector<double> value;      ///< [n * stride]
+  int stride = 0;             ///< max features per point
+  std::vector<int> count;     ///< [n]
+  std::vector<int> index;     ///< [n * stride]
+  std::vector<double> value;  ///< [n * stride]
   void Compute(const HingeGrid& grid, const Eigen::Ref<const Eigen::Matrix2Xd>& xy);
 };
 

@@ -12,7 +12,8 @@ namespace {
 double Logit(double p) { return std::log(p / (1.0 - p)); }
 }  // namespace
 
-void TraverseCells(double x0, double y0, double x1, double y1, std::vector<std::pair<int, int>>* cells) {
+void TraverseCells(double x0, double y0, double x1, double y1,
+                   std::vector<std::pair<int, int>>* cells) {
   cells->clear();
   int ix = static_cast<int>(std::floor(x0)), iy = static_cast<int>(std::floor(y0));
   const int ex = static_cast<int>(std::floor(x1)), ey = static_cast<int>(std::floor(y1));
@@ -67,7 +68,8 @@ GridMap BuildGridMap(const GridMapConfig& c, const std::vector<LaserScan>& scans
       const double r = scan.ranges[b];
       if (!(r > 0 && r < c.max_range)) continue;
       const double a = scan.BeamAngle(b);
-      const double px = ox + r * std::cos(a) / g.resolution, py = oy + r * std::sin(a) / g.resolution;
+      const double px = ox + r * std::cos(a) / g.resolution,
+                   py = oy + r * std::sin(a) / g.resolution;
       TraverseCells(ox, oy, px, py, &ray);
       for (std::size_t i = 0; i < ray.size(); ++i) {
         const auto [ix, iy] = ray[i];

@@ -16,10 +16,10 @@ namespace foresight {
 
 struct GridMapConfig {
   double x_min = -20, x_max = 20, y_min = -25, y_max = 10;  ///< m, extent of the grid
-  double resolution = 0.1;                                   ///< m per cell
-  double max_range = 40.0;                                   ///< m, longer beams are skipped
-  double p_hit = 0.7, p_miss = 0.4;                          ///< inverse sensor model
-  double p_min = 0.12, p_max = 0.97;                         ///< clamping
+  double resolution = 0.1;                                  ///< m per cell
+  double max_range = 40.0;                                  ///< m, longer beams are skipped
+  double p_hit = 0.7, p_miss = 0.4;                         ///< inverse sensor model
+  double p_min = 0.12, p_max = 0.97;                        ///< clamping
   CellType cell_type = CellType::kFloat32;
 
   template <class A>
@@ -29,14 +29,18 @@ struct GridMapConfig {
     a->Visit("y_min", &y_min, config::Range::Any(), "grid extent (m)");
     a->Visit("y_max", &y_max, config::Range::Any(), "grid extent (m)");
     a->Visit("resolution", &resolution, config::Range::Positive(), "cell side (m)");
-    a->Visit("max_range", &max_range, config::Range::Positive(), "beams at or beyond this range are skipped (m)");
-    a->Visit("p_hit", &p_hit, config::Range::Open(0.5, 1), "occupancy probability of an end-point cell");
-    a->Visit("p_miss", &p_miss, config::Range::Open(0, 0.5), "occupancy probability of a traversed cell");
+    a->Visit("max_range", &max_range, config::Range::Positive(),
+             "beams at or beyond this range are skipped (m)");
+    a->Visit("p_hit", &p_hit, config::Range::Open(0.5, 1),
+             "occupancy probability of an end-point cell");
+    a->Visit("p_miss", &p_miss, config::Range::Open(0, 0.5),
+             "occupancy probability of a traversed cell");
     a->Visit("p_min", &p_min, config::Range::Open(0, 0.5), "lower clamp of a cell's probability");
     a->Visit("p_max", &p_max, config::Range::Open(0.5, 1), "upper clamp of a cell's probability");
-    a->VisitEnum("cell_type", &cell_type,
-                 config::EnumNames<CellType>{{CellType::kFloat32, "float32"}, {CellType::kUint8, "uint8"}},
-                 "stored cell type");
+    a->VisitEnum(
+        "cell_type", &cell_type,
+        config::EnumNames<CellType>{{CellType::kFloat32, "float32"}, {CellType::kUint8, "uint8"}},
+        "stored cell type");
   }
 };
 
@@ -45,6 +49,7 @@ GridMap BuildGridMap(const GridMapConfig& config, const std::vector<LaserScan>& 
 
 /// Cells visited by the segment from (x0, y0) to (x1, y1) in grid coordinates (cell units),
 /// in order, ending with the cell of the end point (Amanatides-Woo traversal).
-void TraverseCells(double x0, double y0, double x1, double y1, std::vector<std::pair<int, int>>* cells);
+void TraverseCells(double x0, double y0, double x1, double y1,
+                   std::vector<std::pair<int, int>>* cells);
 
 }  // namespace foresight

@@ -49,8 +49,10 @@ HingeMap TrainHilbertMap(const HingeGrid& grid, const HilbertMapConfig& config,
           const int t = idx[i];
           const double w = scale * v[t];
           double w_new = w;
-          if (w > 0) w_new = std::max(0.0, w - (u + q[t]));
-          else if (w < 0) w_new = std::min(0.0, w + (u - q[t]));
+          if (w > 0)
+            w_new = std::max(0.0, w - (u + q[t]));
+          else if (w < 0)
+            w_new = std::min(0.0, w + (u - q[t]));
           q[t] += w_new - w;
           v[t] = w_new / scale;
         }

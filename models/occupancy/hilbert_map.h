@@ -2,12 +2,12 @@
 /// Hilbert map (Ramos & Ott 2015; thesis ch 2 "Hilbert Maps"): logistic regression on hinge
 /// features, p(occupied | x) = sigmoid(w' phi(x)) (errata ch 2), trained by stochastic gradient
 /// descent on the elastic-net penalised log loss
-///   L(w) = sum_n log(1 + exp(-s_n w' phi_n)) + alpha (rho |w|_1 + (1 - rho)/2 ||w||^2),  s_n = +-1,
+///   L(w) = sum_n log(1 + exp(-s_n w' phi_n)) + alpha (rho |w|_1 + (1 - rho)/2 ||w||^2),  s_n =
+///   +-1,
 /// with the L2 part applied through a global scale and the L1 part by the cumulative penalty of
 /// Tsuruoka, Tsujii and Ananiadou (2009), so each step touches only the active features.
 
 #include <Eigen/Core>
-
 #include <cstdint>
 
 #include "core/config.h"
@@ -17,10 +17,10 @@
 namespace foresight {
 
 struct HilbertMapConfig {
-  double alpha = 1e-5;       ///< regularisation strength
-  double l1_ratio = 0.15;    ///< rho: share of the L1 penalty
+  double alpha = 1e-5;         ///< regularisation strength
+  double l1_ratio = 0.15;      ///< rho: share of the L1 penalty
   double learning_rate = 0.5;  ///< eta0 of eta_t = eta0 / (1 + eta0 alpha t)
-  int epochs = 1;            ///< passes over the shuffled training points
+  int epochs = 1;              ///< passes over the shuffled training points
 
   template <class A>
   void Serialize(A* a) {

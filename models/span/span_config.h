@@ -11,9 +11,9 @@ namespace foresight {
 
 /// Continuous trajectory representation of the futures: o(t) = W' phi(t), t from the present.
 struct TrajectoryBasisConfig {
-  int num_centres = 8;        ///< m
-  double gamma = 1.0;         ///< phi(t, t') = exp(-gamma (t - t')^2), 1/s^2
-  double margin = 1.0;        ///< centres span [-margin, T + margin] (s): edges fit without bias
+  int num_centres = 8;         ///< m
+  double gamma = 1.0;          ///< phi(t, t') = exp(-gamma (t - t')^2), 1/s^2
+  double margin = 1.0;         ///< centres span [-margin, T + margin] (s): edges fit without bias
   double ridge_lambda = 1e-4;  ///< ridge penalty of the fit (thesis eq. lsuqares)
   /// Include o(0) = present position in the fit. Off by default: the anchor makes phi(0)' W = 0
   /// hold exactly, a degenerate direction of the weight distribution that the NLL exploits.
@@ -47,10 +47,10 @@ struct SpanNetConfig {
     a->Visit("hidden", &hidden, config::Range::Closed(1, 4096), "hidden layer widths (ReLU)");
     a->Visit("components", &components, config::Range::Closed(1, 32),
              "R, matrix-normal mixture components (1 = SPAN)");
-    a->VisitEnum("u_param", &u_param,
-                 config::EnumNames<UParam>{{UParam::kCholesky, "cholesky"},
-                                           {UParam::kDiagonal, "diagonal"}},
-                 "parameterisation of the row scale U (full Cholesky or log-diagonal)");
+    a->VisitEnum(
+        "u_param", &u_param,
+        config::EnumNames<UParam>{{UParam::kCholesky, "cholesky"}, {UParam::kDiagonal, "diagonal"}},
+        "parameterisation of the row scale U (full Cholesky or log-diagonal)");
     a->Visit("rotate_to_heading", &rotate_to_heading, config::Range::Any(),
              "rotate each window so the observed heading is +x (predictions rotate back exactly)");
     a->Visit("residual_to_constant_velocity", &residual_to_constant_velocity, config::Range::Any(),

@@ -23,11 +23,12 @@ SpanSamples MakeSpanSamples(const WindowSet& w, const TimeBasis& basis,
   s.targets.resize(w.size(), 2 * m);
   Eigen::MatrixXd points(times.size(), 2);
   for (int n = 0; n < w.size(); ++n) {
-    const EgoFrame frame = EgoFrame::FromPast(p, [&](int i) { return w.Past(n, i); }, rotate);
+    const EgoFrame frame = EgoFrame::FromPast(
+        p, [&](int i) { return w.Past(n, i); }, rotate);
     for (int i = 0; i < p; ++i) s.inputs.row(n).segment<2>(2 * i) = frame.ToEgo(w.Past(n, i));
     const Eigen::Vector2d v =
-        residual ? Eigen::Vector2d(frame.rotation.transpose() * (w.Past(n, p - 1) - w.Past(n, p - 2)) /
-                                   w.seconds_per_step)
+        residual ? Eigen::Vector2d(frame.rotation.transpose() *
+                                   (w.Past(n, p - 1) - w.Past(n, p - 2)) / w.seconds_per_step)
                  : Eigen::Vector2d::Zero();
     if (first == 0) points.row(0).setZero();
     for (int k = 1; k <= f; ++k)

@@ -20,7 +20,8 @@ struct SpanSamples {
 };
 
 /// Ego-frame inputs and ridge-fitted future weights (thesis eq. lsuqares) for every window.
-/// With `residual_to_constant_velocity`, the fitted futures are y(t) - v t (v: last step's velocity).
+/// With `residual_to_constant_velocity`, the fitted futures are y(t) - v t (v: last step's
+/// velocity).
 SpanSamples MakeSpanSamples(const WindowSet& windows, const TimeBasis& basis,
                             const TrajectoryBasisConfig& config, bool rotate,
                             bool residual_to_constant_velocity = false);

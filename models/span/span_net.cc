@@ -22,7 +22,9 @@ SpanNetImpl::SpanNetImpl(int input_dim, const SpanNetConfig& config, const HeadL
   head_->bias.zero_();
 }
 
-torch::Tensor SpanNetImpl::forward(const torch::Tensor& x) { return head_->forward(mlp_->forward(x)); }
+torch::Tensor SpanNetImpl::forward(const torch::Tensor& x) {
+  return head_->forward(mlp_->forward(x));
+}
 
 std::vector<std::string> SpanNetImpl::DenseLayerNames() const {
   std::vector<std::string> names;
@@ -50,8 +52,10 @@ MatrixNormalParams DecodeHead(const torch::Tensor& raw, const HeadLayout& L) {
     p.chol_u = chol;
   }
   const auto v = z.narrow(2, 1 + 2 * m + L.UBlock(), 3);
-  const auto a = torch::exp(torch::clamp(v.select(2, 0), HeadLayout::kLogDiagMin, HeadLayout::kLogDiagMax));
-  const auto c = torch::exp(torch::clamp(v.select(2, 2), HeadLayout::kLogDiagMin, HeadLayout::kLogDiagMax));
+  const auto a =
+      torch::exp(torch::clamp(v.select(2, 0), HeadLayout::kLogDiagMin, HeadLayout::kLogDiagMax));
+  const auto c =
+      torch::exp(torch::clamp(v.select(2, 2), HeadLayout::kLogDiagMin, HeadLayout::kLogDiagMax));
   p.chol_v = torch::stack({a, v.select(2, 1), c}, 2);
   return p;
 }

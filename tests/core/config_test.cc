@@ -28,7 +28,8 @@ struct Outer {
     a->Visit("count", &count, config::Range::AtLeast(1), "a count");
     a->Visit("name", &name, config::Range::Any(), "a name");
     a->Visit("flag", &flag, config::Range::Any(), "a flag");
-    a->VisitEnum("kind", &kind, config::EnumNames<Kind>{{Kind::kA, "a"}, {Kind::kB, "b"}}, "a kind");
+    a->VisitEnum("kind", &kind, config::EnumNames<Kind>{{Kind::kA, "a"}, {Kind::kB, "b"}},
+                 "a kind");
     a->Visit("inner", &inner, config::Range::Any(), "nested");
   }
 };
@@ -41,7 +42,8 @@ TEST(Config, DefaultsAndValues) {
   const Outer d = Parse("{}");
   EXPECT_EQ(d.count, 3);
   EXPECT_EQ(d.inner.widths, (std::vector<int>{4, 8}));
-  const Outer o = Parse("count: 7\nname: hi\nflag: true\nkind: b\ninner: {rate: 0.25, widths: [1, 2, 3]}\n");
+  const Outer o =
+      Parse("count: 7\nname: hi\nflag: true\nkind: b\ninner: {rate: 0.25, widths: [1, 2, 3]}\n");
   EXPECT_EQ(o.count, 7);
   EXPECT_EQ(o.name, "hi");
   EXPECT_TRUE(o.flag);
@@ -56,23 +58,27 @@ TEST(Config, UnknownKeyNamesFileLineAndPath) {
 }
 
 TEST(Config, WrongTypeNamesPathValueAndExpectation) {
-  testing::ExpectErrorContains([] { Parse("count: abc\n"); }, {"test.yaml:1", "'count'", "'abc'", "integer"});
+  testing::ExpectErrorContains([] { Parse("count: abc\n"); },
+                               {"test.yaml:1", "'count'", "'abc'", "integer"});
   testing::ExpectErrorContains([] { Parse("count: 2.5\n"); }, {"'count'", "'2.5'"});
   testing::ExpectErrorContains([] { Parse("flag: maybe\n"); }, {"'flag'", "true or false"});
   testing::ExpectErrorContains([] { Parse("inner: 3\n"); }, {"'inner'", "mapping"});
-  testing::ExpectErrorContains([] { Parse("inner: {widths: [1, x]}\n"); }, {"'inner.widths[1]'", "'x'"});
+  testing::ExpectErrorContains([] { Parse("inner: {widths: [1, x]}\n"); },
+                               {"'inner.widths[1]'", "'x'"});
   testing::ExpectErrorContains([] { Parse("kind: c\n"); }, {"'kind'", "'a'", "'b'"});
   testing::ExpectErrorContains([] { Parse("inner: {rate: nan}\n"); }, {"'inner.rate'", "finite"});
 }
 
 TEST(Config, OutOfRangeNamesTheRange) {
   testing::ExpectErrorContains([] { Parse("count: 0\n"); }, {"'count'", "'0'", ">= 1"});
-  testing::ExpectErrorContains([] { Parse("inner: {rate: 1.0}\n"); }, {"'inner.rate'", "in (0, 1)"});
+  testing::ExpectErrorContains([] { Parse("inner: {rate: 1.0}\n"); },
+                               {"'inner.rate'", "in (0, 1)"});
   testing::ExpectErrorContains([] { Parse("inner: {widths: [0]}\n"); }, {"'inner.widths[0]'"});
 }
 
 TEST(Config, OverridesUseThePathSyntax) {
-  const Outer o = Parse("count: 2\n", {"inner.rate=0.75", "count=9", "inner.widths=[5, 6]", "name=abc"});
+  const Outer o =
+      Parse("count: 2\n", {"inner.rate=0.75", "count=9", "inner.widths=[5, 6]", "name=abc"});
   EXPECT_EQ(o.count, 9);
   EXPECT_DOUBLE_EQ(o.inner.rate, 0.75);
   EXPECT_EQ(o.inner.widths, (std::vector<int>{5, 6}));
@@ -80,7 +86,8 @@ TEST(Config, OverridesUseThePathSyntax) {
   testing::ExpectErrorContains([] { Parse("{}", {"inner.nope=1"}); }, {"unknown key 'inner.nope'"});
   testing::ExpectErrorContains([] { Parse("{}", {"novalue"}); }, {"key.path=value"});
   testing::ExpectErrorContains([] { Parse("{}", {"count.x=1"}); }, {"'count'", "mapping"});
-  testing::ExpectErrorContains([] { Parse("count: 2\n", {"count.x=1"}); }, {"'count' is not a mapping"});
+  testing::ExpectErrorContains([] { Parse("count: 2\n", {"count.x=1"}); },
+                               {"'count' is not a mapping"});
 }
 
 TEST(Config, WriteReadRoundTrip) {
@@ -94,7 +101,8 @@ TEST(Config, WriteReadRoundTrip) {
 
 TEST(Config, ReferenceListsEveryKeyWithDefault) {
   const std::string table = config::ReferenceTable<Outer>();
-  for (const char* key : {"`count`", "`name`", "`flag`", "`kind`", "`inner.rate`", "`inner.widths`"})
+  for (const char* key :
+       {"`count`", "`name`", "`flag`", "`kind`", "`inner.rate`", "`inner.widths`"})
     EXPECT_NE(table.find(key), std::string::npos) << key;
   EXPECT_NE(table.find("a | b"), std::string::npos);
   EXPECT_NE(table.find("`0.5`"), std::string::npos);
@@ -106,7 +114,8 @@ TEST(Config, RepeatedKeysAreRefusedWithBothLines) {
                                {"test.yaml:3", "key 'count' is repeated", "first at line 1"});
   testing::ExpectErrorContains([] { Parse("inner:\n  rate: 0.1\n  rate: 0.2\n"); },
                                {"test.yaml:3", "'rate'", "line 2"});
-  testing::ExpectErrorContains([] { Parse("inner: {widths: [1], widths: [2]}\n"); }, {"'widths' is repeated"});
+  testing::ExpectErrorContains([] { Parse("inner: {widths: [1], widths: [2]}\n"); },
+                               {"'widths' is repeated"});
 }
 
 // Issue 18, defect 6 and 7: an empty config file does not silently train defaults, and a huge one
@@ -114,15 +123,20 @@ TEST(Config, RepeatedKeysAreRefusedWithBothLines) {
 TEST(Config, EmptyAndHugeConfigFilesAreRefused) {
   testing::TempDir dir;
   testing::WriteText(dir.File("empty.yaml"), "# nothing but a comment\n");
-  testing::ExpectErrorContains([&] { config::LoadYamlFile(dir.File("empty.yaml")); }, {"empty.yaml", "empty"});
+  testing::ExpectErrorContains([&] { config::LoadYamlFile(dir.File("empty.yaml")); },
+                               {"empty.yaml", "empty"});
   testing::WriteText(dir.File("huge.yaml"), "widths: [" + std::string(2 << 20, '1') + "]\n");
-  testing::ExpectErrorContains([&] { config::LoadYamlFile(dir.File("huge.yaml")); }, {"huge.yaml", "bytes; at most"});
-  testing::ExpectErrorContains([&] { config::LoadYamlFile(dir.File("none.yaml")); }, {"none.yaml", "cannot open"});
+  testing::ExpectErrorContains([&] { config::LoadYamlFile(dir.File("huge.yaml")); },
+                               {"huge.yaml", "bytes; at most"});
+  testing::ExpectErrorContains([&] { config::LoadYamlFile(dir.File("none.yaml")); },
+                               {"none.yaml", "cannot open"});
 }
 
 TEST(Config, InvalidYamlNamesTheFile) {
-  testing::ExpectErrorContains([] { config::ParseYaml("a: [1, 2", "bad.yaml"); }, {"bad.yaml", "invalid YAML"});
-  testing::ExpectErrorContains([] { config::LoadYamlFile("/nonexistent/x.yaml"); }, {"/nonexistent/x.yaml"});
+  testing::ExpectErrorContains([] { config::ParseYaml("a: [1, 2", "bad.yaml"); },
+                               {"bad.yaml", "invalid YAML"});
+  testing::ExpectErrorContains([] { config::LoadYamlFile("/nonexistent/x.yaml"); },
+                               {"/nonexistent/x.yaml"});
 }
 
 // std::vector<S> of config structs: a YAML sequence of mappings.
@@ -156,7 +170,8 @@ TEST(Config, VectorOfStructsReadsEachElementWithDefaults) {
   const Scene d = ParseScene("{}");
   ASSERT_EQ(d.segments.size(), 2u);
   EXPECT_DOUBLE_EQ(d.segments[1].x1, 3);
-  const Scene s = ParseScene("segments:\n  - {x0: -1.5, x1: 2}\n  - x1: 4\n    box: [1, 2, 3]\n  - {}\n");
+  const Scene s =
+      ParseScene("segments:\n  - {x0: -1.5, x1: 2}\n  - x1: 4\n    box: [1, 2, 3]\n  - {}\n");
   ASSERT_EQ(s.segments.size(), 3u);
   EXPECT_DOUBLE_EQ(s.segments[0].x0, -1.5);
   EXPECT_DOUBLE_EQ(s.segments[0].x1, 2);
@@ -174,8 +189,10 @@ TEST(Config, VectorOfStructsErrorsNameTheElementPath) {
                                {"scene.yaml:2", "'segments[0].x1'", "'-1'", ">= 0"});
   testing::ExpectErrorContains([] { ParseScene("segments:\n  - {}\n  - {box: [1, a]}\n"); },
                                {"'segments[1].box[1]'", "'a'"});
-  testing::ExpectErrorContains([] { ParseScene("segments: {x0: 1}\n"); }, {"'segments'", "a list of mappings"});
-  testing::ExpectErrorContains([] { ParseScene("segments: [3]\n"); }, {"'segments[0]'", "'3'", "a mapping"});
+  testing::ExpectErrorContains([] { ParseScene("segments: {x0: 1}\n"); },
+                               {"'segments'", "a list of mappings"});
+  testing::ExpectErrorContains([] { ParseScene("segments: [3]\n"); },
+                               {"'segments[0]'", "'3'", "a mapping"});
 }
 
 TEST(Config, OverridesReachListElements) {
@@ -191,7 +208,8 @@ TEST(Config, OverridesReachListElements) {
   testing::ExpectErrorContains([&] { parse("segments[2].x0=1"); }, {"has 2 elements", "index 2"});
   testing::ExpectErrorContains([&] { parse("segments[a].x0=1"); }, {"key[index]"});
   testing::ExpectErrorContains([&] { parse("name[0].x0=1"); }, {"'name' is not a list"});
-  testing::ExpectErrorContains([&] { parse("segments[0].y9=1"); }, {"unknown key 'segments[0].y9'"});
+  testing::ExpectErrorContains([&] { parse("segments[0].y9=1"); },
+                               {"unknown key 'segments[0].y9'"});
 }
 
 TEST(Config, VectorOfStructsRoundTripsAndIsDocumented) {
@@ -206,10 +224,12 @@ TEST(Config, VectorOfStructsRoundTripsAndIsDocumented) {
   Scene empty;
   empty.segments.clear();
   const std::string empty_text = config::ToYaml(empty);
-  EXPECT_TRUE(config::FromYaml<Scene>(config::ParseYaml(empty_text, "e"), "e").segments.empty()) << empty_text;
+  EXPECT_TRUE(config::FromYaml<Scene>(config::ParseYaml(empty_text, "e"), "e").segments.empty())
+      << empty_text;
 
   const std::string table = config::ReferenceTable<Scene>();
-  for (const char* key : {"`segments`", "`segments[].x0`", "`segments[].x1`", "`segments[].box`", "`inner.rate`"})
+  for (const char* key :
+       {"`segments`", "`segments[].x0`", "`segments[].x1`", "`segments[].box`", "`inner.rate`"})
     EXPECT_NE(table.find(key), std::string::npos) << key << "\n" << table;
   EXPECT_NE(table.find("list of mapping"), std::string::npos);
   EXPECT_NE(table.find("`2 entries`"), std::string::npos) << table;

@@ -18,8 +18,9 @@ TEST(H5, WriteAtomicallyLeavesNothingWhenTheDiskIsFull) {
   const Eigen::MatrixXd big = Eigen::MatrixXd::Ones(200, 200);  // 320 kB
   {
     const testing::ScopedFileSizeLimit limit(64 * 1024);
-    testing::ExpectErrorContains([&] { h5::WriteAtomically(path, [&](h5::File* f) { f->WriteMatrix("/m", big); }); },
-                                 {"big.h5"});
+    testing::ExpectErrorContains(
+        [&] { h5::WriteAtomically(path, [&](h5::File* f) { f->WriteMatrix("/m", big); }); },
+        {"big.h5"});
   }
   EXPECT_FALSE(std::filesystem::exists(path));
   EXPECT_FALSE(std::filesystem::exists(path + ".tmp"));
@@ -70,11 +71,15 @@ TEST(H5, ErrorsNameFileAndObject) {
     f.WriteMatrix("/m", m);
   }
   h5::File f = h5::File::Open(path);
-  testing::ExpectErrorContains([&] { f.ReadDouble("/missing"); }, {path, "missing dataset '/missing'"});
-  testing::ExpectErrorContains([&] { f.ReadMatrixD("/m", 3, 4); }, {path, "'/m'", "4x4", "expected 3x4"});
-  testing::ExpectErrorContains([&] { f.GetIntAttr("/", "nope"); }, {path, "missing attribute 'nope'"});
+  testing::ExpectErrorContains([&] { f.ReadDouble("/missing"); },
+                               {path, "missing dataset '/missing'"});
+  testing::ExpectErrorContains([&] { f.ReadMatrixD("/m", 3, 4); },
+                               {path, "'/m'", "4x4", "expected 3x4"});
+  testing::ExpectErrorContains([&] { f.GetIntAttr("/", "nope"); },
+                               {path, "missing attribute 'nope'"});
   testing::ExpectErrorContains([&] { f.ReadInt("/m"); }, {"wrong element type"});
-  testing::ExpectErrorContains([] { h5::File::Open("/nonexistent/file.h5"); }, {"/nonexistent/file.h5", "not found"});
+  testing::ExpectErrorContains([] { h5::File::Open("/nonexistent/file.h5"); },
+                               {"/nonexistent/file.h5", "not found"});
 }
 
 TEST(H5, ScalarReadsRefuseArrays) {
@@ -96,7 +101,8 @@ TEST(H5, ScalarReadsRefuseArrays) {
     const char strings[12] = {'a', 'b', 'c', 0, 'd', 'e', 'f', 0, 'g', 'h', 'i', 0};
     const hid_t a1 = H5Acreate2(group, "ints", H5T_NATIVE_INT64, space, H5P_DEFAULT, H5P_DEFAULT);
     H5Awrite(a1, H5T_NATIVE_INT64, ints);
-    const hid_t a2 = H5Acreate2(group, "doubles", H5T_NATIVE_DOUBLE, space, H5P_DEFAULT, H5P_DEFAULT);
+    const hid_t a2 =
+        H5Acreate2(group, "doubles", H5T_NATIVE_DOUBLE, space, H5P_DEFAULT, H5P_DEFAULT);
     H5Awrite(a2, H5T_NATIVE_DOUBLE, doubles);
     const hid_t a3 = H5Acreate2(group, "strings", str, space, H5P_DEFAULT, H5P_DEFAULT);
     H5Awrite(a3, str, strings);
@@ -111,9 +117,12 @@ TEST(H5, ScalarReadsRefuseArrays) {
   }
   h5::File f = h5::File::Open(path);
   EXPECT_EQ(f.GetIntAttr("/g", "marker"), 1);
-  testing::ExpectErrorContains([&] { f.GetIntAttr("/g", "ints"); }, {path, "'ints'", "'/g'", "3 elements"});
-  testing::ExpectErrorContains([&] { f.GetDoubleAttr("/g", "doubles"); }, {path, "'doubles'", "'/g'", "3 elements"});
-  testing::ExpectErrorContains([&] { f.GetStringAttr("/g", "strings"); }, {path, "'strings'", "'/g'", "3 elements"});
+  testing::ExpectErrorContains([&] { f.GetIntAttr("/g", "ints"); },
+                               {path, "'ints'", "'/g'", "3 elements"});
+  testing::ExpectErrorContains([&] { f.GetDoubleAttr("/g", "doubles"); },
+                               {path, "'doubles'", "'/g'", "3 elements"});
+  testing::ExpectErrorContains([&] { f.GetStringAttr("/g", "strings"); },
+                               {path, "'strings'", "'/g'", "3 elements"});
   testing::ExpectErrorContains([&] { f.ReadString("/texts"); }, {path, "'/texts'", "3 elements"});
 }
 
@@ -128,7 +137,8 @@ TEST(H5, TruncatedAndForeignFilesAreClearErrors) {
   testing::Truncate(path, 3000);
   testing::ExpectErrorContains([&] { h5::File::Open(path).ReadDouble("/m"); }, {path});
   testing::WriteText(dir.File("text.h5"), "this is not hdf5\n");
-  testing::ExpectErrorContains([&] { h5::File::Open(dir.File("text.h5")); }, {"text.h5", "not a readable HDF5 file"});
+  testing::ExpectErrorContains([&] { h5::File::Open(dir.File("text.h5")); },
+                               {"text.h5", "not a readable HDF5 file"});
 }
 
 }  // namespace

@@ -29,7 +29,9 @@ MatrixNormal RandomMatrixNormal(int m, std::mt19937_64* rng) {
   std::normal_distribution<double> n01;
   MatrixNormal d;
   d.mean = Eigen::MatrixXd::NullaryExpr(m, 2, [&] { return n01(*rng); });
-  d.chol_u = Eigen::MatrixXd::NullaryExpr(m, m, [&] { return 0.3 * n01(*rng); }).triangularView<Eigen::Lower>();
+  d.chol_u = Eigen::MatrixXd::NullaryExpr(m, m, [&] {
+               return 0.3 * n01(*rng);
+             }).triangularView<Eigen::Lower>();
   for (int i = 0; i < m; ++i) d.chol_u(i, i) = std::exp(0.3 * n01(*rng));
   d.chol_v << std::exp(0.2 * n01(*rng)), 0, 0.5 * n01(*rng), std::exp(0.2 * n01(*rng));
   return d;
@@ -110,7 +112,8 @@ TEST(Gaussian2, MatchesDenseFormula) {
   cov << 2.0, 0.3, 0.3, 0.5;
   const Eigen::Vector2d x(0.4, -1.0), mu(0.1, 0.2);
   const Eigen::Vector2d d = x - mu;
-  const double ref = -0.5 * d.dot(cov.inverse() * d) - std::log(2 * M_PI) - 0.5 * std::log(cov.determinant());
+  const double ref =
+      -0.5 * d.dot(cov.inverse() * d) - std::log(2 * M_PI) - 0.5 * std::log(cov.determinant());
   EXPECT_NEAR(LogGaussian2(x, mu, cov), ref, 1e-12);
 }
 

@@ -1,10 +1,10 @@
 #include "core/rbf.h"
 
-#include "core/error.h"
-
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+
+#include "core/error.h"
 
 namespace foresight {
 namespace {
@@ -13,7 +13,8 @@ TEST(TimeBasis, EvaluatesSquaredExponential) {
   const TimeBasis b(5, 0.0, 4.0, 0.7);
   ASSERT_EQ(b.size(), 5);
   const Eigen::VectorXd phi = b.Evaluate(1.3);
-  for (int j = 0; j < 5; ++j) EXPECT_NEAR(phi[j], std::exp(-0.7 * std::pow(1.3 - j * 1.0, 2)), 1e-15);
+  for (int j = 0; j < 5; ++j)
+    EXPECT_NEAR(phi[j], std::exp(-0.7 * std::pow(1.3 - j * 1.0, 2)), 1e-15);
 }
 
 TEST(Ridge, MatchesAugmentedLeastSquaresByQr) {
@@ -37,7 +38,8 @@ TEST(Ridge, RecoversSmoothTrajectoriesAtTheSampleTimes) {
   const TimeBasis b(8, -1.0, 5.8, 1.0);
   Eigen::VectorXd t = Eigen::VectorXd::LinSpaced(13, 0.0, 4.8);
   Eigen::MatrixXd y(13, 2);
-  for (int i = 0; i < 13; ++i) y.row(i) << 1.2 * t[i], 0.3 * std::sin(0.8 * t[i]);  // walking, slight sway
+  for (int i = 0; i < 13; ++i)
+    y.row(i) << 1.2 * t[i], 0.3 * std::sin(0.8 * t[i]);  // walking, slight sway
   const Eigen::MatrixXd w = b.FitRidge(t, y, 1e-4);
   const Eigen::MatrixXd fit = b.Design(t) * w;
   EXPECT_LT((fit - y).cwiseAbs().maxCoeff(), 0.01);  // sub-centimetre reconstruction
@@ -49,7 +51,9 @@ TEST(Ridge, RecoversSmoothTrajectoriesAtTheSampleTimes) {
 TEST(Ridge, BadInputIsAnError) {
   EXPECT_THROW(TimeBasis(0, 0.0, 1.0, 1.0), Error);
   EXPECT_THROW(TimeBasis(3, 0.0, 1.0, -1.0), Error);
-  EXPECT_THROW(TimeBasis(3, 0.0, 1.0, 1.0).FitRidge(Eigen::VectorXd::Zero(2), Eigen::MatrixXd::Zero(2, 2), -1.0), Error);
+  EXPECT_THROW(TimeBasis(3, 0.0, 1.0, 1.0)
+                   .FitRidge(Eigen::VectorXd::Zero(2), Eigen::MatrixXd::Zero(2, 2), -1.0),
+               Error);
 }
 
 }  // namespace

@@ -35,7 +35,8 @@ TEST(VonMises, WrapAngleIsHalfOpen) {
 }
 
 TEST(VonMises, LogBesselI0MatchesStdCylBesselWhereFinite) {
-  std::vector<double> ks = {0, 1e-10, 1e-3, 0.1, 0.5, 1, 2, 5, 10, 20, 29.9, 30, 30.1, 40, 75, 150, 300, 500, 700};
+  std::vector<double> ks = {0,    1e-10, 1e-3, 0.1, 0.5, 1,   2,   5,   10, 20,
+                            29.9, 30,    30.1, 40,  75,  150, 300, 500, 700};
   for (double k : ks) {
     const double ref = std::log(std::cyl_bessel_i(0.0, k));
     EXPECT_NEAR(LogBesselI0(k), ref, 1e-13 * std::max(1.0, std::abs(ref))) << "kappa " << k;
@@ -49,7 +50,8 @@ TEST(VonMises, LogBesselI0MatchesLargeKappaExpansionBeyondOverflow) {
   // log I0(k) = k - log(2 pi k)/2 + log(1 + 1/(8k) + 9/(128 k^2) + 225/(3072 k^3)) + O(k^-4).
   for (double k : {710.0, 1e3, 1e4, 1e6, 1e9, 1e15, 1e300}) {
     const double ref_scaled =
-        -0.5 * std::log(2 * M_PI * k) + std::log1p(1 / (8 * k) + 9 / (128 * k * k) + 225 / (3072 * k * k * k));
+        -0.5 * std::log(2 * M_PI * k) +
+        std::log1p(1 / (8 * k) + 9 / (128 * k * k) + 225 / (3072 * k * k * k));
     EXPECT_NEAR(LogBesselI0Scaled(k), ref_scaled, 1e-12 * std::abs(ref_scaled)) << k;
     EXPECT_TRUE(std::isfinite(LogBesselI0(k))) << k;
     EXPECT_NEAR(LogBesselI0(k), k + ref_scaled, 1e-15 * k + 1e-12) << k;
@@ -74,7 +76,8 @@ TEST(VonMises, A1MatchesStdCylBesselRatio) {
   // Large kappa: A1 = 1 - 1/(2k) - 1/(8k^2) - 1/(8k^3) - 25/(128k^4) + O(k^-5).
   for (double k : {1e3, 1e5, 1e8}) {
     const double k2 = k * k;
-    EXPECT_NEAR(BesselRatioA1(k), 1 - 1 / (2 * k) - 1 / (8 * k2) - 1 / (8 * k2 * k) - 25 / (128 * k2 * k2), 1e-14)
+    EXPECT_NEAR(BesselRatioA1(k),
+                1 - 1 / (2 * k) - 1 / (8 * k2) - 1 / (8 * k2 * k) - 25 / (128 * k2 * k2), 1e-14)
         << k;
   }
   // Derivative against central finite differences.
@@ -103,7 +106,8 @@ TEST(VonMises, InverseA1InvertsA1) {
 TEST(VonMises, DensityIntegratesToOneAndMatchesClosedForm) {
   for (double k : {0.0, 0.1, 1.0, 4.0, 30.0, 100.0, 1000.0, 5000.0}) {
     const double mu = 2.9;
-    const double integral = IntegrateCircle([&](double t) { return std::exp(VonMisesLogDensity(t, mu, k)); }, 40000);
+    const double integral =
+        IntegrateCircle([&](double t) { return std::exp(VonMisesLogDensity(t, mu, k)); }, 40000);
     EXPECT_NEAR(integral, 1.0, 1e-10) << k;
     if (k <= 700) {
       const double t = -2.0;
@@ -113,9 +117,11 @@ TEST(VonMises, DensityIntegratesToOneAndMatchesClosedForm) {
   }
   EXPECT_NEAR(std::exp(VonMisesLogDensity(1.0, -1.0, 0)), 1 / (2 * M_PI), 1e-15);
   // Periodic in theta and mu.
-  EXPECT_NEAR(VonMisesLogDensity(0.3 + 2 * M_PI, -3.0, 7.0), VonMisesLogDensity(0.3, -3.0 + 4 * M_PI, 7.0), 1e-12);
+  EXPECT_NEAR(VonMisesLogDensity(0.3 + 2 * M_PI, -3.0, 7.0),
+              VonMisesLogDensity(0.3, -3.0 + 4 * M_PI, 7.0), 1e-12);
   // Far from the mode at huge kappa: finite, very negative.
-  EXPECT_NEAR(VonMisesLogDensity(M_PI, 0, 1e6), -2e6 - std::log(2 * M_PI) - LogBesselI0Scaled(1e6), 1e-6);
+  EXPECT_NEAR(VonMisesLogDensity(M_PI, 0, 1e6), -2e6 - std::log(2 * M_PI) - LogBesselI0Scaled(1e6),
+              1e-6);
 }
 
 TEST(VonMises, MixtureDensityIntegratesToOneAndIsTheWeightedSum) {
@@ -123,13 +129,15 @@ TEST(VonMises, MixtureDensityIntegratesToOneAndIsTheWeightedSum) {
   alpha << 0.2, 0.5, 0.3;
   mu << -3.0, 0.4, 2.0;
   kappa << 2.0, 50.0, 800.0;
-  const double integral =
-      IntegrateCircle([&](double t) { return std::exp(VonMisesMixtureLogDensity(t, alpha, mu, kappa)); }, 40000);
+  const double integral = IntegrateCircle(
+      [&](double t) { return std::exp(VonMisesMixtureLogDensity(t, alpha, mu, kappa)); }, 40000);
   EXPECT_NEAR(integral, 1.0, 1e-10);
   for (double t : {-3.1, -1.0, 0.4, 2.05}) {
     double direct = 0;
-    for (int r = 0; r < 3; ++r) direct += alpha[r] * std::exp(VonMisesLogDensity(t, mu[r], kappa[r]));
-    EXPECT_NEAR(std::exp(VonMisesMixtureLogDensity(t, alpha, mu, kappa)), direct, 1e-12 * direct) << t;
+    for (int r = 0; r < 3; ++r)
+      direct += alpha[r] * std::exp(VonMisesLogDensity(t, mu[r], kappa[r]));
+    EXPECT_NEAR(std::exp(VonMisesMixtureLogDensity(t, alpha, mu, kappa)), direct, 1e-12 * direct)
+        << t;
   }
   // alpha = 0 components are absent; large kappa far from every mode stays finite in log space.
   Eigen::VectorXd a2(2), m2(2), k2(2);
@@ -138,7 +146,8 @@ TEST(VonMises, MixtureDensityIntegratesToOneAndIsTheWeightedSum) {
   k2 << 1e5, 1e5;
   EXPECT_NEAR(VonMisesMixtureLogDensity(3.0, a2, m2, k2), VonMisesLogDensity(3.0, 0.0, 1e5), 1e-9);
   EXPECT_TRUE(std::isfinite(VonMisesMixtureLogDensity(3.0, a2, m2, k2)));
-  testing::ExpectErrorContains([&] { VonMisesMixtureLogDensity(0, a2, mu, k2); }, {"alpha [2]", "mu [3]"});
+  testing::ExpectErrorContains([&] { VonMisesMixtureLogDensity(0, a2, mu, k2); },
+                               {"alpha [2]", "mu [3]"});
 }
 
 TEST(VonMises, SamplerMeanResultantLengthIsA1) {
@@ -173,7 +182,8 @@ TEST(VonMises, SamplerMatchesTheDensityHistogram) {
   for (int b = 0; b < bins; ++b) {
     const double lo = -M_PI + 2 * M_PI * b / bins, w = 2 * M_PI / bins;
     double p = 0;
-    for (int j = 0; j < 200; ++j) p += std::exp(VonMisesLogDensity(lo + w * (j + 0.5) / 200, mu, k)) * w / 200;
+    for (int j = 0; j < 200; ++j)
+      p += std::exp(VonMisesLogDensity(lo + w * (j + 0.5) / 200, mu, k)) * w / 200;
     EXPECT_NEAR(count[b] / static_cast<double>(n), p, 5 * std::sqrt(p * (1 - p) / n) + 1e-4) << b;
   }
 }
@@ -209,7 +219,8 @@ TEST(VonMises, WeightedFitEqualsRepeatedSamples) {
   EXPECT_NEAR(same.mu, 1.0, 1e-12);
   testing::ExpectErrorContains([&] { FitVonMises(theta, Eigen::VectorXd::Zero(3)); }, {"sum to 0"});
   testing::ExpectErrorContains([&] { FitVonMises(theta, -w); }, {"weight 0", "-1"});
-  testing::ExpectErrorContains([&] { FitVonMises(theta, Eigen::VectorXd::Ones(2)); }, {"theta [3]", "weight [2]"});
+  testing::ExpectErrorContains([&] { FitVonMises(theta, Eigen::VectorXd::Ones(2)); },
+                               {"theta [3]", "weight [2]"});
 }
 
 TEST(VonMises, AverageLikelihoodAndMinimumRotationErrorByHand) {
@@ -243,9 +254,11 @@ TEST(VonMises, AverageLikelihoodAndMinimumRotationErrorByHand) {
   EXPECT_NEAR(MinimumRotationError(m, theta), (1.75 + 0.1 + 0.0) / 3, 1e-12);
 
   Eigen::VectorXd short_theta(2);
-  testing::ExpectErrorContains([&] { AverageLikelihood(m, short_theta); }, {"AverageLikelihood", "2 headings"});
+  testing::ExpectErrorContains([&] { AverageLikelihood(m, short_theta); },
+                               {"AverageLikelihood", "2 headings"});
   m.alpha.row(2).setZero();
-  testing::ExpectErrorContains([&] { MinimumRotationError(m, theta); }, {"mixture 2", "positive alpha"});
+  testing::ExpectErrorContains([&] { MinimumRotationError(m, theta); },
+                               {"mixture 2", "positive alpha"});
 }
 
 }  // namespace

@@ -20,7 +20,9 @@ std::string CsvRow(double x, double y, double raw, int path) {
   std::snprintf(buf, sizeof(buf), "%.17g,%.17g,%.17g,%d\n", x, y, raw, path);
   return buf;
 }
-double Raw(double px, double py, double x, double y) { return M_PI / 2 + std::atan2(py - y, px - x); }
+double Raw(double px, double py, double x, double y) {
+  return M_PI / 2 + std::atan2(py - y, px - x);
+}
 
 void ExpectCounted(const DirectionalReadStats& s) {
   EXPECT_EQ(s.points, s.kept + s.first_points + s.dropped());
@@ -71,23 +73,30 @@ TEST(DirectionalGridCsv, BadInputIsAnErrorWithFileAndLine) {
   testing::WriteText(path, "x,y,theta\n1,2,3\n");
   testing::ExpectErrorContains([&] { ReadDirectionalGridCsv(path); }, {"bad.csv:1", "header"});
   testing::WriteText(path, header + "0,0,0,0\n1,0,1\n");
-  testing::ExpectErrorContains([&] { ReadDirectionalGridCsv(path); }, {"bad.csv:3", "4 comma-separated", "got 3"});
+  testing::ExpectErrorContains([&] { ReadDirectionalGridCsv(path); },
+                               {"bad.csv:3", "4 comma-separated", "got 3"});
   testing::WriteText(path, header + "0,0,0,0\nnan,0,0,0\n");
-  testing::ExpectErrorContains([&] { ReadDirectionalGridCsv(path); }, {"bad.csv:3", "x_m", "not finite"});
+  testing::ExpectErrorContains([&] { ReadDirectionalGridCsv(path); },
+                               {"bad.csv:3", "x_m", "not finite"});
   testing::WriteText(path, header + "0,0,0,0\n1,zero,0,0\n");
-  testing::ExpectErrorContains([&] { ReadDirectionalGridCsv(path); }, {"bad.csv:3", "y_m", "not a number", "zero"});
+  testing::ExpectErrorContains([&] { ReadDirectionalGridCsv(path); },
+                               {"bad.csv:3", "y_m", "not a number", "zero"});
   testing::WriteText(path, header + "0,0,0,0\n1,0,0,1.5\n");
-  testing::ExpectErrorContains([&] { ReadDirectionalGridCsv(path); }, {"bad.csv:3", "path_id", "1.5"});
+  testing::ExpectErrorContains([&] { ReadDirectionalGridCsv(path); },
+                               {"bad.csv:3", "path_id", "1.5"});
   testing::WriteText(path, header + CsvRow(0, 0, 0, 0) + CsvRow(1, 0, Raw(0, 0, 1, 0), 0) +
                                CsvRow(5, 5, 0, 1) + CsvRow(2, 0, 0, 0));
-  testing::ExpectErrorContains([&] { ReadDirectionalGridCsv(path); }, {"bad.csv:5", "path_id 0", "again"});
+  testing::ExpectErrorContains([&] { ReadDirectionalGridCsv(path); },
+                               {"bad.csv:5", "path_id 0", "again"});
   // Heading column in another convention (the heading itself instead of heading - pi/2).
   testing::WriteText(path, header + CsvRow(0, 0, 0, 0) + CsvRow(1, 1, std::atan2(1, 1), 0));
-  testing::ExpectErrorContains([&] { ReadDirectionalGridCsv(path); }, {"bad.csv:3", "README convention"});
+  testing::ExpectErrorContains([&] { ReadDirectionalGridCsv(path); },
+                               {"bad.csv:3", "README convention"});
   testing::WriteText(path, header);
   testing::ExpectErrorContains([&] { ReadDirectionalGridCsv(path); }, {"bad.csv", "no data rows"});
   testing::WriteText(path, header + CsvRow(0, 0, 0, 0) + CsvRow(0, 0, 0, 0));
-  testing::ExpectErrorContains([&] { ReadDirectionalGridCsv(path); }, {"bad.csv", "no direction samples"});
+  testing::ExpectErrorContains([&] { ReadDirectionalGridCsv(path); },
+                               {"bad.csv", "no direction samples"});
 }
 
 /// An Edinburgh TRACK line from (x, y, frame) triples, with its Properties line.
@@ -104,19 +113,20 @@ std::string EdinburghTrack(int id, const std::vector<std::array<long long, 3>>& 
 TEST(EdinburghTracks, ConvertsPixelsFramesAndFilters) {
   testing::TempDir dir;
   const std::string path = dir.File("tracks.test.txt");
-  const std::string text = "% Total number of trajectories in file are  3 \n\n" +
-                           EdinburghTrack(1, {{100, 200, 10},
-                                              {105, 200, 11},    // +x, 5 px/frame = 1.11 m/s
-                                              {110, 195, 12},    // +x +y (image y up is world +y)
-                                              {110, 195, 13},    // standing
-                                              {110, 195, 13},    // same frame twice: jump
-                                              {150, 195, 14},    // 40 px in a frame = 8.9 m/s: jump
-                                              {145, 195, 15},    // -x
-                                              {140, 195, 40},    // 25 frames = 2.8 s: gap
-                                              {140, 201, 42}}) + // image y down: world -y
-                           EdinburghTrack(2, {{10, 10, 5}, {12, 10, 6}, {14, 10, 7}}) +  // short
-                           EdinburghTrack(3, {{300, 300, 3}, {300, 290, 4}, {300, 280, 5},
-                                              {300, 270, 6}, {300, 260, 7}});
+  const std::string text =
+      "% Total number of trajectories in file are  3 \n\n" +
+      EdinburghTrack(1, {{100, 200, 10},
+                         {105, 200, 11},     // +x, 5 px/frame = 1.11 m/s
+                         {110, 195, 12},     // +x +y (image y up is world +y)
+                         {110, 195, 13},     // standing
+                         {110, 195, 13},     // same frame twice: jump
+                         {150, 195, 14},     // 40 px in a frame = 8.9 m/s: jump
+                         {145, 195, 15},     // -x
+                         {140, 195, 40},     // 25 frames = 2.8 s: gap
+                         {140, 201, 42}}) +  // image y down: world -y
+      EdinburghTrack(2, {{10, 10, 5}, {12, 10, 6}, {14, 10, 7}}) +  // short
+      EdinburghTrack(3,
+                     {{300, 300, 3}, {300, 290, 4}, {300, 280, 5}, {300, 270, 6}, {300, 260, 7}});
   testing::WriteText(path, text);
   DirectionalReadStats st;
   const DirectionalSamples s = ReadEdinburghTracks(path, HeadingFilter{}, &st);
@@ -164,29 +174,40 @@ TEST(EdinburghTracks, BadInputIsAnErrorWithFileAndLine) {
   testing::TempDir dir;
   const std::string path = dir.File("tracks.bad.txt");
   const HeadingFilter f;
-  testing::ExpectErrorContains([&] { ReadEdinburghTracks(dir.File("none.txt"), f); }, {"none.txt", "cannot open"});
+  testing::ExpectErrorContains([&] { ReadEdinburghTracks(dir.File("none.txt"), f); },
+                               {"none.txt", "cannot open"});
   testing::WriteText(path, "% header\n TRACK.R1=[[1 2 3];[4 5 6]\n");
-  testing::ExpectErrorContains([&] { ReadEdinburghTracks(path, f); }, {"tracks.bad.txt:2", "TRACK.R1", "must look like"});
-  testing::WriteText(path, " TRACK.R1=[[1 2 3];[4 nan 4];[5 5 5]];\n");
-  testing::ExpectErrorContains([&] { ReadEdinburghTracks(path, f); }, {"tracks.bad.txt:1", "point 2", "non-finite"});
-  testing::WriteText(path, " TRACK.R1=[[1 2 3];[4 5];[5 5 5]];\n");
-  testing::ExpectErrorContains([&] { ReadEdinburghTracks(path, f); }, {"tracks.bad.txt:1", "point 2", "x y frame"});
-  testing::WriteText(path, " TRACK.R7=[[1 2 3];[4 5 2.5]];\n");
-  testing::ExpectErrorContains([&] { ReadEdinburghTracks(path, f); }, {"tracks.bad.txt:1", "TRACK.R7", "not an integer"});
-  testing::WriteText(path, "\n TRACK.R1=[[1 2 3];[4 5 2]];\n");
-  testing::ExpectErrorContains([&] { ReadEdinburghTracks(path, f); }, {"tracks.bad.txt:2", "back in time", "frame 2 after 3"});
-  testing::WriteText(path, "Properties.R1=[3 3 4 1.0];\n TRACK.R1=[[1 2 3];[4 5 4]];\n");
   testing::ExpectErrorContains([&] { ReadEdinburghTracks(path, f); },
-                               {"tracks.bad.txt:2", "2 points in frames 3..4", "Properties.R1 says 3 points"});
+                               {"tracks.bad.txt:2", "TRACK.R1", "must look like"});
+  testing::WriteText(path, " TRACK.R1=[[1 2 3];[4 nan 4];[5 5 5]];\n");
+  testing::ExpectErrorContains([&] { ReadEdinburghTracks(path, f); },
+                               {"tracks.bad.txt:1", "point 2", "non-finite"});
+  testing::WriteText(path, " TRACK.R1=[[1 2 3];[4 5];[5 5 5]];\n");
+  testing::ExpectErrorContains([&] { ReadEdinburghTracks(path, f); },
+                               {"tracks.bad.txt:1", "point 2", "x y frame"});
+  testing::WriteText(path, " TRACK.R7=[[1 2 3];[4 5 2.5]];\n");
+  testing::ExpectErrorContains([&] { ReadEdinburghTracks(path, f); },
+                               {"tracks.bad.txt:1", "TRACK.R7", "not an integer"});
+  testing::WriteText(path, "\n TRACK.R1=[[1 2 3];[4 5 2]];\n");
+  testing::ExpectErrorContains([&] { ReadEdinburghTracks(path, f); },
+                               {"tracks.bad.txt:2", "back in time", "frame 2 after 3"});
+  testing::WriteText(path, "Properties.R1=[3 3 4 1.0];\n TRACK.R1=[[1 2 3];[4 5 4]];\n");
+  testing::ExpectErrorContains(
+      [&] { ReadEdinburghTracks(path, f); },
+      {"tracks.bad.txt:2", "2 points in frames 3..4", "Properties.R1 says 3 points"});
   testing::WriteText(path, "garbage\n");
-  testing::ExpectErrorContains([&] { ReadEdinburghTracks(path, f); }, {"tracks.bad.txt:1", "expected a comment"});
+  testing::ExpectErrorContains([&] { ReadEdinburghTracks(path, f); },
+                               {"tracks.bad.txt:1", "expected a comment"});
   testing::WriteText(path, "% only a comment\n");
-  testing::ExpectErrorContains([&] { ReadEdinburghTracks(path, f); }, {"tracks.bad.txt", "no TRACK lines"});
+  testing::ExpectErrorContains([&] { ReadEdinburghTracks(path, f); },
+                               {"tracks.bad.txt", "no TRACK lines"});
   testing::WriteText(path, " TRACK.R1=[[1 2 3];[1 2 4];[1 2 5];[1 2 6];[1 2 7]];\n");
-  testing::ExpectErrorContains([&] { ReadEdinburghTracks(path, f); }, {"tracks.bad.txt", "no direction samples left"});
+  testing::ExpectErrorContains([&] { ReadEdinburghTracks(path, f); },
+                               {"tracks.bad.txt", "no direction samples left"});
   HeadingFilter bad;
   bad.max_speed = -1;
-  testing::ExpectErrorContains([&] { ReadEdinburghTracks(path, bad); }, {"heading filter", "max_speed -1"});
+  testing::ExpectErrorContains([&] { ReadEdinburghTracks(path, bad); },
+                               {"heading filter", "max_speed -1"});
 }
 
 TEST(DirectionalSamples, SelectAndValidate) {
@@ -204,11 +225,13 @@ TEST(DirectionalSamples, SelectAndValidate) {
   testing::ExpectErrorContains([&] { s.Select({5}); }, {"row 5", "[0, 5)"});
   DirectionalSamples bad = s;
   bad.theta[2] = M_PI;
-  testing::ExpectErrorContains([&] { bad.Validate("here"); }, {"here", "sample 2", "outside [-pi, pi)"});
+  testing::ExpectErrorContains([&] { bad.Validate("here"); },
+                               {"here", "sample 2", "outside [-pi, pi)"});
   bad = s;
   bad.y[3] = std::nan("");
   testing::ExpectErrorContains([&] { bad.Validate("here"); }, {"here", "sample 3", "not finite"});
-  testing::ExpectErrorContains([&] { DirectionalSamples().Validate("empty"); }, {"empty", "no direction samples"});
+  testing::ExpectErrorContains([&] { DirectionalSamples().Validate("empty"); },
+                               {"empty", "no direction samples"});
 }
 
 TEST(CrossingFlow, DeterministicAndTheDominantDirectionFlips) {
@@ -285,7 +308,8 @@ TEST(KFold, PartitionsEveryRowOnceAndIsSeeded) {
 std::string RealFile(const std::string& relative) {
   std::vector<std::filesystem::path> roots;
   if (const char* data = std::getenv("FORESIGHT_DATA")) roots.emplace_back(data);
-  if (const std::string shared = testing::SharedDataDir(); !shared.empty()) roots.emplace_back(shared);
+  if (const std::string shared = testing::SharedDataDir(); !shared.empty())
+    roots.emplace_back(shared);
   for (const auto& root : roots)
     if (std::filesystem::exists(root / relative)) return (root / relative).string();
   return "";
@@ -295,7 +319,8 @@ TEST(DirectionalGridCsv, RealFilesWhenPresent) {
   for (const std::string name : {"unimodal_sim1.csv", "multimodal_sim2.csv"}) {
     const std::string path = RealFile("directional_grid_maps_sim/" + name);
     if (path.empty())
-      GTEST_SKIP() << "directional_grid_maps_sim/" << name << " not found under $FORESIGHT_DATA or ../shared/data";
+      GTEST_SKIP() << "directional_grid_maps_sim/" << name
+                   << " not found under $FORESIGHT_DATA or ../shared/data";
     DirectionalReadStats st;
     const DirectionalSamples s = ReadDirectionalGridCsv(path, &st);
     ExpectCounted(st);
@@ -314,7 +339,8 @@ TEST(EdinburghTracks, RealFilesWhenPresent) {
   for (const std::string name : {"tracks.01Aug.txt", "tracks.01Jul.txt"}) {
     const std::string path = RealFile("edinburgh_forum/" + name);
     if (path.empty())
-      GTEST_SKIP() << "edinburgh_forum/" << name << " not found under $FORESIGHT_DATA or ../shared/data";
+      GTEST_SKIP() << "edinburgh_forum/" << name
+                   << " not found under $FORESIGHT_DATA or ../shared/data";
     DirectionalReadStats st;
     const DirectionalSamples s = ReadEdinburghTracks(path, HeadingFilter{}, &st);
     ExpectCounted(st);

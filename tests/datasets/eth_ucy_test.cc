@@ -13,9 +13,10 @@ TEST(EthUcy, ReadsTracksAndSplitsAtGaps) {
   testing::TempDir dir;
   const std::string path = dir.File("scene.txt");
   // Pedestrian 1: frames 0..30 then a gap to 60..70 (two tracks); pedestrian 2: 10..20.
-  testing::WriteText(path,
-                     "0\t1\t0.0\t0.0\n10\t1\t0.4\t0.0\n10\t2.0\t5.0\t5.0\n20\t1\t0.8\t0.0\n20\t2.0\t5.0\t5.4\n"
-                     "30\t1\t1.2\t0.0\n60\t1\t2.4\t0.0\n70\t1\t2.8\t0.0\n");
+  testing::WriteText(
+      path,
+      "0\t1\t0.0\t0.0\n10\t1\t0.4\t0.0\n10\t2.0\t5.0\t5.0\n20\t1\t0.8\t0.0\n20\t2.0\t5.0\t5.4\n"
+      "30\t1\t1.2\t0.0\n60\t1\t2.4\t0.0\n70\t1\t2.8\t0.0\n");
   EthUcyReadStats stats;
   const TrackSet set = ReadEthUcy(path, 0.4, &stats);
   EXPECT_EQ(stats.rows, 8u);
@@ -44,7 +45,8 @@ TEST(EthUcy, MalformedInputNamesFileAndLine) {
   check("0\t1\t0.0\t0.0\n0\t1\t1.0\t0.0\n", {"pedestrian 1", "twice in frame 0"});
   check("", {"no observations"});
   check("0\t1.5\t0.0\t0.0\n", {":1:", "ped_id is not an integer"});
-  testing::ExpectErrorContains([] { ReadEthUcy("/nonexistent/eth.txt", 0.4); }, {"/nonexistent/eth.txt"});
+  testing::ExpectErrorContains([] { ReadEthUcy("/nonexistent/eth.txt", 0.4); },
+                               {"/nonexistent/eth.txt"});
 }
 
 TEST(EthUcy, ReadsEveryRealSceneWhenPresent) {

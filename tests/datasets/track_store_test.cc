@@ -35,7 +35,8 @@ TEST(TrackStore, RejectsForeignAndCorruptFiles) {
     h5::File f = h5::File::Create(dir.File("other.h5"));
     f.SetAttr("/", "kind", std::string("something.else"));
   }
-  testing::ExpectErrorContains([&] { ReadTrackStore(dir.File("other.h5")); }, {"other.h5", "not a foresight track store"});
+  testing::ExpectErrorContains([&] { ReadTrackStore(dir.File("other.h5")); },
+                               {"other.h5", "not a foresight track store"});
   SyntheticPedestrianConfig cfg;
   cfg.num_tracks = 200;
   WriteTrackStore(dir.File("t.h5"), GenerateSyntheticPedestrians(cfg));
@@ -67,7 +68,8 @@ TEST(TrackStore, RejectsANonPositiveTimeStep) {
   for (const double step : {-1.0, 0.0, std::nan("")}) {
     set.seconds_per_step = step;
     WriteTrackStore(dir.File("bad.h5"), set);
-    testing::ExpectErrorContains([&] { ReadTrackStore(dir.File("bad.h5")); }, {"bad.h5", "seconds_per_step"});
+    testing::ExpectErrorContains([&] { ReadTrackStore(dir.File("bad.h5")); },
+                                 {"bad.h5", "seconds_per_step"});
   }
 }
 
@@ -76,8 +78,9 @@ TEST(TrackStore, RejectsOffsetsOutsideThePoints) {
   const std::string path = dir.File("offsets.h5");
   WriteStoreWithOffsets(path, {0, 2, 2, 5});
   EXPECT_EQ(ReadTrackStore(path).tracks[1].size(), 0);  // an empty track is allowed
-  WriteStoreWithOffsets(path, {0, 7, 3, 5});  // track 0 runs past the last point
-  testing::ExpectErrorContains([&] { ReadTrackStore(path); }, {path, "/tracks/offsets", "track 0", "[0, 7)"});
+  WriteStoreWithOffsets(path, {0, 7, 3, 5});            // track 0 runs past the last point
+  testing::ExpectErrorContains([&] { ReadTrackStore(path); },
+                               {path, "/tracks/offsets", "track 0", "[0, 7)"});
   WriteStoreWithOffsets(path, {0, -2, 4, 5});
   testing::ExpectErrorContains([&] { ReadTrackStore(path); }, {path, "track 0", "[0, -2)"});
   WriteStoreWithOffsets(path, {0, 3, 2, 5});
@@ -123,7 +126,11 @@ TEST(Windows, CutsEveryWindowAndSplitsDeterministically) {
   EXPECT_EQ(s1.train.tracks.size() + s1.val.tracks.size() + s1.test.tracks.size(), 3u);
   EXPECT_EQ(s1.val.tracks[0].agent_id, s2.val.tracks[0].agent_id);
   set.tracks[0].time[5] += 0.1;  // not uniformly sampled
-  testing::ExpectErrorContains([&] { MakeWindows(set, WindowConfig{8, 12, 1}); }, {"not sampled every 0.4 s"});
+  testing::ExpectErrorContains(
+      [&] {
+        MakeWindows(set, WindowConfig{8, 12, 1});
+      },
+      {"not sampled every 0.4 s"});
 }
 
 }  // namespace

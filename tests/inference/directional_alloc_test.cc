@@ -6,22 +6,24 @@
 #include <cmath>
 
 #include "inference/directional/directional_map.h"
-#include "tests/inference/directional_test_util.h"
-
 #include "tests/alloc_counter.h"  // replaces operator new: one per binary
+#include "tests/inference/directional_test_util.h"
 
 namespace foresight {
 namespace {
 
 TEST(DirectionalMapQueries, AllocateNothingWhenSized) {
-  for (const DirectionalVariant v : {DirectionalVariant::kSpatiotemporal, DirectionalVariant::kSpatial}) {
-    const DirectionalMap m = testing::RandomDirectionalMap(v, testing::SmallFeatureConfig(), 16, 5, 1);
+  for (const DirectionalVariant v :
+       {DirectionalVariant::kSpatiotemporal, DirectionalVariant::kSpatial}) {
+    const DirectionalMap m =
+        testing::RandomDirectionalMap(v, testing::SmallFeatureConfig(), 16, 5, 1);
     auto ws = m.MakeWorkspace();
     const int n = 300;
     // Inside, outside the extent, outside the time range.
     const Eigen::VectorXd x = Eigen::VectorXd::Random(n) * 12.0 + Eigen::VectorXd::Constant(n, 5.0);
     const Eigen::VectorXd y = Eigen::VectorXd::Random(n) * 8.0 + Eigen::VectorXd::Constant(n, 2.0);
-    const Eigen::VectorXd t = Eigen::VectorXd::Random(n) * 80.0 + Eigen::VectorXd::Constant(n, 30.0);
+    const Eigen::VectorXd t =
+        Eigen::VectorXd::Random(n) * 80.0 + Eigen::VectorXd::Constant(n, 30.0);
     const Eigen::VectorXd theta = Eigen::VectorXd::Random(n) * 3.0;
     VonMisesMixtureBatch batch;
     Eigen::VectorXd density(n);

@@ -1,12 +1,13 @@
 // Kernel features and the directional-map engine against independent computations (torch-free).
 
+#include "inference/directional/directional_map.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
 
 #include "core/von_mises.h"
-#include "inference/directional/directional_map.h"
 #include "inference/directional/features.h"
 #include "inference/prediction/span_predictor.h"
 #include "tests/inference/directional_test_util.h"
@@ -34,8 +35,9 @@ TEST(DirectionalFeatures, KernelsMatchClosedFormAndCutoff) {
     f.Spatial(x, y, phi);
     for (int j = 0; j < f.spatial_size(); ++j) {
       const double d2 = (Eigen::Vector2d(x, y) - f.SpatialPoint(j)).squaredNorm();
-      const double expected = d2 > std::pow(c.cutoff * c.length_scale, 2) ? 0.0
-                                                                           : std::exp(-d2 / (2 * c.length_scale * c.length_scale));
+      const double expected = d2 > std::pow(c.cutoff * c.length_scale, 2)
+                                  ? 0.0
+                                  : std::exp(-d2 / (2 * c.length_scale * c.length_scale));
       EXPECT_NEAR(phi[j], expected, 1e-7) << x << " " << y << " j " << j;
     }
     f.Temporal(t, phit);
@@ -98,7 +100,8 @@ Eigen::VectorXf ReferenceRaw(const DirectionalMap& m, double x, double y, double
 class EngineVariants : public ::testing::TestWithParam<DirectionalVariant> {};
 
 TEST_P(EngineVariants, MatchesDenseReferenceAndIsAProperMixture) {
-  const DirectionalMap m = testing::RandomDirectionalMap(GetParam(), SmallFeatureConfig(), 12, 5, 4);
+  const DirectionalMap m =
+      testing::RandomDirectionalMap(GetParam(), SmallFeatureConfig(), 12, 5, 4);
   auto ws = m.MakeWorkspace();
   std::mt19937_64 rng(8);
   std::uniform_real_distribution<double> ux(-3, 13), uy(-5, 9), ut(-10, 70);
@@ -106,7 +109,8 @@ TEST_P(EngineVariants, MatchesDenseReferenceAndIsAProperMixture) {
     const double x = ux(rng), y = uy(rng), t = ut(rng);
     m.RawOutput(x, y, t, &ws);
     const Eigen::VectorXf ref = ReferenceRaw(m, x, y, t);
-    for (int k = 0; k < ref.size(); ++k) EXPECT_NEAR(ws.raw[k], ref[k], 1e-5 * std::max(1.0f, std::abs(ref[k])));
+    for (int k = 0; k < ref.size(); ++k)
+      EXPECT_NEAR(ws.raw[k], ref[k], 1e-5 * std::max(1.0f, std::abs(ref[k])));
     m.QueryOne(x, y, t, &ws);
     EXPECT_NEAR(ws.alpha.sum(), 1.0, 1e-12);
     EXPECT_TRUE((ws.kappa.array() > 0).all());
@@ -121,12 +125,14 @@ TEST_P(EngineVariants, MatchesDenseReferenceAndIsAProperMixture) {
     if (ws.kappa.maxCoeff() < 1e4) {
       EXPECT_NEAR(d.sum() * 2 * M_PI / n, 1.0, 1e-6);
     }
-    EXPECT_NEAR(d[17], std::exp(VonMisesMixtureLogDensity(th[17], ws.alpha, ws.mu, ws.kappa)), 1e-12);
+    EXPECT_NEAR(d[17], std::exp(VonMisesMixtureLogDensity(th[17], ws.alpha, ws.mu, ws.kappa)),
+                1e-12);
   }
 }
 
 TEST_P(EngineVariants, QueriesOutsideTheGridAndTimeRange) {
-  const DirectionalMap m = testing::RandomDirectionalMap(GetParam(), SmallFeatureConfig(), 12, 5, 6);
+  const DirectionalMap m =
+      testing::RandomDirectionalMap(GetParam(), SmallFeatureConfig(), 12, 5, 6);
   auto ws = m.MakeWorkspace();
   // t is clamped to [t_min, t_max] = [0, 60].
   m.QueryOne(4.0, 2.0, 60.0, &ws);
@@ -164,15 +170,18 @@ TEST_P(EngineVariants, QueriesOutsideTheGridAndTimeRange) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Directional, EngineVariants,
-                         ::testing::Values(DirectionalVariant::kSpatiotemporal, DirectionalVariant::kSpatial),
+                         ::testing::Values(DirectionalVariant::kSpatiotemporal,
+                                           DirectionalVariant::kSpatial),
                          [](const ::testing::TestParamInfo<DirectionalVariant>& p) {
                            return std::string(VariantName(p.param));
                          });
 
 TEST(DirectionalArtifact, RoundTripAndWrongKinds) {
   testing::TempDir dir;
-  for (const DirectionalVariant v : {DirectionalVariant::kSpatiotemporal, DirectionalVariant::kSpatial}) {
-    const DirectionalMap m = testing::RandomDirectionalMap(v, SmallFeatureConfig(), 8, 3, 2, 2.0f, 50.0);
+  for (const DirectionalVariant v :
+       {DirectionalVariant::kSpatiotemporal, DirectionalVariant::kSpatial}) {
+    const DirectionalMap m =
+        testing::RandomDirectionalMap(v, SmallFeatureConfig(), 8, 3, 2, 2.0f, 50.0);
     const std::string path = dir.File(std::string(VariantName(v)) + ".h5");
     m.Save(path, "model: directional\n", 0);
     const DirectionalMap loaded = DirectionalMap::Load(path);
@@ -191,16 +200,20 @@ TEST(DirectionalArtifact, RoundTripAndWrongKinds) {
   testing::WriteRandomSpanArtifact(span, {});
   testing::ExpectErrorContains([&] { DirectionalMap::Load(span); },
                                {span, "'span_predictor'", "expected 'directional_map'"});
-  testing::ExpectErrorContains([&] { DirectionalMap::Load(dir.File("missing.h5")); }, {"missing.h5"});
+  testing::ExpectErrorContains([&] { DirectionalMap::Load(dir.File("missing.h5")); },
+                               {"missing.h5"});
   // Inconsistent tensors: an LSTM that does not take M_s inputs.
   DirectionalFeatureConfig other = SmallFeatureConfig();
   other.cells_x = 6;
-  const DirectionalMap good = testing::RandomDirectionalMap(DirectionalVariant::kSpatiotemporal, other, 8, 3, 2);
+  const DirectionalMap good =
+      testing::RandomDirectionalMap(DirectionalVariant::kSpatiotemporal, other, 8, 3, 2);
   // The features of the 5 x 4 grid with the LSTM of the 6 x 4 grid.
-  const DirectionalMap small = testing::RandomDirectionalMap(DirectionalVariant::kSpatiotemporal, SmallFeatureConfig(), 8, 3, 2);
+  const DirectionalMap small = testing::RandomDirectionalMap(DirectionalVariant::kSpatiotemporal,
+                                                             SmallFeatureConfig(), 8, 3, 2);
   testing::ExpectErrorContains(
       [&] {
-        DirectionalMap(DirectionalVariant::kSpatiotemporal, SmallFeatureConfig(), good.lstm(), small.heads());
+        DirectionalMap(DirectionalVariant::kSpatiotemporal, SmallFeatureConfig(), good.lstm(),
+                       small.heads());
       },
       {"LSTM takes 24 inputs", "M_s = 20"});
 }

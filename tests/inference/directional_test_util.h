@@ -28,22 +28,28 @@ inline DirectionalFeatureConfig SmallFeatureConfig() {
 }
 
 /// Random LSTM and heads; weights ~ N(0, scale^2).
-inline DirectionalMap RandomDirectionalMap(DirectionalVariant v, const DirectionalFeatureConfig& f, int hidden,
-                                           int components, std::uint64_t seed, float scale = 0.5f,
+inline DirectionalMap RandomDirectionalMap(DirectionalVariant v, const DirectionalFeatureConfig& f,
+                                           int hidden, int components, std::uint64_t seed,
+                                           float scale = 0.5f,
                                            double max_kappa = kDirectionalDefaultMaxKappa) {
   std::mt19937_64 rng(seed);
   std::normal_distribution<float> n(0.0f, scale);
-  auto mat = [&](long r, long c) { return Eigen::MatrixXf(Eigen::MatrixXf::NullaryExpr(r, c, [&] { return n(rng); })); };
-  auto vec = [&](long r) { return Eigen::VectorXf(Eigen::VectorXf::NullaryExpr(r, [&] { return n(rng); })); };
+  auto mat = [&](long r, long c) {
+    return Eigen::MatrixXf(Eigen::MatrixXf::NullaryExpr(r, c, [&] { return n(rng); }));
+  };
+  auto vec = [&](long r) {
+    return Eigen::VectorXf(Eigen::VectorXf::NullaryExpr(r, [&] { return n(rng); }));
+  };
   const int ms = f.cells_x * f.cells_y;
   Lstm lstm;
   int d = ms;
   if (v == DirectionalVariant::kSpatiotemporal) {
-    lstm = Lstm(LstmWeights{mat(4 * hidden, ms), mat(4 * hidden, hidden), vec(4 * hidden), vec(4 * hidden)});
+    lstm = Lstm(LstmWeights{mat(4 * hidden, ms), mat(4 * hidden, hidden), vec(4 * hidden),
+                            vec(4 * hidden)});
     d = hidden;
   }
-  DirectionalHeads h{mat(components, d), mat(components, d), mat(components, d), vec(components), vec(components),
-                     vec(components)};
+  DirectionalHeads h{mat(components, d), mat(components, d), mat(components, d),
+                     vec(components),    vec(components),    vec(components)};
   return DirectionalMap(v, f, std::move(lstm), std::move(h), max_kappa);
 }
 

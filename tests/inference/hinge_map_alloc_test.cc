@@ -9,9 +9,8 @@
 
 #include "inference/mapping/grid_map.h"
 #include "inference/mapping/hinge_map.h"
-#include "tests/occupancy_test_util.h"
-
 #include "tests/alloc_counter.h"  // replaces operator new: one per binary
+#include "tests/occupancy_test_util.h"
 
 namespace foresight {
 namespace {

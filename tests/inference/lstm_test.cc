@@ -1,12 +1,13 @@
 // The Eigen LSTM layer against a hand-written double-precision reference of PyTorch's equations.
 
+#include "inference/engine/lstm.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
 
 #include "core/h5.h"
-#include "inference/engine/lstm.h"
 #include "tests/test_util.h"
 
 namespace foresight {
@@ -35,7 +36,8 @@ Eigen::VectorXd ReferenceLstm(const LstmWeights& w, const Eigen::MatrixXd& seq) 
       for (int gate = 0; gate < 4; ++gate) {
         const int row = gate * h + j;
         double s = static_cast<double>(w.bias_ih[row]) + static_cast<double>(w.bias_hh[row]);
-        for (Eigen::Index i = 0; i < seq.cols(); ++i) s += static_cast<double>(w.weight_ih(row, i)) * seq(k, i);
+        for (Eigen::Index i = 0; i < seq.cols(); ++i)
+          s += static_cast<double>(w.weight_ih(row, i)) * seq(k, i);
         for (int i = 0; i < h; ++i) s += static_cast<double>(w.weight_hh(row, i)) * hs[i];
         pre[gate] = s;
       }
@@ -50,7 +52,8 @@ Eigen::VectorXd ReferenceLstm(const LstmWeights& w, const Eigen::MatrixXd& seq) 
 }
 
 TEST(Lstm, MatchesHandWrittenReference) {
-  for (const auto& [in, h, steps] : std::vector<std::tuple<int, int, int>>{{1, 1, 1}, {3, 4, 5}, {17, 8, 9}, {40, 20, 3}}) {
+  for (const auto& [in, h, steps] :
+       std::vector<std::tuple<int, int, int>>{{1, 1, 1}, {3, 4, 5}, {17, 8, 9}, {40, 20, 3}}) {
     const LstmWeights w = RandomWeights(in, h, 5 + in);
     const Lstm lstm(w);
     EXPECT_EQ(lstm.input_size(), in);
@@ -61,7 +64,8 @@ TEST(Lstm, MatchesHandWrittenReference) {
     const Eigen::VectorXd ref = ReferenceLstm(w, seq.cast<float>().cast<double>());
     auto ws = lstm.MakeWorkspace();
     const Eigen::VectorXf out = lstm.Forward(seq.cast<float>(), &ws);
-    for (int j = 0; j < h; ++j) EXPECT_NEAR(out[j], ref[j], 2e-5) << in << " " << h << " unit " << j;
+    for (int j = 0; j < h; ++j)
+      EXPECT_NEAR(out[j], ref[j], 2e-5) << in << " " << h << " unit " << j;
     // Step by step, and with a precomputed scaled projection, give the same state.
     lstm.Reset(&ws);
     for (int k = 0; k < steps; ++k) lstm.Step(seq.row(k).transpose().cast<float>(), &ws);

@@ -18,7 +18,8 @@
 namespace foresight {
 namespace {
 
-Eigen::Matrix<double, Eigen::Dynamic, 2> Walk(int p, double heading, double speed, Eigen::Vector2d start) {
+Eigen::Matrix<double, Eigen::Dynamic, 2> Walk(int p, double heading, double speed,
+                                              Eigen::Vector2d start) {
   Eigen::Matrix<double, Eigen::Dynamic, 2> past(p, 2);
   for (int i = 0; i < p; ++i)
     past.row(i) = (start + 0.4 * i * speed * Eigen::Vector2d(std::cos(heading), std::sin(heading)) +
@@ -48,7 +49,8 @@ TEST_P(SpanEngine, EvaluationAllocatesNothingAfterSetUp) {
   std::vector<TrajectoryDistribution> outs(4, model.MakeDistribution());
   Eigen::MatrixXd batch(4, 2 * model.observed());
   for (int k = 0; k < 4; ++k)
-    for (int i = 0; i < model.observed(); ++i) batch.row(k).segment<2>(2 * i) = past.row(i) + Eigen::RowVector2d(k, 0);
+    for (int i = 0; i < model.observed(); ++i)
+      batch.row(k).segment<2>(2 * i) = past.row(i) + Eigen::RowVector2d(k, 0);
   model.Predict(past, &ws, &dist);  // warm-up
   g_allocations = 0;
   g_counting = true;
@@ -78,7 +80,8 @@ TEST_P(SpanEngine, PredictionsAreRotationAndTranslationEquivariant) {
   rot << std::cos(angle), -std::sin(angle), std::sin(angle), std::cos(angle);
   const Eigen::Vector2d shift(5, -3);
   Eigen::Matrix<double, Eigen::Dynamic, 2> moved = past;
-  for (int i = 0; i < past.rows(); ++i) moved.row(i) = (rot * past.row(i).transpose() + shift).transpose();
+  for (int i = 0; i < past.rows(); ++i)
+    moved.row(i) = (rot * past.row(i).transpose() + shift).transpose();
   model.Predict(past, &ws, &a);
   model.Predict(moved, &ws, &b);
   for (double t : {0.4, 2.0, 4.8}) {
@@ -165,9 +168,10 @@ TEST_P(SpanEngine, BatchEqualsSingleCalls) {
 
 INSTANTIATE_TEST_SUITE_P(
     Heads, SpanEngine,
-    ::testing::Values(testing::RandomSpanSpec{},
-                      testing::RandomSpanSpec{8, 12, 6, 3, UParam::kDiagonal, {16}, 0.4, true, 4, true},
-                      testing::RandomSpanSpec{5, 10, 4, 2, UParam::kCholesky, {8, 8, 8}, 0.1, false, 9}),
+    ::testing::Values(
+        testing::RandomSpanSpec{},
+        testing::RandomSpanSpec{8, 12, 6, 3, UParam::kDiagonal, {16}, 0.4, true, 4, true},
+        testing::RandomSpanSpec{5, 10, 4, 2, UParam::kCholesky, {8, 8, 8}, 0.1, false, 9}),
     [](const ::testing::TestParamInfo<testing::RandomSpanSpec>& p) {
       return "R" + std::to_string(p.param.components) + "_" + UParamName(p.param.u_param) +
              (p.param.rotate ? "_ego" : "_world") + (p.param.residual_cv ? "_cv" : "");
@@ -183,7 +187,11 @@ TEST(SpanEngineErrors, BadInputIsAClearError) {
   Eigen::Matrix<double, Eigen::Dynamic, 2> past = Walk(8, 0, 1, {0, 0});
   past(3, 1) = NAN;
   testing::ExpectErrorContains([&] { model.Predict(past, &ws, &dist); }, {"NaN"});
-  testing::ExpectErrorContains([&] { model.Predict(Walk(5, 0, 1, {0, 0}), &ws, &dist); }, {"expected 8 observed points, got 5"});
+  testing::ExpectErrorContains(
+      [&] {
+        model.Predict(Walk(5, 0, 1, {0, 0}), &ws, &dist);
+      },
+      {"expected 8 observed points, got 5"});
 }
 
 TEST(SpanEngineErrors, OutputOfAnotherLayoutIsAnError) {
@@ -200,17 +208,21 @@ TEST(SpanEngineErrors, OutputOfAnotherLayoutIsAnError) {
                                  {"output distribution has", "the model predicts 1 over 6"});
     std::vector<TrajectoryDistribution> outs{a.MakeDistribution(), dist};
     Eigen::MatrixXd batch(2, 16);
-    batch.row(0) = batch.row(1) = Eigen::Map<const Eigen::RowVectorXd>(Eigen::MatrixXd(past.transpose()).data(), 16);
-    testing::ExpectErrorContains([&] { a.PredictBatch(batch, &ws, &outs); }, {"output distribution has"});
+    batch.row(0) = batch.row(1) =
+        Eigen::Map<const Eigen::RowVectorXd>(Eigen::MatrixXd(past.transpose()).data(), 16);
+    testing::ExpectErrorContains([&] { a.PredictBatch(batch, &ws, &outs); },
+                                 {"output distribution has"});
   }
   TrajectoryDistribution empty;
-  testing::ExpectErrorContains([&] { a.Predict(past, &ws, &empty); }, {"0 components over 0 basis functions"});
+  testing::ExpectErrorContains([&] { a.Predict(past, &ws, &empty); },
+                               {"0 components over 0 basis functions"});
 }
 
 TEST(SpanEngineErrors, TruncatedForeignAndWrongTypeArtifacts) {
   testing::TempDir dir;
   const std::string path = dir.File("model.h5");
-  testing::WriteRandomSpanArtifact(path, {8, 12, 6, 1, UParam::kCholesky, {256, 256}, 0.4, true, 1});
+  testing::WriteRandomSpanArtifact(path,
+                                   {8, 12, 6, 1, UParam::kCholesky, {256, 256}, 0.4, true, 1});
   {
     std::string copy = dir.File("copy.h5");
     std::filesystem::copy_file(path, copy);
@@ -230,7 +242,8 @@ TEST(SpanEngineErrors, TruncatedForeignAndWrongTypeArtifacts) {
     Artifact::WriteHeader(&f, kSpanModelType, "", 0);
     f.SetAttr("/", "format_version", std::int64_t{99});
   }
-  testing::ExpectErrorContains([&] { SpanPredictor::Load(dir.File("future.h5")); }, {"format_version 99"});
+  testing::ExpectErrorContains([&] { SpanPredictor::Load(dir.File("future.h5")); },
+                               {"format_version 99"});
 }
 
 // Issue 18, defect 7: edited attributes are refused with the file, the attribute and the value,
@@ -246,9 +259,11 @@ TEST(SpanEngineErrors, EditedAttributesAreRefusedWithFileAndValue) {
     return path;
   };
   const std::string wide = edited("observed", (std::int64_t{1} << 32) + 8);
-  testing::ExpectErrorContains([&] { SpanPredictor::Load(wide); }, {wide, "/model/observed", "4294967304"});
+  testing::ExpectErrorContains([&] { SpanPredictor::Load(wide); },
+                               {wide, "/model/observed", "4294967304"});
   const std::string step = edited("seconds_per_step", std::nan(""));
-  testing::ExpectErrorContains([&] { SpanPredictor::Load(step); }, {step, "seconds_per_step", "nan"});
+  testing::ExpectErrorContains([&] { SpanPredictor::Load(step); },
+                               {step, "seconds_per_step", "nan"});
   const std::string gamma = edited("basis_gamma", -1.0);
   testing::ExpectErrorContains([&] { SpanPredictor::Load(gamma); }, {gamma, "basis_gamma", "-1"});
   const std::string many = edited("components", std::int64_t{1} << 40);

@@ -1,28 +1,28 @@
-#include "models/directional/grid_map.h"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
 
 #include "core/von_mises.h"
-#include "tests/test_util.h"
-
+#include "models/directional/grid_map.h"
 #include "tests/alloc_counter.h"  // replaces operator new: one per binary
+#include "tests/test_util.h"
 
 namespace foresight {
 namespace {
 
-/// n samples uniform in the box [x0, x1] x [y0, y1] with headings from the mixture (alpha, mu, kappa).
+/// n samples uniform in the box [x0, x1] x [y0, y1] with headings from the mixture (alpha, mu,
+/// kappa).
 void AddSamples(int n, double x0, double x1, double y0, double y1, const std::vector<double>& alpha,
-                const std::vector<double>& mu, const std::vector<double>& kappa, std::mt19937_64* rng,
-                std::vector<std::array<double, 3>>* out) {
+                const std::vector<double>& mu, const std::vector<double>& kappa,
+                std::mt19937_64* rng, std::vector<std::array<double, 3>>* out) {
   std::uniform_real_distribution<double> u(0, 1);
   for (int i = 0; i < n; ++i) {
     double pick = u(*rng);
     std::size_t k = 0;
     while (k + 1 < alpha.size() && pick >= alpha[k]) pick -= alpha[k++];
-    out->push_back({x0 + (x1 - x0) * u(*rng), y0 + (y1 - y0) * u(*rng), SampleVonMises(mu[k], kappa[k], rng)});
+    out->push_back(
+        {x0 + (x1 - x0) * u(*rng), y0 + (y1 - y0) * u(*rng), SampleVonMises(mu[k], kappa[k], rng)});
   }
 }
 
@@ -54,7 +54,8 @@ DirectionalGridConfig TwoByTwo(GridDirectionalKind kind) {
 
 TEST(DirectionalGridMap, CellLayoutIsRowMajorOverXThenY) {
   DirectionalSamples s = ToSamples({{0.5, 0.5, 0.0}});
-  const DirectionalGridMap map = DirectionalGridMap::Fit(s, TwoByTwo(GridDirectionalKind::kUnimodal));
+  const DirectionalGridMap map =
+      DirectionalGridMap::Fit(s, TwoByTwo(GridDirectionalKind::kUnimodal));
   EXPECT_EQ(map.num_cells(), 4);
   EXPECT_EQ(map.CellIndex(0.5, 1.0), 0);
   EXPECT_EQ(map.CellIndex(1.5, 1.0), 1);
@@ -73,7 +74,8 @@ TEST(DirectionalGridMap, UnimodalRecoversEachCellAndEmptyCellsAreUniform) {
   AddSamples(4000, 0, 1, 0, 2, {1.0}, {mus[0]}, {kappas[0]}, &rng, &rows);  // cell 0
   AddSamples(4000, 1, 2, 0, 2, {1.0}, {mus[1]}, {kappas[1]}, &rng, &rows);  // cell 1
   AddSamples(4000, 0, 1, 2, 4, {1.0}, {mus[2]}, {kappas[2]}, &rng, &rows);  // cell 2; cell 3 empty
-  const DirectionalGridMap map = DirectionalGridMap::Fit(ToSamples(rows), TwoByTwo(GridDirectionalKind::kUnimodal));
+  const DirectionalGridMap map =
+      DirectionalGridMap::Fit(ToSamples(rows), TwoByTwo(GridDirectionalKind::kUnimodal));
   Eigen::VectorXd qx(5), qy(5);
   qx << 0.5, 1.5, 0.5, 1.5, 7.0;
   qy << 1.0, 1.0, 3.0, 3.0, -5.0;  // the last one is outside: nearest cell is cell 1
@@ -83,7 +85,8 @@ TEST(DirectionalGridMap, UnimodalRecoversEachCellAndEmptyCellsAreUniform) {
   ASSERT_EQ(out.alpha.cols(), 1);
   for (int cell = 0; cell < 3; ++cell) {
     EXPECT_EQ(out.alpha(cell, 0), 1.0);
-    EXPECT_NEAR(WrapAngle(out.mu(cell, 0) - mus[cell]), 0.0, 4 / std::sqrt(kappas[cell] * 4000)) << cell;
+    EXPECT_NEAR(WrapAngle(out.mu(cell, 0) - mus[cell]), 0.0, 4 / std::sqrt(kappas[cell] * 4000))
+        << cell;
     EXPECT_NEAR(out.kappa(cell, 0), kappas[cell], 0.08 * kappas[cell]) << cell;
   }
   EXPECT_EQ(out.alpha(3, 0), 1.0);
@@ -101,8 +104,9 @@ TEST(DirectionalGridMap, UnimodalRecoversEachCellAndEmptyCellsAreUniform) {
   std::vector<double> cell1;
   for (const auto& r : rows)
     if (r[0] >= 1 && r[1] < 2) cell1.push_back(r[2]);
-  const VonMisesFit ref = FitVonMises(Eigen::Map<Eigen::VectorXd>(cell1.data(), static_cast<Eigen::Index>(cell1.size())),
-                                      Eigen::VectorXd::Ones(static_cast<Eigen::Index>(cell1.size())));
+  const VonMisesFit ref = FitVonMises(
+      Eigen::Map<Eigen::VectorXd>(cell1.data(), static_cast<Eigen::Index>(cell1.size())),
+      Eigen::VectorXd::Ones(static_cast<Eigen::Index>(cell1.size())));
   EXPECT_NEAR(out.mu(1, 0), ref.mu, 1e-12);
   EXPECT_NEAR(out.kappa(1, 0), ref.kappa, 1e-9);
 }
@@ -125,8 +129,10 @@ TEST(DirectionalGridMap, MultimodalRecoversABimodalCellAndBeatsUnimodalOnAl) {
   AddSamples(2000, 0, 1, 0, 2, alpha, mu, kappa, &rng, &test_rows);
   const DirectionalSamples train = ToSamples(train_rows), test = ToSamples(test_rows);
 
-  const DirectionalGridMap mm = DirectionalGridMap::Fit(train, TwoByTwo(GridDirectionalKind::kMultimodal));
-  const DirectionalGridMap um = DirectionalGridMap::Fit(train, TwoByTwo(GridDirectionalKind::kUnimodal));
+  const DirectionalGridMap mm =
+      DirectionalGridMap::Fit(train, TwoByTwo(GridDirectionalKind::kMultimodal));
+  const DirectionalGridMap um =
+      DirectionalGridMap::Fit(train, TwoByTwo(GridDirectionalKind::kUnimodal));
   ASSERT_EQ(mm.output_components(), 3);
   // BIC picks two components in the bimodal cell, one in the unimodal cell.
   const auto& cells = mm.cells();
@@ -138,17 +144,21 @@ TEST(DirectionalGridMap, MultimodalRecoversABimodalCellAndBeatsUnimodalOnAl) {
   for (int j = 0; j < 2; ++j) {
     int k = 0;  // the fitted component nearest the true mean
     for (int m = 1; m < 3; ++m)
-      if (cells.alpha(0, m) > 0 && std::abs(WrapAngle(cells.mu(0, m) - mu[static_cast<std::size_t>(j)])) <
-                                       std::abs(WrapAngle(cells.mu(0, k) - mu[static_cast<std::size_t>(j)])))
+      if (cells.alpha(0, m) > 0 &&
+          std::abs(WrapAngle(cells.mu(0, m) - mu[static_cast<std::size_t>(j)])) <
+              std::abs(WrapAngle(cells.mu(0, k) - mu[static_cast<std::size_t>(j)])))
         k = m;
     EXPECT_NEAR(WrapAngle(cells.mu(0, k) - mu[static_cast<std::size_t>(j)]), 0.0, 0.05) << j;
     EXPECT_NEAR(cells.alpha(0, k), alpha[static_cast<std::size_t>(j)], 0.03) << j;
-    EXPECT_NEAR(cells.kappa(0, k), kappa[static_cast<std::size_t>(j)], 0.15 * kappa[static_cast<std::size_t>(j)]) << j;
+    EXPECT_NEAR(cells.kappa(0, k), kappa[static_cast<std::size_t>(j)],
+                0.15 * kappa[static_cast<std::size_t>(j)])
+        << j;
   }
   VonMisesMixtureBatch out_mm, out_um;
   mm.Query(test.x, test.y, &out_mm);
   um.Query(test.x, test.y, &out_um);
-  const double al_mm = AverageLikelihood(out_mm, test.theta), al_um = AverageLikelihood(out_um, test.theta);
+  const double al_mm = AverageLikelihood(out_mm, test.theta),
+               al_um = AverageLikelihood(out_um, test.theta);
   // True mixture's AL for reference: MM should be close to it, UM well below.
   VonMisesMixtureBatch truth;
   truth.Resize(test.size(), 2);
@@ -185,7 +195,9 @@ TEST(DirectionalGridMap, DbscanCountsModesAndKMeansRulesAreSelectable) {
   const DirectionalSamples s = ToSamples(rows);
   DirectionalGridConfig c = TwoByTwo(GridDirectionalKind::kMultimodal);
   c.components = 5;
-  auto active = [](const DirectionalGridMap& m) { return (m.cells().alpha.row(0).array() > 0).count(); };
+  auto active = [](const DirectionalGridMap& m) {
+    return (m.cells().alpha.row(0).array() > 0).count();
+  };
   EXPECT_EQ(active(DirectionalGridMap::Fit(s, c)), 3);
   c.components = 2;  // keeps the two largest clusters
   const DirectionalGridMap two = DirectionalGridMap::Fit(s, c);
@@ -229,8 +241,9 @@ TEST(DirectionalGridMap, DenseBlendsNearbyDiscsWithRbfWeights) {
     std::vector<double> th;
     for (const auto& r : rows)
       if (std::hypot(r[0] - centre.x(), r[1] - centre.y()) <= 1.0) th.push_back(r[2]);
-    const VonMisesFit f = FitVonMises(Eigen::Map<Eigen::VectorXd>(th.data(), static_cast<Eigen::Index>(th.size())),
-                                      Eigen::VectorXd::Ones(static_cast<Eigen::Index>(th.size())));
+    const VonMisesFit f =
+        FitVonMises(Eigen::Map<Eigen::VectorXd>(th.data(), static_cast<Eigen::Index>(th.size())),
+                    Eigen::VectorXd::Ones(static_cast<Eigen::Index>(th.size())));
     return std::make_pair(f, static_cast<int>(th.size()));
   };
   Eigen::VectorXd qx(3), qy(3);
@@ -257,9 +270,11 @@ TEST(DirectionalGridMap, DenseBlendsNearbyDiscsWithRbfWeights) {
     // Compare the densities at a few headings (column order is an implementation detail).
     for (Eigen::Index j = 0; j < theta.size(); ++j) {
       double ref = 0;
-      for (const auto& [w, f] : parts) ref += w / total * std::exp(VonMisesLogDensity(theta[j], f.mu, f.kappa));
+      for (const auto& [w, f] : parts)
+        ref += w / total * std::exp(VonMisesLogDensity(theta[j], f.mu, f.kappa));
       const double got = std::exp(VonMisesMixtureLogDensity(theta[j], out.alpha.row(i).transpose(),
-                                                            out.mu.row(i).transpose(), out.kappa.row(i).transpose()));
+                                                            out.mu.row(i).transpose(),
+                                                            out.kappa.row(i).transpose()));
       EXPECT_NEAR(got, ref, 1e-10 * ref) << i << " " << j;
     }
   }
@@ -274,7 +289,8 @@ TEST(DirectionalGridMap, DenseAnswersUniformFarFromData) {
   c.dense = true;
   c.kind = GridDirectionalKind::kMultimodal;
   c.components = 2;
-  const DirectionalGridMap map = DirectionalGridMap::Fit(ToSamples({{0.5, 0.5, 1.0}, {0.6, 0.4, 1.2}}), c);
+  const DirectionalGridMap map =
+      DirectionalGridMap::Fit(ToSamples({{0.5, 0.5, 1.0}, {0.6, 0.4, 1.2}}), c);
   Eigen::VectorXd qx(2), qy(2);
   qx << 4.5, 0.5;
   qy << 4.5, 0.5;
@@ -291,7 +307,8 @@ TEST(DirectionalGridMap, QueryDoesNotAllocateWhenOutIsSized) {
   std::mt19937_64 rng(8);
   std::vector<std::array<double, 3>> rows;
   AddSamples(500, 0, 4, 0, 4, {0.5, 0.5}, {0.0, 2.0}, {5.0, 5.0}, &rng, &rows);
-  Eigen::VectorXd qx = Eigen::VectorXd::LinSpaced(300, -1, 5), qy = Eigen::VectorXd::LinSpaced(300, 5, -1);
+  Eigen::VectorXd qx = Eigen::VectorXd::LinSpaced(300, -1, 5),
+                  qy = Eigen::VectorXd::LinSpaced(300, 5, -1);
   for (bool dense : {false, true}) {
     DirectionalGridConfig c;
     c.kind = GridDirectionalKind::kMultimodal;
@@ -327,13 +344,18 @@ TEST(DirectionalGridMap, BadInputIsAnError) {
   c = TwoByTwo(GridDirectionalKind::kMultimodal);
   c.components = 0;
   testing::ExpectErrorContains([&] { DirectionalGridMap::Fit(s, c); }, {"components 0"});
-  testing::ExpectErrorContains([&] { DirectionalGridMap::Fit(DirectionalSamples(), TwoByTwo(GridDirectionalKind::kUnimodal)); },
-                               {"training data", "no direction samples"});
+  testing::ExpectErrorContains(
+      [&] {
+        DirectionalGridMap::Fit(DirectionalSamples(), TwoByTwo(GridDirectionalKind::kUnimodal));
+      },
+      {"training data", "no direction samples"});
   DirectionalSamples nan = s;
   nan.x[0] = std::nan("");
-  testing::ExpectErrorContains([&] { DirectionalGridMap::Fit(nan, TwoByTwo(GridDirectionalKind::kUnimodal)); },
-                               {"training data", "not finite"});
-  const DirectionalGridMap map = DirectionalGridMap::Fit(s, TwoByTwo(GridDirectionalKind::kUnimodal));
+  testing::ExpectErrorContains(
+      [&] { DirectionalGridMap::Fit(nan, TwoByTwo(GridDirectionalKind::kUnimodal)); },
+      {"training data", "not finite"});
+  const DirectionalGridMap map =
+      DirectionalGridMap::Fit(s, TwoByTwo(GridDirectionalKind::kUnimodal));
   VonMisesMixtureBatch out;
   Eigen::VectorXd x(2), y(1);
   x << 0.5, std::nan("");

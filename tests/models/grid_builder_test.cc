@@ -222,7 +222,7 @@ TEST(GridBuilder, UnknownCellsAreOneHalfAfterLoadAndBeamsLeavingTheGridAreCut) {
     EXPECT_EQ(loaded.cell_type(), type);
     const double tol = type == CellType::kUint8 ? 0.5 / 254 : 1e-6;
     for (int ix = 45; ix < 50; ++ix) EXPECT_NEAR(At(loaded, ix, 5), 0.4, tol) << ix;
-    EXPECT_NEAR(At(loaded, 45, 15), 0.7, tol);  // end of the second beam (4.55, 1.55)
+    EXPECT_NEAR(At(loaded, 45, 15), 0.7, tol);        // end of the second beam (4.55, 1.55)
     EXPECT_TRUE(std::isnan(loaded.cells()(20, 20)));  // never seen: stored as unknown
     EXPECT_EQ(At(loaded, 0, 0), 0.5f);
   }

@@ -25,7 +25,8 @@ MatrixNormalMixture ToCore(const MatrixNormalParams& p, const HeadLayout& L, int
         for (int j = 0; j <= i; ++j) d.chol_u(i, j) = p.chol_u[b][r][i][j].item<double>();
       }
     }
-    d.chol_v << p.chol_v[b][r][0].item<double>(), 0, p.chol_v[b][r][1].item<double>(), p.chol_v[b][r][2].item<double>();
+    d.chol_v << p.chol_v[b][r][0].item<double>(), 0, p.chol_v[b][r][1].item<double>(),
+        p.chol_v[b][r][2].item<double>();
     mix.components.push_back(d);
   }
   return mix;
@@ -49,7 +50,8 @@ TEST_P(MixtureNllTest, MatchesIndependentMatrixNormalDensity) {
   const auto nll = MixtureNll(params, w, L);
   for (int b = 0; b < 4; ++b) {
     Eigen::MatrixXd wm(c.m, 2);
-    for (int i = 0; i < c.m; ++i) wm(i, 0) = w[b][i][0].item<double>(), wm(i, 1) = w[b][i][1].item<double>();
+    for (int i = 0; i < c.m; ++i)
+      wm(i, 0) = w[b][i][0].item<double>(), wm(i, 1) = w[b][i][1].item<double>();
     EXPECT_NEAR(nll[b].item<double>(), -ToCore(params, L, b).LogPdf(wm), 1e-9);
   }
 }
@@ -78,8 +80,10 @@ TEST_P(MixtureNllTest, GradientMatchesFiniteDifferences) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Heads, MixtureNllTest,
-                         ::testing::Values(Case{1, 1, UParam::kCholesky}, Case{6, 1, UParam::kCholesky},
-                                           Case{6, 1, UParam::kDiagonal}, Case{5, 3, UParam::kDiagonal},
+                         ::testing::Values(Case{1, 1, UParam::kCholesky},
+                                           Case{6, 1, UParam::kCholesky},
+                                           Case{6, 1, UParam::kDiagonal},
+                                           Case{5, 3, UParam::kDiagonal},
                                            Case{4, 2, UParam::kCholesky}));
 
 TEST(SpanNet, LayerNamesAreTheArtifactTensorNames) {
@@ -89,9 +93,10 @@ TEST(SpanNet, LayerNamesAreTheArtifactTensorNames) {
   EXPECT_EQ(net->DenseLayerNames(), (std::vector<std::string>{"mlp.0", "mlp.2", "head"}));
   std::vector<std::string> keys;
   for (const auto& p : net->named_parameters()) keys.push_back(p.key());
-  EXPECT_EQ(keys, (std::vector<std::string>{"mlp.0.weight", "mlp.0.bias", "mlp.2.weight", "mlp.2.bias",
-                                            "head.weight", "head.bias"}));
-  EXPECT_EQ(net->forward(torch::zeros({3, 16})).size(1), HeadLayout({4, 1, UParam::kCholesky}).Total());
+  EXPECT_EQ(keys, (std::vector<std::string>{"mlp.0.weight", "mlp.0.bias", "mlp.2.weight",
+                                            "mlp.2.bias", "head.weight", "head.bias"}));
+  EXPECT_EQ(net->forward(torch::zeros({3, 16})).size(1),
+            HeadLayout({4, 1, UParam::kCholesky}).Total());
 }
 
 }  // namespace

@@ -23,7 +23,8 @@ TEST(ChanceBound, UpperBoundsTheMonteCarloProbability) {
   std::mt19937_64 rng(7);
   std::normal_distribution<double> n01;
   for (int trial = 0; trial < 12; ++trial) {
-    const Eigen::Vector2d mean(std::uniform_real_distribution<double>(-1.5, 1.5)(rng), 0.3 * trial - 1.5);
+    const Eigen::Vector2d mean(std::uniform_real_distribution<double>(-1.5, 1.5)(rng),
+                               0.3 * trial - 1.5);
     Eigen::Matrix2d l;
     l << 0.2 + 0.05 * trial, 0, 0.1, 0.3;
     const Eigen::Matrix2d cov = l * l.transpose();
@@ -87,7 +88,6 @@ TEST(CrowdForecast, StandingPedestriansCollideWithinTheSumOfRadii) {
   EXPECT_EQ(f.MaxBound(1, Eigen::Vector2d(2.5, 0), 0.8), 0.0);
 }
 
-
 TEST(CrowdForecast, TablesThePredictorAndAgreesWithTheBoundByBruteForce) {
   for (int components : {1, 3}) {
     testing::TempDir dir;
@@ -120,7 +120,8 @@ TEST(CrowdForecast, TablesThePredictorAndAgreesWithTheBoundByBruteForce) {
       const int k = 1 + i % 20;
       const double bound = f.MaxBound(k, x, 0.8);
       if (std::abs(bound - 0.25) < 1e-6) continue;
-      EXPECT_EQ(f.Collides(k, x, 0.8, t), bound > 0.25) << "k " << k << " x " << x.transpose() << " bound " << bound;
+      EXPECT_EQ(f.Collides(k, x, 0.8, t), bound > 0.25)
+          << "k " << k << " x " << x.transpose() << " bound " << bound;
       ++checked;
     }
     EXPECT_GT(checked, 2900);

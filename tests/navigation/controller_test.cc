@@ -17,7 +17,8 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-/// 12 m x 8 m free room with 0.1 m cells; `wall` adds a vertical wall at x = 5 with a gap at y in [5, 6.5].
+/// 12 m x 8 m free room with 0.1 m cells; `wall` adds a vertical wall at x = 5 with a gap at y in
+/// [5, 6.5].
 GridMap Room(bool wall) {
   GridGeometry g;
   g.x_min = -1;
@@ -40,7 +41,8 @@ GridMap Room(bool wall) {
 Eigen::MatrixXd Standing(const std::vector<Eigen::Vector2d>& at, int p) {
   Eigen::MatrixXd rows(static_cast<Eigen::Index>(at.size()), 2 * p);
   for (std::size_t n = 0; n < at.size(); ++n)
-    for (int i = 0; i < p; ++i) rows.row(static_cast<Eigen::Index>(n)).segment(2 * i, 2) = at[n].transpose();
+    for (int i = 0; i < p; ++i)
+      rows.row(static_cast<Eigen::Index>(n)).segment(2 * i, 2) = at[n].transpose();
   return rows;
 }
 
@@ -61,11 +63,11 @@ TEST(StaticCollisionField, TabulatesTheSweptOccupancy) {
       ++checked;
     }
   EXPECT_LT(disagree, checked / 20);
-  EXPECT_TRUE(field.Collides(5.0, 2.0, 0.25, &ws));   // on the wall
-  EXPECT_TRUE(field.Collides(4.7, 2.0, 0.25, &ws));   // robot disc touches the wall
-  EXPECT_FALSE(field.Collides(4.2, 2.0, 0.25, &ws));  // clear of it
+  EXPECT_TRUE(field.Collides(5.0, 2.0, 0.25, &ws));    // on the wall
+  EXPECT_TRUE(field.Collides(4.7, 2.0, 0.25, &ws));    // robot disc touches the wall
+  EXPECT_FALSE(field.Collides(4.2, 2.0, 0.25, &ws));   // clear of it
   EXPECT_FALSE(field.Collides(5.0, 5.75, 0.25, &ws));  // in the gap
-  EXPECT_TRUE(field.Collides(-3.0, 2.0, 0.25, &ws));  // outside the map: prior 0.5
+  EXPECT_TRUE(field.Collides(-3.0, 2.0, 0.25, &ws));   // outside the map: prior 0.5
 }
 
 TEST(GoalDistanceField, IsEuclideanInOpenSpaceAndGoesAroundWalls) {
@@ -74,7 +76,8 @@ TEST(GoalDistanceField, IsEuclideanInOpenSpaceAndGoesAroundWalls) {
   const Eigen::Vector2d goal(9, 2);
   const GoalDistanceField free_space(open_field, goal, 0.25), around(walled_field, goal, 0.25);
   // Away from walls: the straight-line distance up to the 8-connected grid error (<= 8 %).
-  for (const Eigen::Vector2d& x : {Eigen::Vector2d(3, 2), Eigen::Vector2d(5, 4), Eigen::Vector2d(7, 3.5)}) {
+  for (const Eigen::Vector2d& x :
+       {Eigen::Vector2d(3, 2), Eigen::Vector2d(5, 4), Eigen::Vector2d(7, 3.5)}) {
     const double euclid = (x - goal).norm();
     EXPECT_GE(free_space.Distance(x), euclid - 0.05);
     EXPECT_LE(free_space.Distance(x), 1.09 * euclid + 0.05);
@@ -118,7 +121,8 @@ TEST(SpanController, CostIsDistancePlusKappaOverTheFirstCollisionTime) {
   c.Forecast(in);
   double tau = 0;
   const double cost = c.Cost(in.robot, in.goal, {1.0, 0.0}, &tau);
-  // Straight at 1 m/s: first step with ||x - o|| < 0.8 is x = 1.3 m (step 13; x = 1.2 is exactly 0.8 away).
+  // Straight at 1 m/s: first step with ||x - o|| < 0.8 is x = 1.3 m (step 13; x = 1.2 is exactly
+  // 0.8 away).
   EXPECT_NEAR(tau, 1.3, 1e-9);
   EXPECT_NEAR(cost, 6.0 + 100.0 / 1.3, 1e-9);
   EXPECT_NEAR(c.Cost(in.robot, in.goal, {0.0, 0.0}, &tau), 10.0, 1e-12);
@@ -138,7 +142,8 @@ TEST(SpanController, CobylaFindsAsGoodAControlAsAGridSearch) {
   double grid_best = kInf;
   for (int i = 0; i <= 40; ++i)
     for (int j = 0; j <= 40; ++j)
-      grid_best = std::min(grid_best, c.Cost(in.robot, in.goal, {-1.0 + 0.05 * i, -1.0 + 0.05 * j}, nullptr));
+      grid_best = std::min(grid_best,
+                           c.Cost(in.robot, in.goal, {-1.0 + 0.05 * i, -1.0 + 0.05 * j}, nullptr));
   EXPECT_TRUE(out.solved());
   EXPECT_LE(out.cost, grid_best + 0.05) << "COBYLA " << out.cost << " vs grid " << grid_best;
 }
@@ -193,7 +198,8 @@ TEST(SpanController, NonFiniteObservationsNeverThrow) {
   in.past_rows = &rows;
   const ControlOutcome out = c.Compute(in);
   EXPECT_TRUE(out.solved());
-  EXPECT_EQ(c.forecast().pedestrians(), 1);  // the all-NaN row is dropped, the other stands at its last finite point
+  EXPECT_EQ(c.forecast().pedestrians(),
+            1);  // the all-NaN row is dropped, the other stands at its last finite point
   EXPECT_EQ(c.forecast().Mean(0, 1, 0), Eigen::Vector2d(2.0, 0.0));
 }
 

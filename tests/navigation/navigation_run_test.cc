@@ -54,8 +54,9 @@ TEST(NavigationRun, EveryMethodRunsAnEpisodeAndTheSummaryHasItsKeys) {
   std::ifstream in(dir.File("summary.json"));
   std::stringstream text;
   text << in.rdbuf();
-  for (const char* key : {"\"span\"", "\"reactive\"", "\"cl_rrt_star\"", "success_rate", "collision_free_rate", "ttg_mean",
-                          "doc_mean", "min_clearance", "cycle_ms_median", "cycle_ms_p99"})
+  for (const char* key :
+       {"\"span\"", "\"reactive\"", "\"cl_rrt_star\"", "success_rate", "collision_free_rate",
+        "ttg_mean", "doc_mean", "min_clearance", "cycle_ms_median", "cycle_ms_p99"})
     EXPECT_NE(text.str().find(key), std::string::npos) << key;
   for (const char* f : {"episodes.csv", "paths.png", "episode.avi", "map.h5"})
     EXPECT_TRUE(std::filesystem::exists(dir.File(f))) << f;
@@ -84,7 +85,8 @@ TEST(NavigationRun, BadScenesAndArtifactsAreClearErrors) {
   testing::ExpectErrorContains([&] { RunNavigation(bad, dir.path(), 1); }, {"robot_goal"});
   // A wall across the whole square: the goal is unreachable.
   bad.scenario.robot_goal = {4.5, 4.5};
-  testing::ExpectErrorContains([&] { RunNavigation(bad, dir.path(), 1); }, {"robot_goal", "unreachable"});
+  testing::ExpectErrorContains([&] { RunNavigation(bad, dir.path(), 1); },
+                               {"robot_goal", "unreachable"});
   // A start in collision with the border.
   bad = c;
   bad.scenario.robot_start = {-5.9, -4.5, 0};
@@ -98,7 +100,8 @@ TEST(NavigationRun, BadScenesAndArtifactsAreClearErrors) {
   bad.methods = {"span"};
   RunNavigation(c, dir.path(), 1);  // writes map.h5
   bad.predictor.artifact = dir.File("map.h5");
-  testing::ExpectErrorContains([&] { PrepareNavigation(bad, dir.path()); }, {"map.h5", "span_predictor"});
+  testing::ExpectErrorContains([&] { PrepareNavigation(bad, dir.path()); },
+                               {"map.h5", "span_predictor"});
   bad = c;
   bad.map.artifact = c.predictor.artifact;
   EXPECT_THROW(PrepareNavigation(bad, dir.path()), Error);
@@ -110,12 +113,13 @@ TEST(NavigationRun, BadScenesAndArtifactsAreClearErrors) {
   spec.seconds_per_step = 0.15;
   bad.predictor.artifact = dir.File("odd.h5");
   testing::WriteRandomSpanArtifact(bad.predictor.artifact, spec);
-  testing::ExpectErrorContains([&] { PrepareNavigation(bad, dir.path()); }, {"odd.h5", "multiple of dt"});
+  testing::ExpectErrorContains([&] { PrepareNavigation(bad, dir.path()); },
+                               {"odd.h5", "multiple of dt"});
   bad = c;
   bad.methods = {"teleport"};
-  testing::ExpectErrorContains([&] { PrepareNavigation(bad, dir.path()); }, {"methods", "teleport"});
+  testing::ExpectErrorContains([&] { PrepareNavigation(bad, dir.path()); },
+                               {"methods", "teleport"});
 }
-
 
 TEST(NavigationRun, SummaryMetricsFollowTheirDefinitions) {
   auto episode = [](bool reached, double ttg, double doc, double clear, std::vector<double> ms) {
@@ -128,7 +132,8 @@ TEST(NavigationRun, SummaryMetricsFollowTheirDefinitions) {
     r.cycle_ms = std::move(ms);
     return r;
   };
-  std::vector<EpisodeResult> results = {episode(true, 20, 0.0, 0.2, {1, 2, 3}), episode(false, 90, 0.5, -0.1, {4, 5}),
+  std::vector<EpisodeResult> results = {episode(true, 20, 0.0, 0.2, {1, 2, 3}),
+                                        episode(false, 90, 0.5, -0.1, {4, 5}),
                                         episode(true, 30, 0.2, 0.05, {6})};
   results.push_back(results[0]);
   results.back().method = "reactive";  // other methods are not mixed in
@@ -146,7 +151,8 @@ TEST(NavigationRun, SummaryMetricsFollowTheirDefinitions) {
   // None reached: TTG is null in the JSON, never NaN.
   NavigationExperimentConfig c;
   c.scenario.name = "a\"b";
-  const std::string json = SummaryJson(c, 1, {Summarise("span", {episode(false, 90, 0, 0.1, {1})})});
+  const std::string json =
+      SummaryJson(c, 1, {Summarise("span", {episode(false, 90, 0, 0.1, {1})})});
   EXPECT_NE(json.find("\"ttg_mean\": null"), std::string::npos) << json;
   EXPECT_EQ(json.find("nan"), std::string::npos);
   EXPECT_EQ(json.find("inf"), std::string::npos);

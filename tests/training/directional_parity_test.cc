@@ -46,7 +46,8 @@ TEST_P(Parity, EngineMatchesLibTorchOnARandomExportedModel) {
   DirectionalNet net(GetParam(), feats.spatial_size(), 5, 40);
   {
     torch::NoGradGuard no_grad;
-    for (auto& p : net->parameters()) p.add_(0.3 * torch::randn_like(p));  // away from the initialisation
+    for (auto& p : net->parameters())
+      p.add_(0.3 * torch::randn_like(p));  // away from the initialisation
   }
   testing::TempDir dir;
   const std::string path = dir.File("model.h5");
@@ -74,7 +75,8 @@ TEST_P(Parity, EngineMatchesLibTorchOnARandomExportedModel) {
     for (int k = 0; k < 15; ++k) {
       const double a = raw[0][k].item<double>(), b = ws.raw[k];
       worst = std::max(worst, std::abs(a - b) / std::max(1.0, std::abs(a)));
-      EXPECT_NEAR(b, a, 1e-5 * std::max(1.0, std::abs(a))) << "output " << k << " at " << x << ", " << y << ", " << t;
+      EXPECT_NEAR(b, a, 1e-5 * std::max(1.0, std::abs(a)))
+          << "output " << k << " at " << x << ", " << y << ", " << t;
     }
     // Decoded mixtures agree too.
     const auto p = DecodeDirectionalHead(raw.to(torch::kFloat64), 5);
@@ -89,7 +91,8 @@ TEST_P(Parity, EngineMatchesLibTorchOnARandomExportedModel) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Directional, Parity,
-                         ::testing::Values(DirectionalVariant::kSpatiotemporal, DirectionalVariant::kSpatial),
+                         ::testing::Values(DirectionalVariant::kSpatiotemporal,
+                                           DirectionalVariant::kSpatial),
                          [](const ::testing::TestParamInfo<DirectionalVariant>& p) {
                            return std::string(VariantName(p.param));
                          });
@@ -121,8 +124,9 @@ TEST(DirectionalNet, WrittenOutLstmMatchesTorchLstmAndSparseMatchesDense) {
   const auto seq = tt.unsqueeze(2) * ts.unsqueeze(1);
   const auto out = std::get<0>(ref->forward(seq));
   const auto h = out.select(1, out.size(1) - 1);
-  const auto expected = torch::cat({net->alpha_head()->forward(h), net->mu_head()->forward(h),
-                                    net->kappa_head()->forward(h)}, 1);
+  const auto expected = torch::cat(
+      {net->alpha_head()->forward(h), net->mu_head()->forward(h), net->kappa_head()->forward(h)},
+      1);
   const auto dense = net->forward(ts, tt);
   EXPECT_LT((dense - expected).abs().max().item<float>(), 1e-5f);
   std::vector<std::int64_t> index, offsets;
@@ -130,15 +134,17 @@ TEST(DirectionalNet, WrittenOutLstmMatchesTorchLstmAndSparseMatchesDense) {
   feats.SpatialSparseBatch(x, y, &index, &value, &offsets);
   EXPECT_LT(index.size(), static_cast<std::size_t>(B * feats.spatial_size()));
   const auto n = static_cast<std::int64_t>(index.size());
-  const auto sparse = net->forward_sparse(torch::from_blob(index.data(), {n}, torch::kInt64),
-                                          torch::from_blob(value.data(), {n}, torch::kFloat32),
-                                          torch::from_blob(offsets.data(), {B + 1}, torch::kInt64), tt);
+  const auto sparse =
+      net->forward_sparse(torch::from_blob(index.data(), {n}, torch::kInt64),
+                          torch::from_blob(value.data(), {n}, torch::kFloat32),
+                          torch::from_blob(offsets.data(), {B + 1}, torch::kInt64), tt);
   EXPECT_LT((sparse - dense).abs().max().item<float>(), 1e-5f);
   DirectionalNet spatial(DirectionalVariant::kSpatial, feats.spatial_size(), 4, 0);
   const auto sd = spatial->forward(ts, tt);
-  const auto ss = spatial->forward_sparse(torch::from_blob(index.data(), {n}, torch::kInt64),
-                                          torch::from_blob(value.data(), {n}, torch::kFloat32),
-                                          torch::from_blob(offsets.data(), {B + 1}, torch::kInt64), tt);
+  const auto ss =
+      spatial->forward_sparse(torch::from_blob(index.data(), {n}, torch::kInt64),
+                              torch::from_blob(value.data(), {n}, torch::kFloat32),
+                              torch::from_blob(offsets.data(), {B + 1}, torch::kInt64), tt);
   EXPECT_LT((sd - ss).abs().max().item<float>(), 1e-5f);
 }
 
@@ -146,7 +152,8 @@ TEST(DirectionalLoss, NllMatchesCoreVonMisesMixture) {
   torch::manual_seed(1);
   const int B = 64, R = 5;
   auto raw = torch::randn({B, 3 * R}, torch::kFloat64) * 2.0;
-  raw.narrow(1, 2 * R, R).mul_(3.0);  // log kappa over roughly [-20, 20]: both clamps and large kappa
+  raw.narrow(1, 2 * R, R)
+      .mul_(3.0);  // log kappa over roughly [-20, 20]: both clamps and large kappa
   const auto theta = (torch::rand({B}, torch::kFloat64) * 2 - 1) * M_PI;
   const auto p = DecodeDirectionalHead(raw, R, 1e6);  // large kappa allowed here
   const auto nll = VonMisesMixtureNll(p, theta);
@@ -173,7 +180,9 @@ TEST(DirectionalLoss, GradientsMatchFiniteDifferencesAndPenaltyIsAdded) {
   const int B = 8, R = 3;
   auto raw = (torch::randn({B, 3 * R}, torch::kFloat64)).requires_grad_(true);
   const auto theta = (torch::rand({B}, torch::kFloat64) * 2 - 1) * M_PI;
-  auto loss_of = [&](const torch::Tensor& r) { return VonMisesMixtureNll(DecodeDirectionalHead(r, R), theta).mean(); };
+  auto loss_of = [&](const torch::Tensor& r) {
+    return VonMisesMixtureNll(DecodeDirectionalHead(r, R), theta).mean();
+  };
   const auto loss = loss_of(raw);
   loss.backward();
   const auto grad = raw.grad().clone();
@@ -193,7 +202,8 @@ TEST(DirectionalLoss, GradientsMatchFiniteDifferencesAndPenaltyIsAdded) {
   const auto th = theta.to(torch::kFloat32);
   const DirectionalPenalty pen{0.01, 0.0, 0.02};
   const double with = DirectionalLoss(*net, s, t, th, pen).item<double>();
-  const double nll = VonMisesMixtureNll(DecodeDirectionalHead(net->forward(s, t), R), th).mean().item<double>();
+  const double nll =
+      VonMisesMixtureNll(DecodeDirectionalHead(net->forward(s, t), R), th).mean().item<double>();
   const double expected = 0.01 * net->alpha_head()->weight.square().sum().item<double>() +
                           0.02 * net->kappa_head()->weight.square().sum().item<double>();
   EXPECT_GT(expected, 0);
@@ -246,7 +256,8 @@ TEST(DirectionalPipeline, TinyCrossingTrainExportEval) {
   const DirectionalRunResult r = RunDirectionalExperiment(c, dir.path(), false);
   EXPECT_FALSE(r.interrupted);
   EXPECT_EQ(r.report.folds_evaluated, 2);
-  for (const char* m : {"spatiotemporal", "spatial", "grid_um", "grid_mm", "grid_um_dense", "grid_mm_dense"}) {
+  for (const char* m :
+       {"spatiotemporal", "spatial", "grid_um", "grid_mm", "grid_um_dense", "grid_mm_dense"}) {
     const DirectionalMethodMetrics* mm = r.report.Find(m);
     ASSERT_NE(mm, nullptr) << m;
     EXPECT_EQ(mm->al.size(), 2u);
@@ -254,24 +265,30 @@ TEST(DirectionalPipeline, TinyCrossingTrainExportEval) {
     EXPECT_TRUE(std::isfinite(mm->MeanMre()) && mm->MeanMre() >= 0 && mm->MeanMre() <= M_PI) << m;
   }
   const std::string json = ReadFile(dir.File("eval.json"));
-  for (const char* key : {"\"spatiotemporal\": {\"al\": ", "\"spatial\": {\"al\": ", "\"grid_um\": {\"al\": ",
-                          "\"grid_mm\": {\"al\": ", "\"mre\": "})
+  for (const char* key : {"\"spatiotemporal\": {\"al\": ", "\"spatial\": {\"al\": ",
+                          "\"grid_um\": {\"al\": ", "\"grid_mm\": {\"al\": ", "\"mre\": "})
     EXPECT_NE(json.find(key), std::string::npos) << key << " not in " << json;
   EXPECT_EQ(json.find("null"), std::string::npos);
   EXPECT_NE(ReadFile(dir.File("eval.csv")).find("grid_mm,1,"), std::string::npos);
   const DirectionalMap m = DirectionalMap::Load(dir.File("model.h5"));
   EXPECT_EQ(m.variant(), DirectionalVariant::kSpatiotemporal);
   EXPECT_EQ(m.components(), 3);
-  EXPECT_EQ(DirectionalMap::Load(dir.File("model_spatial.h5")).variant(), DirectionalVariant::kSpatial);
-  for (const char* f : {"plots/directions.png", "plots/trajectories.png", "folds/1/spatial/metrics.csv", "config.yaml"})
+  EXPECT_EQ(DirectionalMap::Load(dir.File("model_spatial.h5")).variant(),
+            DirectionalVariant::kSpatial);
+  for (const char* f : {"plots/directions.png", "plots/trajectories.png",
+                        "folds/1/spatial/metrics.csv", "config.yaml"})
     EXPECT_TRUE(std::filesystem::exists(dir.File(f))) << f;
-  // A fresh start refuses the used directory; resume finds everything done and gives the same report.
-  testing::ExpectErrorContains([&] { RunDirectionalExperiment(c, dir.path(), false); }, {"already holds a run"});
+  // A fresh start refuses the used directory; resume finds everything done and gives the same
+  // report.
+  testing::ExpectErrorContains([&] { RunDirectionalExperiment(c, dir.path(), false); },
+                               {"already holds a run"});
   const DirectionalRunResult again = RunDirectionalExperiment(c, dir.path(), true);
-  EXPECT_DOUBLE_EQ(again.report.Find("spatiotemporal")->MeanAl(), r.report.Find("spatiotemporal")->MeanAl());
+  EXPECT_DOUBLE_EQ(again.report.Find("spatiotemporal")->MeanAl(),
+                   r.report.Find("spatiotemporal")->MeanAl());
   DirectionalExperimentConfig other = c;
   other.train.epochs = 4;
-  testing::ExpectErrorContains([&] { RunDirectionalExperiment(other, dir.path(), true); }, {"differs"});
+  testing::ExpectErrorContains([&] { RunDirectionalExperiment(other, dir.path(), true); },
+                               {"differs"});
 }
 
 TEST(DirectionalPipeline, BadInput) {
@@ -279,39 +296,56 @@ TEST(DirectionalPipeline, BadInput) {
   DirectionalExperimentConfig c = TinyCrossing();
   c.data.format = DirectionalSource::kGridCsv;
   // NaN coordinates.
-  testing::WriteText(dir.File("nan.csv"), "x_m,y_m,orientation_raw_rad,path_id\n1,2,0,0\nnan,2.5,0,0\n1,3,0,0\n");
+  testing::WriteText(dir.File("nan.csv"),
+                     "x_m,y_m,orientation_raw_rad,path_id\n1,2,0,0\nnan,2.5,0,0\n1,3,0,0\n");
   c.data.file = dir.File("nan.csv");
   testing::ExpectErrorContains([&] { LoadDirectionalSamples(c); }, {"nan.csv"});
   // No data rows.
   testing::WriteText(dir.File("empty.csv"), "x_m,y_m,orientation_raw_rad,path_id\n");
   c.data.file = dir.File("empty.csv");
-  testing::ExpectErrorContains([&] { RunDirectionalExperiment(c, dir.File("run"), false); }, {"empty.csv"});
+  testing::ExpectErrorContains([&] { RunDirectionalExperiment(c, dir.File("run"), false); },
+                               {"empty.csv"});
   // Config errors name the key.
   testing::ExpectErrorContains(
-      [&] { config::ExperimentConfigFromYaml<DirectionalExperimentConfig>("model: directional\ndata: {format: grid_csv}\n", "x.yaml"); },
+      [&] {
+        config::ExperimentConfigFromYaml<DirectionalExperimentConfig>(
+            "model: directional\ndata: {format: grid_csv}\n", "x.yaml");
+      },
       {"x.yaml", "data.file"});
-  testing::ExpectErrorContains([&] { config::ExperimentConfigFromYaml<DirectionalExperimentConfig>("model: directional\nfeatures: {cells: 3}\n", "x.yaml"); },
-                               {"x.yaml", "features.cells"});
-  testing::ExpectErrorContains([&] { config::ExperimentConfigFromYaml<DirectionalExperimentConfig>("model: span_predictor\n", "x.yaml"); },
-                               {"'model'", "directional"});
+  testing::ExpectErrorContains(
+      [&] {
+        config::ExperimentConfigFromYaml<DirectionalExperimentConfig>(
+            "model: directional\nfeatures: {cells: 3}\n", "x.yaml");
+      },
+      {"x.yaml", "features.cells"});
+  testing::ExpectErrorContains(
+      [&] {
+        config::ExperimentConfigFromYaml<DirectionalExperimentConfig>("model: span_predictor\n",
+                                                                      "x.yaml");
+      },
+      {"'model'", "directional"});
   // Artifacts of the other kind, both ways.
   const std::string span = dir.File("span.h5");
   testing::WriteRandomSpanArtifact(span, {});
-  testing::ExpectErrorContains([&] { LoadDirectionalNetFromArtifact(span); }, {"expected 'directional_map'"});
+  testing::ExpectErrorContains([&] { LoadDirectionalNetFromArtifact(span); },
+                               {"expected 'directional_map'"});
   DirectionalNet net(DirectionalVariant::kSpatial, 35, 5, 0);
   const std::string dm = dir.File("dm.h5");
   WriteDirectionalArtifact(*net, Features(), "model: directional\n", 0, dm);
   testing::ExpectErrorContains([&] { SpanPredictor::Load(dm); }, {"expected 'span_predictor'"});
   DirectionalFeatureConfig unresolved = Features();
   unresolved.auto_extent = true;
-  testing::ExpectErrorContains([&] { WriteDirectionalArtifact(*net, unresolved, "", 0, dm); }, {"unresolved"});
+  testing::ExpectErrorContains([&] { WriteDirectionalArtifact(*net, unresolved, "", 0, dm); },
+                               {"unresolved"});
 }
 
 TEST(DirectionalConfigs, ShippedConfigsLoad) {
   const char* src = std::getenv("FORESIGHT_SOURCE_DIR");
   ASSERT_NE(src, nullptr);
   for (const char* name : {"p1", "p2", "crossing", "edinburgh"})
-    EXPECT_NO_THROW(config::LoadExperimentConfig<DirectionalExperimentConfig>(std::string(src) + "/configs/directional/" + name + ".yaml", {})) << name;
+    EXPECT_NO_THROW(config::LoadExperimentConfig<DirectionalExperimentConfig>(
+        std::string(src) + "/configs/directional/" + name + ".yaml", {}))
+        << name;
 }
 
 }  // namespace

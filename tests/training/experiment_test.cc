@@ -38,13 +38,14 @@ ExperimentKind ToyKind() {
   k.reference = [] { return config::ReferenceTable<ToyConfig>(); };
   k.train = [](const TrainRequest& req) {
     const auto c = LoadRequestConfig<ToyConfig>(req, "model: toy\n", "toy default");
-    StartRunDirectory(req.run_dir, config::ToYaml(c), req.resume, RunDirectoryRules{{"model.txt"}, false});
+    StartRunDirectory(req.run_dir, config::ToYaml(c), req.resume,
+                      RunDirectoryRules{{"model.txt"}, false});
     testing::WriteText(req.run_dir + "/model.txt", std::to_string(c.value));
   };
   k.evaluate = [](const std::string& run_dir, const std::vector<std::string>& overrides) {
     const auto c = LoadRunConfig<ToyConfig>(run_dir, overrides);
-    return "{\"value\": " + testing::ReadText(run_dir + "/model.txt") + ", \"config\": " + std::to_string(c.value) +
-           "}";
+    return "{\"value\": " + testing::ReadText(run_dir + "/model.txt") +
+           ", \"config\": " + std::to_string(c.value) + "}";
   };
   return k;
 }
@@ -64,10 +65,12 @@ TEST(Experiment, RegistryDispatchesByModelTag) {
   EXPECT_EQ(kind.tag, "toy");
   EXPECT_EQ(kind.evaluate(req.run_dir, {}), "{\"value\": 4.000000, \"config\": 4.000000}");
   testing::ExpectErrorContains([&] { kind.NoSuchStep("export"); }, {"'toy' has no export step"});
-  testing::ExpectErrorContains([&] { kind.train(req); }, {"already holds a run (model.txt)", "new or empty"});
+  testing::ExpectErrorContains([&] { kind.train(req); },
+                               {"already holds a run (model.txt)", "new or empty"});
   req.resume = true;
   testing::ExpectErrorContains([&] { kind.train(req); }, {"--resume", "cannot be continued"});
-  EXPECT_NE(r.ReferenceMarkdown().find("| `value` | number | `1.0` |"), std::string::npos) << r.ReferenceMarkdown();
+  EXPECT_NE(r.ReferenceMarkdown().find("| `value` | number | `1.0` |"), std::string::npos)
+      << r.ReferenceMarkdown();
 }
 
 TEST(Experiment, LookupErrorsNameTheSourceAndTheKnownKinds) {
@@ -75,16 +78,19 @@ TEST(Experiment, LookupErrorsNameTheSourceAndTheKnownKinds) {
   ExperimentRegistry r;
   r.Add(ToyKind());
   testing::WriteText(dir.File("other.yaml"), "model: teleport\n");
-  testing::ExpectErrorContains([&] { r.ForConfig(dir.File("other.yaml")); },
-                               {dir.File("other.yaml"), "no experiment kind 'teleport'", "known: toy"});
+  testing::ExpectErrorContains(
+      [&] { r.ForConfig(dir.File("other.yaml")); },
+      {dir.File("other.yaml"), "no experiment kind 'teleport'", "known: toy"});
   testing::WriteText(dir.File("untagged.yaml"), "value: 3\n");
-  testing::ExpectErrorContains([&] { r.ForConfig(dir.File("untagged.yaml")); }, {"untagged.yaml", "'model'"});
+  testing::ExpectErrorContains([&] { r.ForConfig(dir.File("untagged.yaml")); },
+                               {"untagged.yaml", "'model'"});
   testing::ExpectErrorContains([&] { r.ForRun(dir.path()); }, {dir.path(), "not a run directory"});
   testing::ExpectErrorContains([&] { r.ForConfig("default"); }, {"no default config"});
   testing::ExpectErrorContains([&] { r.Add(ToyKind()); }, {"'toy' is registered twice"});
   testing::WriteText(dir.File("bad.yaml"), "model: toy\nvalue: -1\n");
-  testing::ExpectErrorContains([&] { config::LoadExperimentConfig<ToyConfig>(dir.File("bad.yaml")); },
-                               {"bad.yaml", "'value'", "-1"});
+  testing::ExpectErrorContains(
+      [&] { config::LoadExperimentConfig<ToyConfig>(dir.File("bad.yaml")); },
+      {"bad.yaml", "'value'", "-1"});
 }
 
 /// A tiny config per kind of this build; a new kind adds its own here (the test fails without).
@@ -92,16 +98,22 @@ const std::map<std::string, std::string>& TinyConfigs() {
   static const std::map<std::string, std::string> configs{
       {"span_predictor",
        "model: span_predictor\ndata: {synthetic: {num_tracks: 120}}\nnetwork: {hidden: [16, 16]}\n"
-       "basis: {num_centres: 5}\ntrain: {epochs: 2, batch_size: 64, progress: none}\neval: {plot_tracks: 0}\n"},
+       "basis: {num_centres: 5}\ntrain: {epochs: 2, batch_size: 64, progress: none}\neval: "
+       "{plot_tracks: 0}\n"},
       {"occupancy.",
-       "model: occupancy.fast_bhm\ndata:\n  format: synthetic\n  synthetic: {width: 10, height: 8, num_robots: 2, "
-       "scans_per_robot: 30, max_range: 10}\nfeatures: {x_min: -1, x_max: 11, y_min: -1, y_max: 9, spacing: 0.5}\n"
+       "model: occupancy.fast_bhm\ndata:\n  format: synthetic\n  synthetic: {width: 10, height: 8, "
+       "num_robots: 2, "
+       "scans_per_robot: 30, max_range: 10}\nfeatures: {x_min: -1, x_max: 11, y_min: -1, y_max: 9, "
+       "spacing: 0.5}\n"
        "grid: {x_min: -1, x_max: 11, y_min: -1, y_max: 9, resolution: 0.1, max_range: 10.0}\n"},
       {"directional",
        "model: directional\ndata: {format: crossing, crossing: {num_tracks: 80, duration: 60}}\n"
-       "features: {x_min: 0, x_max: 10, y_min: 0, y_max: 10, cells_x: 4, cells_y: 4, length_scale: 2.5, t_min: 0, "
-       "t_max: 60, time_points: 3, time_length_scale: 15}\nnetwork: {components: 2, hidden: 8, spatial_epochs: 2}\n"
-       "train: {epochs: 2, batch_size: 128, progress: none}\neval: {folds: 2, max_folds: 1, plots: false}\n"},
+       "features: {x_min: 0, x_max: 10, y_min: 0, y_max: 10, cells_x: 4, cells_y: 4, length_scale: "
+       "2.5, t_min: 0, "
+       "t_max: 60, time_points: 3, time_length_scale: 15}\nnetwork: {components: 2, hidden: 8, "
+       "spatial_epochs: 2}\n"
+       "train: {epochs: 2, batch_size: 128, progress: none}\neval: {folds: 2, max_folds: 1, plots: "
+       "false}\n"},
       {"navigation", "model: navigation\n"},
   };
   return configs;
@@ -113,7 +125,8 @@ TEST(Experiment, EveryBuiltinKindRunsThroughTrainExportAndEval) {
   for (const ExperimentKind& kind : registry.kinds()) {
     SCOPED_TRACE(kind.tag);
     const auto tiny = TinyConfigs().find(kind.tag);
-    ASSERT_NE(tiny, TinyConfigs().end()) << "add a tiny config for kind '" << kind.tag << "' to this test";
+    ASSERT_NE(tiny, TinyConfigs().end())
+        << "add a tiny config for kind '" << kind.tag << "' to this test";
     testing::TempDir dir;
     const std::string config = dir.File("tiny.yaml"), run = dir.File("run");
     testing::WriteText(config, tiny->second);
@@ -124,7 +137,8 @@ TEST(Experiment, EveryBuiltinKindRunsThroughTrainExportAndEval) {
     if (!kind.train) {
       // A kind without steps says so in one line for each (navigation is run by `navigate`).
       EXPECT_FALSE(kind.export_run || kind.evaluate);
-      testing::ExpectErrorContains([&] { kind.NoSuchStep("train"); }, {"'" + kind.tag + "' has no train step"});
+      testing::ExpectErrorContains([&] { kind.NoSuchStep("train"); },
+                                   {"'" + kind.tag + "' has no train step"});
       continue;
     }
     kind.train(TrainRequest{config, {}, run, false, true});

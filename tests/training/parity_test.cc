@@ -60,7 +60,8 @@ TEST_P(Parity, EngineMatchesLibTorchOnRandomInputs) {
     Eigen::Matrix<double, Eigen::Dynamic, 2> past(p, 2);
     for (int i = 0; i < p; ++i) past.row(i) << 3 * n01(rng), 3 * n01(rng);
     // Reference: ego-frame features -> normalise -> LibTorch forward -> DecodeHead.
-    const EgoFrame frame = EgoFrame::FromPast(p, [&](int i) { return Eigen::Vector2d(past(i, 0), past(i, 1)); }, true);
+    const EgoFrame frame = EgoFrame::FromPast(
+        p, [&](int i) { return Eigen::Vector2d(past(i, 0), past(i, 1)); }, true);
     auto x = torch::zeros({1, 2 * p}, torch::kFloat32);
     for (int i = 0; i < p; ++i) {
       const Eigen::Vector2d q = frame.ToEgo(past.row(i).transpose());
@@ -97,9 +98,11 @@ TEST_P(Parity, EngineMatchesLibTorchOnRandomInputs) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Heads, Parity,
-                         ::testing::Values(std::make_pair(1, UParam::kCholesky), std::make_pair(3, UParam::kDiagonal)),
+                         ::testing::Values(std::make_pair(1, UParam::kCholesky),
+                                           std::make_pair(3, UParam::kDiagonal)),
                          [](const auto& p) {
-                           return "R" + std::to_string(p.param.first) + "_" + UParamName(p.param.second);
+                           return "R" + std::to_string(p.param.first) + "_" +
+                                  UParamName(p.param.second);
                          });
 
 TEST(Pipeline, TrainExportEvalWritesEveryKey) {
@@ -109,8 +112,9 @@ TEST(Pipeline, TrainExportEvalWritesEveryKey) {
   std::ifstream in(t->dir.File("eval.json"));
   std::stringstream ss;
   ss << in.rdbuf();
-  for (const char* key : {"\"ade\"", "\"fde\"", "\"nll\"", "\"best_of_20_ade\"", "\"best_of_20_fde\"", "\"cv_ade\"",
-                          "\"cv_fde\"", "\"cv_nll\"", "\"cv_best_of_20_ade\"", "\"cv_best_of_20_fde\""})
+  for (const char* key :
+       {"\"ade\"", "\"fde\"", "\"nll\"", "\"best_of_20_ade\"", "\"best_of_20_fde\"", "\"cv_ade\"",
+        "\"cv_fde\"", "\"cv_nll\"", "\"cv_best_of_20_ade\"", "\"cv_best_of_20_fde\""})
     EXPECT_NE(ss.str().find(key), std::string::npos) << key;
   EXPECT_TRUE(std::filesystem::exists(t->dir.File("plots/samples.png")));
   EXPECT_TRUE(std::isfinite(r.model.ade) && std::isfinite(r.model.nll) && std::isfinite(r.cv.nll));
@@ -125,14 +129,17 @@ TEST(Pipeline, EvalRefusesDataWindowsOrSeedOtherThanTrainedWith) {
   const auto t = TrainTiny(1, UParam::kCholesky);
   SpanExperimentConfig c = t->config;
   c.data.synthetic.num_tracks = 100;
-  testing::ExpectErrorContains([&] { EvaluateSpan(c, t->artifact, t->dir.path()); },
-                               {t->artifact, "data.synthetic.num_tracks = 150, not 100", "config.yaml"});
+  testing::ExpectErrorContains(
+      [&] { EvaluateSpan(c, t->artifact, t->dir.path()); },
+      {t->artifact, "data.synthetic.num_tracks = 150, not 100", "config.yaml"});
   c = t->config;
   c.windows.predicted = 10;
-  testing::ExpectErrorContains([&] { EvaluateSpan(c, t->artifact, t->dir.path()); }, {"windows.predicted = 12, not 10"});
+  testing::ExpectErrorContains([&] { EvaluateSpan(c, t->artifact, t->dir.path()); },
+                               {"windows.predicted = 12, not 10"});
   c = t->config;
   c.seed = 5;
-  testing::ExpectErrorContains([&] { EvaluateSpan(c, t->artifact, t->dir.path()); }, {"seed = 0, not 5"});
+  testing::ExpectErrorContains([&] { EvaluateSpan(c, t->artifact, t->dir.path()); },
+                               {"seed = 0, not 5"});
   // Where the files are and how to evaluate may differ.
   c = t->config;
   c.data.root = "/elsewhere";
@@ -152,9 +159,10 @@ SpanEvalReport ReportWith(double value, int val_windows) {
 
 TEST(EvalJson, HasTheDocumentedKeysAndNoNonFiniteNumbers) {
   const std::string json = ReportWith(1.5, 4).ToJson(20);
-  for (const char* key : {"ade", "fde", "nll", "best_of_20_ade", "best_of_20_fde", "cv_ade", "cv_fde", "cv_nll",
-                          "cv_best_of_20_ade", "cv_best_of_20_fde"})
-    EXPECT_NE(json.find("\n  \"" + std::string(key) + "\": 1.5,"), std::string::npos) << key << " in " << json;
+  for (const char* key : {"ade", "fde", "nll", "best_of_20_ade", "best_of_20_fde", "cv_ade",
+                          "cv_fde", "cv_nll", "cv_best_of_20_ade", "cv_best_of_20_fde"})
+    EXPECT_NE(json.find("\n  \"" + std::string(key) + "\": 1.5,"), std::string::npos)
+        << key << " in " << json;
   EXPECT_NE(json.find("\"val\": {\"windows\": 4, \"ade\": 1.5"), std::string::npos) << json;
   for (double bad : {double(NAN), double(INFINITY), -double(INFINITY)}) {
     const std::string b = ReportWith(bad, 4).ToJson(20);
@@ -181,7 +189,8 @@ TEST(EvalJson, EmptySplitsAreErrors) {
   SpanEvalConfig ec;
   ec.num_samples = 2;
   EXPECT_GT(EvaluateSpanOn(artifact, windows, windows, ec).windows, 0);
-  testing::ExpectErrorContains([&] { EvaluateSpanOn(artifact, windows, empty, ec); }, {artifact, "no windows"});
+  testing::ExpectErrorContains([&] { EvaluateSpanOn(artifact, windows, empty, ec); },
+                               {artifact, "no windows"});
   testing::ExpectErrorContains([&] { EvaluateSpanOn(artifact, empty, windows, ec); },
                                {"constant-velocity", "no training windows"});
 }

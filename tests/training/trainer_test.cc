@@ -29,8 +29,10 @@ SpanExperimentConfig TinyConfig() {
   return c;
 }
 
-std::vector<torch::Tensor> Parameters(const std::string& checkpoint, const SpanExperimentConfig& c) {
-  SpanNet net(2 * c.windows.observed, c.network, HeadLayout{c.basis.num_centres, c.network.components, c.network.u_param});
+std::vector<torch::Tensor> Parameters(const std::string& checkpoint,
+                                      const SpanExperimentConfig& c) {
+  SpanNet net(2 * c.windows.observed, c.network,
+              HeadLayout{c.basis.num_centres, c.network.components, c.network.u_param});
   LoadCheckpointModel(checkpoint, net.ptr().get());
   std::vector<torch::Tensor> out;
   for (const auto& p : net->parameters()) out.push_back(p.detach().clone());
@@ -67,8 +69,10 @@ TEST(Trainer, ResumeAfterAnInterruptionIsBitIdentical) {
   const auto a = Parameters(dir.File("full") + "/checkpoints/last.pt", c);
   const auto b = Parameters(dir.File("resumed") + "/checkpoints/last.pt", c);
   ASSERT_EQ(a.size(), b.size());
-  for (std::size_t i = 0; i < a.size(); ++i) EXPECT_TRUE(torch::equal(a[i], b[i])) << "parameter " << i;
-  EXPECT_EQ(LossColumns(dir.File("full") + "/metrics.csv"), LossColumns(dir.File("resumed") + "/metrics.csv"));
+  for (std::size_t i = 0; i < a.size(); ++i)
+    EXPECT_TRUE(torch::equal(a[i], b[i])) << "parameter " << i;
+  EXPECT_EQ(LossColumns(dir.File("full") + "/metrics.csv"),
+            LossColumns(dir.File("resumed") + "/metrics.csv"));
 }
 
 std::vector<std::string> Lines(const std::string& path) {
@@ -176,7 +180,8 @@ TEST(Trainer, ResumedRunExportsAndEvaluatesTheSameModelAsAnUninterruptedOne) {
   EXPECT_EQ(ArtifactDigest(a), ArtifactDigest(b));
   EvaluateSpan(c, a, dir.File("full"));
   EvaluateSpan(c, b, dir.File("resumed"));
-  EXPECT_EQ(testing::ReadText(dir.File("full/eval.json")), testing::ReadText(dir.File("resumed/eval.json")));
+  EXPECT_EQ(testing::ReadText(dir.File("full/eval.json")),
+            testing::ReadText(dir.File("resumed/eval.json")));
 }
 
 TEST(Trainer, MetricsRowPrecedesItsCheckpointAndResumeRewritesIt) {
@@ -258,8 +263,9 @@ TEST(Trainer, FreshStartRefusesARunDirectoryThatHoldsARun) {
   EXPECT_THROW(TrainSpan(c, dir.path(), false), Error);
   c.data.val_fraction = 0.1;
   TrainSpan(c, dir.path(), false);
-  testing::ExpectErrorContains([&] { TrainSpan(c, dir.path(), false); },
-                               {dir.path(), "already holds a run (checkpoints/)", "--resume", "--run-dir"});
+  testing::ExpectErrorContains(
+      [&] { TrainSpan(c, dir.path(), false); },
+      {dir.path(), "already holds a run (checkpoints/)", "--resume", "--run-dir"});
   for (const char* name : {"model.h5", "eval.json"}) {
     testing::TempDir other;
     testing::WriteText(other.File(name), "x");
@@ -338,9 +344,12 @@ class ExplodingTask : public TrainingTask {
   torch::Tensor BatchLoss(const torch::Tensor& idx) override {
     ++calls_;
     auto loss = linear_->forward(torch::ones({idx.size(0), 2})).square().mean();
-    return calls_ > 4 ? loss * std::numeric_limits<float>::quiet_NaN() : loss;  // batch 4 of 2 per epoch
+    return calls_ > 4 ? loss * std::numeric_limits<float>::quiet_NaN()
+                      : loss;  // batch 4 of 2 per epoch
   }
-  double ValidationLoss() override { return linear_->forward(torch::ones({1, 2})).square().item<double>(); }
+  double ValidationLoss() override {
+    return linear_->forward(torch::ones({1, 2})).square().item<double>();
+  }
 
  private:
   torch::nn::Linear linear_;
@@ -358,7 +367,8 @@ TEST(Trainer, NonFiniteLossStopsCleanlyAndKeepsTheLastGoodCheckpoint) {
   const auto s = Train(&task, c, RunPaths{dir.path()}, 0, false);
   EXPECT_EQ(s.reason, TerminationReason::kNonFiniteLoss);
   EXPECT_EQ(s.epochs_completed, 2);
-  for (const auto& p : task.module().parameters()) EXPECT_TRUE(torch::isfinite(p).all().item<bool>());
+  for (const auto& p : task.module().parameters())
+    EXPECT_TRUE(torch::isfinite(p).all().item<bool>());
   // The checkpoint on disk is the epoch-2 one and loads.
   ExplodingTask other;
   LoadCheckpointModel(dir.File("checkpoints/last.pt"), &other.module());
@@ -371,9 +381,11 @@ TEST(Trainer, CorruptOrMissingCheckpointIsAClearError) {
   TrainSpan(c, dir.path(), false);
   const std::string ckpt = dir.File("checkpoints/last.pt");
   testing::Truncate(ckpt, std::filesystem::file_size(ckpt) / 3);
-  testing::ExpectErrorContains([&] { TrainSpan(c, dir.path(), true); }, {ckpt, "corrupt or truncated checkpoint"});
+  testing::ExpectErrorContains([&] { TrainSpan(c, dir.path(), true); },
+                               {ckpt, "corrupt or truncated checkpoint"});
   testing::TempDir empty;
-  testing::ExpectErrorContains([&] { TrainSpan(c, empty.path(), true); }, {"no config.yaml to resume from"});
+  testing::ExpectErrorContains([&] { TrainSpan(c, empty.path(), true); },
+                               {"no config.yaml to resume from"});
 }
 
 TEST(Trainer, LearningRateSchedules) {
