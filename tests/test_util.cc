@@ -18,6 +18,32 @@ std::string ReadText(const std::string& path) {
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
+Eigen::VectorXd CentralGradient(const std::function<double(const Eigen::VectorXd&)>& f,
+                                const Eigen::VectorXd& x, double h) {
+  Eigen::VectorXd g(x.size());
+  for (Eigen::Index i = 0; i < x.size(); ++i) {
+    Eigen::VectorXd a = x, b = x;
+    a[i] += h;
+    b[i] -= h;
+    g[i] = (f(a) - f(b)) / (2 * h);
+  }
+  return g;
+}
+
+::testing::AssertionResult MatricesNear(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b,
+                                        double tol) {
+  if (a.rows() != b.rows() || a.cols() != b.cols())
+    return ::testing::AssertionFailure() << "shapes differ: " << a.rows() << " x " << a.cols()
+                                         << " vs " << b.rows() << " x " << b.cols();
+  Eigen::Index r = 0, c = 0;
+  const double worst = a.size() ? (a - b).cwiseAbs().maxCoeff(&r, &c) : 0.0;
+  if (!(worst <= tol))
+    return ::testing::AssertionFailure()
+           << "entry (" << r << ", " << c << "): " << a(r, c) << " vs " << b(r, c) << " differ by "
+           << worst << " > " << tol;
+  return ::testing::AssertionSuccess();
+}
+
 namespace {
 void OverwriteAttrRaw(const std::string& path, const std::string& object, const std::string& name,
                       hid_t type, const void* value) {

@@ -76,6 +76,14 @@ class ScopedFileSizeLimit {
   void (*previous_)(int) = nullptr;
 };
 
+/// d f / d x at `x` by central differences with step `h` in each coordinate.
+Eigen::VectorXd CentralGradient(const std::function<double(const Eigen::VectorXd&)>& f,
+                                const Eigen::VectorXd& x, double h = 1e-6);
+
+/// |a - b| <= tol in every entry (same shapes); the failure message names the worst entry.
+::testing::AssertionResult MatricesNear(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b,
+                                        double tol);
+
 /// Writes `text` to `path`.
 void WriteText(const std::string& path, const std::string& text);
 /// The whole text of `path` (an empty string when it cannot be read).

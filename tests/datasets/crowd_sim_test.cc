@@ -14,17 +14,11 @@
 namespace foresight {
 namespace {
 
-/// d/dx of f at x by central differences (per coordinate).
+/// d/dx of f at x by central differences (the shared helper, in 2-D).
 Eigen::Vector2d Gradient(const std::function<double(const Eigen::Vector2d&)>& f,
                          const Eigen::Vector2d& x, double h = 1e-6) {
-  Eigen::Vector2d g;
-  for (int i = 0; i < 2; ++i) {
-    Eigen::Vector2d a = x, b = x;
-    a[i] += h;
-    b[i] -= h;
-    g[i] = (f(a) - f(b)) / (2 * h);
-  }
-  return g;
+  return testing::CentralGradient([&](const Eigen::VectorXd& v) { return f(Eigen::Vector2d(v)); },
+                                  x, h);
 }
 
 /// A simulated scenario of single pedestrians (one-way) from `starts` to `goals`, no robot walls.
