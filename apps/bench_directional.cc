@@ -15,7 +15,7 @@
 #include "apps/commands.h"
 #include "core/error.h"
 #include "inference/directional/directional_map.h"
-#include "training/directional_pipeline.h"
+#include "training/directional/pipeline.h"
 
 namespace foresight::app {
 namespace {

@@ -14,7 +14,7 @@
 #include "inference/prediction/span_predictor.h"
 #ifdef FORESIGHT_WITH_TORCH
 #include "models/span/span_net.h"
-#include "training/span_torch_io.h"
+#include "training/span/torch_io.h"
 #endif
 
 namespace foresight::app {

@@ -18,8 +18,8 @@
 #include "models/occupancy/fast_bhm.h"
 #include "models/occupancy/scan_training.h"
 #include "training/experiment.h"
-#include "training/occupancy_pipeline.h"
-#include "training/octomap_baseline.h"
+#include "training/occupancy/octomap_baseline.h"
+#include "training/occupancy/pipeline.h"
 
 namespace foresight::app {
 namespace {

@@ -14,7 +14,7 @@
 #include "inference/mapping/fusion.h"
 #include "inference/mapping/hinge_map.h"
 #include "inference/mapping/occupancy_map.h"
-#include "training/occupancy_pipeline.h"
+#include "training/occupancy/pipeline.h"
 
 namespace foresight::app {
 namespace fs = std::filesystem;

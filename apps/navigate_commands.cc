@@ -7,11 +7,11 @@
 #include "apps/commands.h"
 #include "core/error.h"
 #include "embedded_navigation_config.h"
-#include "training/navigation_config.h"
-#include "training/navigation_run.h"
+#include "training/navigation/config.h"
+#include "training/navigation/run.h"
 #ifdef FORESIGHT_WITH_TORCH
 #include "embedded_navigation_predictor_config.h"
-#include "training/navigation_predictor.h"
+#include "training/navigation/predictor.h"
 #endif
 
 namespace foresight::app {

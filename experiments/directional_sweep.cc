@@ -24,7 +24,7 @@
 
 #include "core/error.h"
 #include "core/log.h"
-#include "training/directional_pipeline.h"
+#include "training/directional/pipeline.h"
 
 namespace foresight {
 namespace {

@@ -24,8 +24,8 @@
 #include "inference/mapping/hinge_map.h"
 #include "models/occupancy/fast_bhm.h"
 #include "models/occupancy/scan_training.h"
-#include "training/occupancy_pipeline.h"
-#include "training/octomap_baseline.h"
+#include "training/occupancy/octomap_baseline.h"
+#include "training/occupancy/pipeline.h"
 
 namespace fs = std::filesystem;
 using namespace foresight;

@@ -4,7 +4,7 @@
 #include <random>
 
 #include "core/von_mises.h"
-#include "models/directional/grid_map.h"
+#include "models/directional/directional_grid_map.h"
 #include "tests/alloc_counter.h"  // replaces operator new: one per binary
 #include "tests/test_util.h"
 

@@ -1,8 +1,6 @@
 // The navigation harness: a short episode per method end to end, summary.json keys, and the
 // load-time errors of bad configs (unreachable or blocked goals, starts in collision, empty crowds,
 // artifacts of the wrong kind).
-#include "training/navigation_run.h"
-
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -10,6 +8,7 @@
 #include <sstream>
 
 #include "tests/test_util.h"
+#include "training/navigation/run.h"
 
 namespace foresight {
 namespace {

@@ -14,8 +14,8 @@
 #include "inference/prediction/span_predictor.h"
 #include "models/directional/directional_net.h"
 #include "tests/test_util.h"
-#include "training/directional_config.h"
-#include "training/directional_pipeline.h"
+#include "training/directional/config.h"
+#include "training/directional/pipeline.h"
 
 namespace foresight {
 namespace {

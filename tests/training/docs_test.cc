@@ -7,9 +7,9 @@
 #include <sstream>
 
 #include "training/kinds.h"
-#include "training/navigation_config.h"
-#include "training/occupancy_config.h"
-#include "training/span_config.h"
+#include "training/navigation/config.h"
+#include "training/occupancy/config.h"
+#include "training/span/config.h"
 
 namespace foresight {
 namespace {

@@ -12,9 +12,9 @@
 #include "inference/prediction/span_predictor.h"
 #include "models/span/span_net.h"
 #include "tests/test_util.h"
-#include "training/span_eval.h"
-#include "training/span_pipeline.h"
-#include "training/span_torch_io.h"
+#include "training/span/eval.h"
+#include "training/span/pipeline.h"
+#include "training/span/torch_io.h"
 
 namespace foresight {
 namespace {

@@ -11,8 +11,8 @@
 #include "core/h5.h"
 #include "models/span/span_net.h"
 #include "tests/test_util.h"
-#include "training/span_eval.h"
-#include "training/span_pipeline.h"
+#include "training/span/eval.h"
+#include "training/span/pipeline.h"
 
 namespace foresight {
 namespace {

@@ -1,0 +1,534 @@
+#include "training/directional/pipeline.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <numeric>
+#include <random>
+#include <sstream>
+
+#include "core/error.h"
+#include "core/h5.h"
+#include "core/log.h"
+#include "core/von_mises.h"
+#include "datasets/data_root.h"
+#include "inference/engine/artifact.h"
+#include "models/directional/directional_grid_map.h"
+#include "training/directional/plots.h"
+#include "training/run_dir.h"
+
+namespace foresight {
+namespace fs = std::filesystem;
+
+namespace {
+
+using RowMatrixF = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
+std::vector<Eigen::Index> RandomSubset(Eigen::Index n, double fraction, std::uint64_t seed) {
+  std::vector<Eigen::Index> idx(static_cast<std::size_t>(n));
+  std::iota(idx.begin(), idx.end(), Eigen::Index{0});
+  std::mt19937_64 rng(seed);
+  std::shuffle(idx.begin(), idx.end(), rng);
+  const auto keep = std::max<Eigen::Index>(
+      1, static_cast<Eigen::Index>(std::llround(fraction * static_cast<double>(n))));
+  idx.resize(static_cast<std::size_t>(std::min(keep, n)));
+  std::sort(idx.begin(), idx.end());
+  return idx;
+}
+
+torch::Tensor ToTensor(const Eigen::VectorXd& v) {
+  Eigen::VectorXf f = v.cast<float>();
+  return torch::from_blob(f.data(), {f.size()}, torch::kFloat32).clone();
+}
+
+/// Features are computed per batch from the positions (memory stays O(n), not O(n M_s)).
+class DirectionalTask : public TrainingTask {
+ public:
+  DirectionalTask(DirectionalNet net, DirectionalFeatures features, const DirectionalSamples& train,
+                  const DirectionalSamples& val, const DirectionalPenalty& penalty)
+      : net_(std::move(net)),
+        features_(std::move(features)),
+        train_(train),
+        val_(val),
+        penalty_(penalty),
+        theta_train_(ToTensor(train.theta)),
+        theta_val_(ToTensor(val.theta)) {}
+
+  torch::nn::Module& module() override { return *net_; }
+  std::int64_t num_train() const override { return train_.size(); }
+
+  torch::Tensor BatchLoss(const torch::Tensor& indices) override {
+    const auto idx = indices.to(torch::kInt64).contiguous();
+    const std::int64_t b = idx.size(0);
+    const auto* p = idx.data_ptr<std::int64_t>();
+    Eigen::VectorXd x(b), y(b), t(b);
+    for (std::int64_t i = 0; i < b; ++i)
+      x[i] = train_.x[p[i]], y[i] = train_.y[p[i]], t[i] = train_.t[p[i]];
+    return DirectionalLossFromRaw(*net_, Forward(x, y, t), theta_train_.index_select(0, idx),
+                                  penalty_);
+  }
+
+  double ValidationLoss() override {
+    torch::NoGradGuard no_grad;
+    const Eigen::Index n = val_.size();
+    FS_THROW_UNLESS(n > 0, "no validation samples to compute the validation loss on");
+    double sum = 0;
+    for (Eigen::Index b = 0; b < n; b += 512) {
+      const Eigen::Index len = std::min<Eigen::Index>(512, n - b);
+      const auto raw =
+          Forward(val_.x.segment(b, len), val_.y.segment(b, len), val_.t.segment(b, len));
+      sum += VonMisesMixtureNll(DecodeDirectionalHead(raw, net_->components(), net_->max_kappa()),
+                                theta_val_.narrow(0, b, len))
+                 .sum()
+                 .item<double>();
+    }
+    return sum / static_cast<double>(n);
+  }
+
+ private:
+  /// Raw outputs from sparse spatial features (embedding bag) and dense temporal ones.
+  torch::Tensor Forward(const Eigen::VectorXd& x, const Eigen::VectorXd& y,
+                        const Eigen::VectorXd& t) {
+    features_.SpatialSparseBatch(x, y, &index_, &value_, &offsets_);
+    RowMatrixF tm(t.size(), features_.time_size());
+    features_.TemporalBatch(t, tm);
+    const auto n = static_cast<std::int64_t>(index_.size());
+    const auto ti = torch::from_blob(index_.data(), {n}, torch::kInt64).clone();
+    const auto tv = torch::from_blob(value_.data(), {n}, torch::kFloat32).clone();
+    const auto to = torch::from_blob(offsets_.data(), {static_cast<std::int64_t>(offsets_.size())},
+                                     torch::kInt64)
+                        .clone();
+    const auto tt = torch::from_blob(tm.data(), {tm.rows(), tm.cols()}, torch::kFloat32).clone();
+    return net_->forward_sparse(ti, tv, to, tt);
+  }
+
+  DirectionalNet net_;
+  DirectionalFeatures features_;
+  std::vector<std::int64_t> index_, offsets_;
+  std::vector<float> value_;
+  const DirectionalSamples& train_;
+  const DirectionalSamples& val_;
+  DirectionalPenalty penalty_;
+  torch::Tensor theta_train_, theta_val_;
+};
+
+DirectionalPenalty PenaltyOf(const DirectionalNetworkConfig& n) {
+  return {n.lambda_alpha, n.lambda_mu, n.lambda_kappa};
+}
+
+DirectionalNet MakeNet(const DirectionalExperimentConfig& c, const DirectionalFeatureConfig& f,
+                       DirectionalVariant v) {
+  return DirectionalNet(v, f.cells_x * f.cells_y, c.network.components, c.network.Hidden(),
+                        c.network.max_kappa);
+}
+
+/// Splits `samples` into (train, val) with a seeded val_fraction (both non-empty).
+std::pair<DirectionalSamples, DirectionalSamples> SplitVal(const DirectionalSamples& s,
+                                                           double val_fraction,
+                                                           std::uint64_t seed) {
+  FS_THROW_UNLESS(s.size() >= 2, "directional: ", s.size(),
+                  " training samples; need at least 2 (one to train, one to validate)");
+  std::vector<Eigen::Index> idx(static_cast<std::size_t>(s.size()));
+  std::iota(idx.begin(), idx.end(), Eigen::Index{0});
+  std::mt19937_64 rng(seed);
+  std::shuffle(idx.begin(), idx.end(), rng);
+  auto nv = static_cast<std::size_t>(std::llround(val_fraction * static_cast<double>(s.size())));
+  nv = std::clamp<std::size_t>(nv, 1, idx.size() - 1);
+  std::vector<Eigen::Index> val(idx.begin(), idx.begin() + static_cast<long>(nv));
+  std::vector<Eigen::Index> train(idx.begin() + static_cast<long>(nv), idx.end());
+  std::sort(val.begin(), val.end());
+  std::sort(train.begin(), train.end());
+  return {s.Select(train), s.Select(val)};
+}
+
+std::vector<Eigen::Index> Complement(Eigen::Index n, const std::vector<Eigen::Index>& test) {
+  std::vector<char> in(static_cast<std::size_t>(n), 0);
+  for (auto i : test) in[static_cast<std::size_t>(i)] = 1;
+  std::vector<Eigen::Index> out;
+  for (Eigen::Index i = 0; i < n; ++i)
+    if (!in[static_cast<std::size_t>(i)]) out.push_back(i);
+  return out;
+}
+
+std::string Num(double v) {
+  if (!std::isfinite(v)) return "null";
+  std::ostringstream os;
+  os << std::setprecision(6) << v;
+  return os.str();
+}
+
+double Mean(const std::vector<double>& v) {
+  if (v.empty()) return NAN;
+  return std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
+}
+double Std(const std::vector<double>& v) {
+  if (v.size() < 2) return 0.0;
+  const double m = Mean(v);
+  double s = 0;
+  for (double x : v) s += (x - m) * (x - m);
+  return std::sqrt(s / static_cast<double>(v.size() - 1));
+}
+
+DirectionalGridConfig GridConfig(const DirectionalExperimentConfig& c,
+                                 const DirectionalFeatureConfig& f, GridDirectionalKind kind,
+                                 bool dense) {
+  DirectionalGridConfig g;
+  g.kind = kind;
+  g.cells_x = f.cells_x;
+  g.cells_y = f.cells_y;
+  g.extent = Eigen::Vector4d(f.x_min, f.x_max, f.y_min, f.y_max);
+  g.components = c.eval.grid_components;
+  g.dense = dense;
+  const double spacing = 0.5 * ((f.x_max - f.x_min) / f.cells_x + (f.y_max - f.y_min) / f.cells_y);
+  g.length_scale = c.eval.grid_length_scale > 0 ? c.eval.grid_length_scale : spacing;
+  g.seed = static_cast<std::uint64_t>(c.seed);
+  g.max_kappa = c.network.max_kappa;  // one cap for every method
+  return g;
+}
+
+std::pair<double, double> Score(const VonMisesMixtureBatch& b, const Eigen::VectorXd& theta) {
+  return {AverageLikelihood(b, theta), MinimumRotationError(b, theta)};
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+
+DirectionalSamples LoadDirectionalSamples(const DirectionalExperimentConfig& c) {
+  DirectionalSamples s;
+  DirectionalReadStats stats;
+  std::string where;
+  switch (c.data.format) {
+    case DirectionalSource::kCrossing: {
+      CrossingFlowConfig flow = c.data.crossing.flow;
+      flow.seed = static_cast<std::uint64_t>(c.seed);
+      s = GenerateCrossingFlow(flow);
+      where = "synthetic crossing";
+      break;
+    }
+    case DirectionalSource::kGridCsv:
+      where = ResolveDataFile(c.data.root, c.data.file);
+      s = ReadDirectionalGridCsv(where, &stats);
+      break;
+    case DirectionalSource::kEdinburgh:
+      where = ResolveDataFile(c.data.root, c.data.file);
+      s = ReadEdinburghTracks(where, c.data.edinburgh.filter, &stats);
+      break;
+  }
+  if (c.data.format != DirectionalSource::kCrossing)
+    log::Info(where, ": ", stats.points, " points in ", stats.tracks, " tracks, kept ", stats.kept,
+              " headings; dropped standing ", stats.dropped_standing, ", jumps ",
+              stats.dropped_jump, ", gaps ", stats.dropped_gap, ", short tracks ",
+              stats.dropped_short_track);
+  s.Validate(where);
+  if (c.data.max_samples > 0 && s.size() > c.data.max_samples) {
+    s = s.Select(RandomSubset(
+        s.size(), static_cast<double>(c.data.max_samples) / static_cast<double>(s.size()),
+        static_cast<std::uint64_t>(c.seed) + 101));
+    log::Info("subsampled to ", s.size(), " samples (data.max_samples)");
+  }
+  return s;
+}
+
+void WriteDirectionalArtifact(DirectionalNetImpl& net, const DirectionalFeatureConfig& fc,
+                              const std::string& config_yaml, std::int64_t seed,
+                              const std::string& path) {
+  FS_THROW_UNLESS(!fc.auto_extent && !fc.auto_time_range,
+                  "WriteDirectionalArtifact: unresolved feature extent");
+  const auto params = net.named_parameters();
+  auto matrix = [&](const std::string& name) {
+    const torch::Tensor t = params[name].detach().contiguous().to(torch::kFloat32);
+    return Eigen::MatrixXf(
+        Eigen::Map<const Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
+            t.data_ptr<float>(), t.size(0), t.size(1)));
+  };
+  auto vector = [&](const std::string& name) {
+    const torch::Tensor t = params[name].detach().contiguous().to(torch::kFloat32);
+    return Eigen::VectorXf(Eigen::Map<const Eigen::VectorXf>(t.data_ptr<float>(), t.size(0)));
+  };
+  Lstm lstm;
+  if (net.variant() == DirectionalVariant::kSpatiotemporal)
+    lstm = Lstm(LstmWeights{matrix("lstm.weight_ih_l0"), matrix("lstm.weight_hh_l0"),
+                            vector("lstm.bias_ih_l0"), vector("lstm.bias_hh_l0")});
+  DirectionalHeads heads{matrix("alpha.weight"), matrix("mu.weight"), matrix("kappa.weight"),
+                         vector("alpha.bias"),   vector("mu.bias"),   vector("kappa.bias")};
+  DirectionalMap(net.variant(), fc, std::move(lstm), std::move(heads), net.max_kappa())
+      .Save(path, config_yaml, seed);
+}
+
+LoadedDirectionalNet LoadDirectionalNetFromArtifact(const std::string& path) {
+  const Artifact art = Artifact::Open(path, kDirectionalModelType);
+  const h5::File& f = art.file();
+  // The engine loader checks every shape; reuse it for the feature config and the variant.
+  const DirectionalMap map = DirectionalMap::Load(path);
+  LoadedDirectionalNet out;
+  out.features = map.features().config();
+  const int hidden = map.variant() == DirectionalVariant::kSpatial ? 0 : map.lstm().hidden_size();
+  out.net = DirectionalNet(map.variant(), map.features().spatial_size(), map.components(), hidden,
+                           map.max_kappa());
+  torch::NoGradGuard no_grad;
+  for (auto& item : out.net->named_parameters()) {
+    const std::string& key = item.key();
+    const auto dot = key.rfind('.');
+    const auto a = f.ReadFloat("/weights/" + key.substr(0, dot) + "/" + key.substr(dot + 1));
+    FS_THROW_UNLESS(static_cast<std::int64_t>(a.Size()) == item.value().numel(), path, ": tensor ",
+                    key, " has ", a.Size(), " values, the network needs ", item.value().numel());
+    item.value().copy_(
+        torch::from_blob(const_cast<float*>(a.data.data()), item.value().sizes(), torch::kFloat32));
+  }
+  out.net->eval();
+  return out;
+}
+
+TrainingSummary TrainDirectionalNet(const DirectionalExperimentConfig& c,
+                                    const DirectionalFeatureConfig& features,
+                                    DirectionalVariant variant, const DirectionalSamples& train,
+                                    const DirectionalSamples& val, const std::string& dir,
+                                    bool resume, const TrainHooks& hooks) {
+  const std::string artifact = dir + "/model.h5";
+  if (fs::exists(artifact)) {
+    TrainingSummary s;
+    s.reason = TerminationReason::kAlreadyComplete;
+    return s;
+  }
+  fs::create_directories(dir);
+  RunPaths run{dir};
+  const bool can_resume = resume && fs::exists(run.Checkpoint());
+  torch::manual_seed(static_cast<std::uint64_t>(c.seed));
+  DirectionalNet net = MakeNet(c, features, variant);
+  DirectionalTask task(net, DirectionalFeatures(features), train, val, PenaltyOf(c.network));
+  TrainConfig tc = c.train;
+  if (variant == DirectionalVariant::kSpatial && c.network.spatial_epochs > 0)
+    tc.epochs = c.network.spatial_epochs;
+  if (c.data.train_fraction < 1.0) {
+    // Epochs count passes over a full training split: a fraction f trains epochs / f passes (the
+    // same number of optimiser steps), patience likewise.
+    tc.epochs = static_cast<int>(std::ceil(tc.epochs / c.data.train_fraction));
+    tc.patience = static_cast<int>(std::ceil(tc.patience / c.data.train_fraction));
+  }
+  TrainingSummary s = Train(&task, tc, run, static_cast<std::uint64_t>(c.seed), can_resume, hooks);
+  std::ofstream(dir + "/training_summary.json") << s.ToJson();
+  if (s.reason == TerminationReason::kInterrupted) return s;
+  const std::string ckpt =
+      fs::exists(run.BestCheckpoint()) ? run.BestCheckpoint() : run.Checkpoint();
+  FS_THROW_UNLESS(fs::exists(ckpt), dir, ": training produced no checkpoint (", ToString(s.reason),
+                  ")");
+  DirectionalNet best = MakeNet(c, features, variant);
+  LoadCheckpointModel(ckpt, best.ptr().get());
+  WriteDirectionalArtifact(*best, features, config::ToYaml(c), c.seed, artifact);
+  (void)DirectionalMap::Load(artifact);  // the engine loads what was written
+  return s;
+}
+
+std::vector<std::pair<std::string, std::pair<double, double>>> EvaluateDirectionalSplit(
+    const DirectionalExperimentConfig& c, const DirectionalFeatureConfig& f,
+    const DirectionalSamples& train_all, const DirectionalSamples& test,
+    const std::string& work_dir, const TrainHooks& hooks, bool* interrupted) {
+  std::vector<std::pair<std::string, std::pair<double, double>>> out;
+  if (interrupted) *interrupted = false;
+  VonMisesMixtureBatch batch;
+  const auto [train, val] =
+      SplitVal(train_all, c.eval.val_fraction, static_cast<std::uint64_t>(c.seed) + 17);
+  std::vector<DirectionalVariant> variants;
+  if (c.eval.spatiotemporal) variants.push_back(DirectionalVariant::kSpatiotemporal);
+  if (c.eval.spatial) variants.push_back(DirectionalVariant::kSpatial);
+  for (const DirectionalVariant v : variants) {
+    const std::string dir = work_dir + "/" + VariantName(v);
+    const TrainingSummary s = TrainDirectionalNet(c, f, v, train, val, dir, true, hooks);
+    if (s.reason == TerminationReason::kInterrupted) {
+      if (interrupted) *interrupted = true;
+      return out;
+    }
+    const DirectionalMap map = DirectionalMap::Load(dir + "/model.h5");
+    auto ws = map.MakeWorkspace();
+    map.Query(test.x, test.y, test.t, &ws, &batch);
+    out.push_back({VariantName(v), Score(batch, test.theta)});
+  }
+  std::vector<std::pair<std::string, DirectionalGridConfig>> grids{
+      {"grid_um", GridConfig(c, f, GridDirectionalKind::kUnimodal, false)},
+      {"grid_mm", GridConfig(c, f, GridDirectionalKind::kMultimodal, false)}};
+  if (c.eval.dense) {
+    grids.push_back({"grid_um_dense", GridConfig(c, f, GridDirectionalKind::kUnimodal, true)});
+    grids.push_back({"grid_mm_dense", GridConfig(c, f, GridDirectionalKind::kMultimodal, true)});
+  }
+  for (const auto& [name, g] : grids) {
+    const DirectionalGridMap grid = DirectionalGridMap::Fit(train_all, g);
+    grid.Query(test.x, test.y, &batch);
+    out.push_back({name, Score(batch, test.theta)});
+  }
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+
+double DirectionalMethodMetrics::MeanAl() const { return Mean(al); }
+double DirectionalMethodMetrics::MeanMre() const { return Mean(mre); }
+double DirectionalMethodMetrics::StdAl() const { return Std(al); }
+double DirectionalMethodMetrics::StdMre() const { return Std(mre); }
+
+const DirectionalMethodMetrics* DirectionalEvalReport::Find(const std::string& method) const {
+  for (const auto& m : methods)
+    if (m.method == method) return &m;
+  return nullptr;
+}
+
+std::string DirectionalEvalReport::ToJson() const {
+  std::ostringstream os;
+  os << "{\n";
+  auto list = [](const std::vector<double>& v) {
+    std::string s = "[";
+    for (std::size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + Num(v[i]);
+    return s + "]";
+  };
+  for (const auto& m : methods)
+    os << "  \"" << m.method << "\": {\"al\": " << Num(m.MeanAl())
+       << ", \"mre\": " << Num(m.MeanMre()) << ", \"al_std\": " << Num(m.StdAl())
+       << ", \"mre_std\": " << Num(m.StdMre()) << ", \"al_folds\": " << list(m.al)
+       << ", \"mre_folds\": " << list(m.mre) << "},\n";
+  os << "  \"samples\": " << samples << ",\n  \"folds\": " << folds
+     << ",\n  \"folds_evaluated\": " << folds_evaluated
+     << ",\n  \"resolution\": {\"cells_x\": " << features.cells_x
+     << ", \"cells_y\": " << features.cells_y
+     << ", \"inducing_points\": " << features.cells_x * features.cells_y
+     << ", \"length_scale\": " << Num(features.length_scale)
+     << ", \"time_points\": " << features.time_points
+     << ", \"time_length_scale\": " << Num(features.time_length_scale) << ", \"extent\": ["
+     << Num(features.x_min) << ", " << Num(features.x_max) << ", " << Num(features.y_min) << ", "
+     << Num(features.y_max) << "], \"time_range\": [" << Num(features.t_min) << ", "
+     << Num(features.t_max) << "]}\n}\n";
+  return os.str();
+}
+
+std::string DirectionalEvalReport::ToCsv() const {
+  std::ostringstream os;
+  os << "method,fold,al,mre\n";
+  for (const auto& m : methods)
+    for (std::size_t k = 0; k < m.al.size(); ++k)
+      os << m.method << "," << k << "," << Num(m.al[k]) << "," << Num(m.mre[k]) << "\n";
+  return os.str();
+}
+
+std::string DirectionalEvalReport::BriefReport() const {
+  std::ostringstream os;
+  os << "directional eval (" << samples << " samples, " << folds_evaluated << "/" << folds
+     << " folds, " << features.cells_x * features.cells_y << " inducing points / cells):";
+  for (const auto& m : methods)
+    os << "\n  " << std::left << std::setw(16) << m.method << " AL " << std::setprecision(4)
+       << m.MeanAl() << " +- " << m.StdAl() << "   MRE " << m.MeanMre() << " +- " << m.StdMre();
+  return os.str();
+}
+
+namespace {
+/// The run's artifacts: fold 0's networks (trained on fold 0's training split). model.h5 is the
+/// spatiotemporal one, or the spatial one when only that was trained.
+void PublishFoldZero(const DirectionalExperimentConfig& c, const std::string& run_dir) {
+  if (c.eval.spatiotemporal)
+    fs::copy_file(run_dir + "/folds/0/spatiotemporal/model.h5", run_dir + "/model.h5",
+                  fs::copy_options::overwrite_existing);
+  if (c.eval.spatial)
+    fs::copy_file(run_dir + "/folds/0/spatial/model.h5",
+                  run_dir + (c.eval.spatiotemporal ? "/model_spatial.h5" : "/model.h5"),
+                  fs::copy_options::overwrite_existing);
+}
+}  // namespace
+
+std::string ExportDirectionalRun(const std::string& run_dir) {
+  const auto c =
+      config::LoadExperimentConfig<DirectionalExperimentConfig>(run_dir + "/config.yaml");
+  const DirectionalSamples data = LoadDirectionalSamples(c);
+  const DirectionalFeatureConfig f = ResolveExtent(c.features, data.x, data.y, data.t);
+  std::vector<DirectionalVariant> variants;
+  if (c.eval.spatiotemporal) variants.push_back(DirectionalVariant::kSpatiotemporal);
+  if (c.eval.spatial) variants.push_back(DirectionalVariant::kSpatial);
+  const int folds = c.eval.max_folds > 0 ? c.eval.max_folds : c.eval.folds;
+  for (int k = 0; k < folds; ++k) {
+    for (const DirectionalVariant v : variants) {
+      const std::string dir = run_dir + "/folds/" + std::to_string(k) + "/" + VariantName(v);
+      const RunPaths run{dir};
+      const std::string ckpt =
+          fs::exists(run.BestCheckpoint()) ? run.BestCheckpoint() : run.Checkpoint();
+      FS_THROW_UNLESS(fs::exists(ckpt), dir, ": no checkpoint to export (fold ", k,
+                      " is not trained yet; ", "continue with train --resume)");
+      DirectionalNet best = MakeNet(c, f, v);
+      LoadCheckpointModel(ckpt, best.ptr().get());
+      WriteDirectionalArtifact(*best, f, config::ToYaml(c), c.seed, dir + "/model.h5");
+      (void)DirectionalMap::Load(dir + "/model.h5");
+    }
+  }
+  PublishFoldZero(c, run_dir);
+  log::Info("exported ", folds, " folds x ", variants.size(), " networks; ", run_dir,
+            "/model.h5 is fold 0's");
+  return run_dir + "/model.h5";
+}
+
+DirectionalRunResult RunDirectionalExperiment(const DirectionalExperimentConfig& c,
+                                              const std::string& run_dir, bool resume,
+                                              const TrainHooks& hooks) {
+  StartRunDirectory(run_dir, config::ToYaml(c), resume, kDirectionalRunRules);
+  log::Info(resume ? "resuming" : "training", " directional maps in ", run_dir, " (seed ", c.seed,
+            ")");
+
+  const DirectionalSamples data = LoadDirectionalSamples(c);
+  const DirectionalFeatureConfig f = ResolveExtent(c.features, data.x, data.y, data.t);
+  (void)DirectionalFeatures(f);  // checks the resolved extent
+  log::Info(data.size(), " samples; ", f.cells_x, " x ", f.cells_y,
+            " spatial inducing points over x [", f.x_min, ", ", f.x_max, "], y [", f.y_min, ", ",
+            f.y_max, "], ", f.time_points, " temporal over [", f.t_min, ", ", f.t_max, "] s");
+  const auto folds =
+      KFoldTestIndices(data.size(), c.eval.folds, static_cast<std::uint64_t>(c.seed));
+  const int evaluate = c.eval.max_folds > 0 ? c.eval.max_folds : c.eval.folds;
+
+  DirectionalRunResult result;
+  DirectionalEvalReport& report = result.report;
+  report.samples = data.size();
+  report.folds = c.eval.folds;
+  report.features = f;
+  for (int k = 0; k < evaluate; ++k) {
+    const auto& test_idx = folds[static_cast<std::size_t>(k)];
+    DirectionalSamples train = data.Select(Complement(data.size(), test_idx));
+    if (c.data.train_fraction < 1.0)
+      train = train.Select(RandomSubset(train.size(), c.data.train_fraction,
+                                        static_cast<std::uint64_t>(c.seed) + 1000 + k));
+    const DirectionalSamples test = data.Select(test_idx);
+    log::Info("fold ", k + 1, "/", evaluate, ": ", train.size(), " training, ", test.size(),
+              " test samples");
+    const std::string work = run_dir + "/folds/" + std::to_string(k);
+    bool interrupted = false;
+    const auto scores = EvaluateDirectionalSplit(c, f, train, test, work, hooks, &interrupted);
+    if (interrupted) {
+      result.interrupted = true;
+      return result;
+    }
+    for (const auto& [name, score] : scores) {
+      DirectionalMethodMetrics* m = nullptr;
+      for (auto& existing : report.methods)
+        if (existing.method == name) m = &existing;
+      if (!m) {
+        report.methods.push_back({name, {}, {}});
+        m = &report.methods.back();
+      }
+      m->al.push_back(score.first);
+      m->mre.push_back(score.second);
+      log::Info("  fold ", k + 1, " ", name, ": AL ", score.first, " MRE ", score.second);
+    }
+    ++report.folds_evaluated;
+  }
+  PublishFoldZero(c, run_dir);
+  std::ofstream(run_dir + "/eval.json") << report.ToJson();
+  std::ofstream(run_dir + "/eval.csv") << report.ToCsv();
+  if (c.eval.plots) {
+    fs::create_directories(run_dir + "/plots");
+    const DirectionalMap first = DirectionalMap::Load(run_dir + "/model.h5");
+    std::unique_ptr<DirectionalMap> sp;
+    if (c.eval.spatial && c.eval.spatiotemporal)
+      sp = std::make_unique<DirectionalMap>(DirectionalMap::Load(run_dir + "/model_spatial.h5"));
+    PlotDirectionalMaps(data, first, sp.get(), c.eval, static_cast<std::uint64_t>(c.seed),
+                        run_dir + "/plots");
+  }
+  log::Info(report.BriefReport());
+  return result;
+}
+
+}  // namespace foresight

@@ -1,0 +1,65 @@
+#include "training/navigation/config.h"
+
+#include <algorithm>
+
+#include "core/error.h"
+
+namespace foresight {
+
+namespace {
+constexpr NavigationMethod kAllMethods[] = {NavigationMethod::kSpan, NavigationMethod::kReactive,
+                                            NavigationMethod::kClRrtStar};
+}  // namespace
+
+const char* MethodName(NavigationMethod method) {
+  switch (method) {
+    case NavigationMethod::kSpan:
+      return "span";
+    case NavigationMethod::kReactive:
+      return "reactive";
+    case NavigationMethod::kClRrtStar:
+      return "cl_rrt_star";
+  }
+  return "";
+}
+
+NavigationMethod ParseNavigationMethod(const std::string& name, const std::string& where) {
+  for (const NavigationMethod m : kAllMethods)
+    if (name == MethodName(m)) return m;
+  Fail(where, ": unknown method '", name, "' (expected span, reactive or cl_rrt_star)");
+}
+
+std::vector<NavigationMethod> NavigationExperimentConfig::Methods() const {
+  std::vector<NavigationMethod> out;
+  for (const std::string& m : methods) out.push_back(ParseNavigationMethod(m, "methods"));
+  return out;
+}
+
+bool NavigationExperimentConfig::Uses(NavigationMethod method) const {
+  return std::find(methods.begin(), methods.end(), MethodName(method)) != methods.end();
+}
+
+void NavigationExperimentConfig::Validate(const std::string& path) const {
+  const NavigationExperimentConfig& c = *this;
+  FS_THROW_UNLESS(c.model == "navigation", path, ": model: '", c.model, "', expected 'navigation'");
+  FS_THROW_UNLESS(!c.methods.empty(), path, ": methods: empty list");
+  for (std::size_t i = 0; i < c.methods.size(); ++i) {
+    const std::string& m = c.methods[i];
+    (void)ParseNavigationMethod(m, path + ": methods");
+    FS_THROW_UNLESS(std::find(c.methods.begin(), c.methods.begin() + static_cast<long>(i), m) ==
+                        c.methods.begin() + static_cast<long>(i),
+                    path, ": methods: '", m, "' listed twice");
+  }
+  nav::SpanControllerOptions o = c.span.options;
+  o.dt = c.dt;
+  const std::string span_problems = o.Problems();
+  FS_THROW_UNLESS(span_problems.empty(), path, ": span: ", span_problems);
+  const std::string rrt_problems = c.cl_rrt_star.options.Problems();
+  FS_THROW_UNLESS(rrt_problems.empty(), path, ": cl_rrt_star: ", rrt_problems);
+  FS_THROW_UNLESS(c.predictor.tracks == "scenario" || c.predictor.tracks == "replay", path,
+                  ": predictor.tracks: '", c.predictor.tracks, "', expected scenario or replay");
+  (void)ParseNavigationMethod(c.video.method, path + ": video.method");
+  c.scenario.Validate(path + ": scenario");
+}
+
+}  // namespace foresight

@@ -1,0 +1,85 @@
+#include "training/navigation/predictor.h"
+
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <random>
+
+#include "core/error.h"
+#include "core/log.h"
+#include "datasets/crowd_replay.h"
+#include "datasets/track_store.h"
+#include "training/span/eval.h"
+#include "training/span/pipeline.h"
+
+namespace foresight {
+namespace fs = std::filesystem;
+
+std::string EnsureNavigationPredictor(const NavigationExperimentConfig& c,
+                                      const std::string& embedded_default) {
+  const NavigationPredictorConfig& p = c.predictor;
+  if (fs::exists(p.artifact)) return p.artifact;
+  const fs::path artifact(p.artifact);
+  FS_THROW_UNLESS(artifact.filename() == "model.h5", "predictor.artifact: ", p.artifact,
+                  " does not exist; to train it automatically name it <run dir>/model.h5");
+  const std::string run_dir =
+      artifact.parent_path().empty() ? "." : artifact.parent_path().string();
+  fs::create_directories(run_dir);
+  const std::string tracks_file = fs::absolute(fs::path(run_dir) / "tracks.h5").string();
+  if (!fs::exists(tracks_file)) {
+    TrackSet tracks;
+    if (p.tracks == "replay") {
+      tracks = ReadReplayTracks(p.replay);
+    } else {
+      FS_THROW_UNLESS(c.scenario.source == CrowdSource::kSimulated,
+                      "predictor.tracks: 'scenario' needs a simulated ",
+                      "scenario; for replays set predictor.tracks: replay and predictor.replay to "
+                      "other recordings");
+      tracks = RecordCrowdTracks(c.scenario, p.record_episodes, p.record_duration, c.dt,
+                                 static_cast<std::uint64_t>(c.seed) + 1000003);
+      std::mt19937_64 rng(static_cast<std::uint64_t>(c.seed) + 7);
+      std::normal_distribution<double> noise(0.0, p.position_noise);
+      if (p.position_noise > 0)
+        for (Track& t : tracks.tracks)
+          t.positions += t.positions.unaryExpr([&](double) { return noise(rng); });
+    }
+    FS_THROW_UNLESS(!tracks.tracks.empty(), "predictor: no training tracks from ", p.tracks);
+    WriteTrackStore(tracks_file + ".tmp", tracks);
+    fs::rename(tracks_file + ".tmp", tracks_file);
+    log::Info("predictor: ", tracks.tracks.size(), " training tracks (", tracks.NumPoints(),
+              " points) -> ", tracks_file);
+  }
+  const TrackSet stored = ReadTrackStore(tracks_file);
+  const std::vector<std::string> data = {
+      "data.format=track_store", "data.root=", "data.train_files=[" + tracks_file + "]",
+      "data.seconds_per_step=" + std::to_string(stored.seconds_per_step)};
+  const SpanExperimentConfig span =
+      p.train_config == "default"
+          ? config::ExperimentConfigFromYaml<SpanExperimentConfig>(
+                embedded_default, "<embedded configs/navigation/predictor.yaml>", data)
+          : config::LoadExperimentConfig<SpanExperimentConfig>(p.train_config, data);
+  const bool resume = fs::exists(run_dir + "/checkpoints/last.pt");
+  std::cout << "training the SPAN predictor into " << run_dir << (resume ? " (resuming)" : "")
+            << "\n";
+  TrainingSummary s;
+  {
+    const ScopedInterruptFlag interrupt;
+    TrainHooks hooks;
+    hooks.interrupt = interrupt.flag();
+    s = TrainSpan(span, run_dir, resume, hooks);
+  }
+  std::ofstream(run_dir + "/training_summary.json") << s.ToJson();
+  std::cout << s.BriefReport() << "\n";
+  FS_THROW_UNLESS(s.reason != TerminationReason::kInterrupted,
+                  "predictor training interrupted; run again to resume");
+  FS_THROW_UNLESS(s.best_epoch >= 0, run_dir,
+                  ": predictor training produced no usable checkpoint (", ToString(s.reason), ")");
+  const std::string out = ExportSpan(run_dir);
+  const SpanEvalReport r = EvaluateSpan(span, out, run_dir);
+  std::cout << "predictor eval (" << r.windows << " test windows): ADE " << r.model.ade << " FDE "
+            << r.model.fde << " NLL " << r.model.nll << " | constant velocity ADE " << r.cv.ade
+            << " FDE " << r.cv.fde << "\n";
+  return out;
+}
+
+}  // namespace foresight

@@ -1,0 +1,467 @@
+#include "training/navigation/run.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <deque>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <limits>
+#include <numeric>
+#include <opencv2/imgproc.hpp>
+#include <queue>
+#include <sstream>
+#include <unordered_map>
+
+#include "core/error.h"
+#include "core/log.h"
+#include "inference/mapping/grid_map.h"
+#include "inference/navigation/cl_rrt_star.h"
+#include "inference/navigation/goal_distance.h"
+#include "inference/navigation/span_controller.h"
+#include "models/occupancy/fast_bhm.h"
+#include "training/navigation/render.h"
+
+namespace foresight {
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+bool UsesPredictor(const NavigationExperimentConfig& c) { return c.Uses(NavigationMethod::kSpan); }
+
+/// Fast-BHM (or grid) map of the scenario's obstacles, saved as an artifact at `path`.
+void BuildScenarioMap(const NavigationExperimentConfig& c, const OccupancyRaster& raster,
+                      const std::string& path) {
+  const Eigen::Vector4d e = raster.extent;
+  const double step = c.map.raster_resolution, margin = 1.0;
+  const int nx = static_cast<int>(std::ceil((e[1] - e[0] + 2 * margin) / step));
+  const int ny = static_cast<int>(std::ceil((e[3] - e[2] + 2 * margin) / step));
+  const std::string yaml = config::ToYaml(c);
+  if (c.map.kind == NavigationMapKind::kGrid) {
+    GridGeometry g;
+    g.x_min = e[0] - margin;
+    g.y_min = e[2] - margin;
+    g.resolution = step;
+    g.nx = nx;
+    g.ny = ny;
+    // Fraction of occupied raster samples in each cell (4 x 4 sub-samples), mapped to [0.05, 0.95].
+    Eigen::MatrixXf p(ny, nx);
+    for (int iy = 0; iy < ny; ++iy)
+      for (int ix = 0; ix < nx; ++ix) {
+        int occ = 0;
+        for (int sy = 0; sy < 4; ++sy)
+          for (int sx = 0; sx < 4; ++sx)
+            occ += raster.Occupied(g.x_min + (ix + (sx + 0.5) / 4) * step,
+                                   g.y_min + (iy + (sy + 0.5) / 4) * step);
+        p(iy, ix) = 0.05f + 0.9f * static_cast<float>(occ) / 16.0f;
+      }
+    GridMap(g, p, CellType::kFloat32).Save(path, yaml, c.seed);
+    return;
+  }
+  HingeGridConfig hg;
+  hg.x_min = e[0] - margin;
+  hg.x_max = e[1] + margin;
+  hg.y_min = e[2] - margin;
+  hg.y_max = e[3] + margin;
+  hg.spacing = c.map.spacing;
+  hg.gamma = 6.71 * std::pow(0.5 / c.map.spacing, 2);  // the thesis' 0.5 m / 6.71 pairing, rescaled
+  hg.cutoff_radius = 2.0 * c.map.spacing;
+  FastBhmLearner learner{HingeGrid(hg), FastBhmConfig{}};
+  // Labelled points on the raster's sampling grid, fed in row strips like scans.
+  Eigen::Matrix2Xd xy(2, nx);
+  std::vector<std::uint8_t> label(static_cast<std::size_t>(nx));
+  for (int iy = 0; iy < ny; ++iy) {
+    const double y = hg.y_min + (iy + 0.5) * step;
+    for (int ix = 0; ix < nx; ++ix) {
+      const double x = hg.x_min + (ix + 0.5) * step;
+      xy.col(ix) = Eigen::Vector2d(x, y);
+      label[static_cast<std::size_t>(ix)] = raster.Occupied(x, y) ? 1 : 0;
+    }
+    learner.Update(xy, label.data());
+  }
+  learner.ToMap().Save(path, yaml, c.seed);
+}
+
+/// Distance (m) from each raster cell to the nearest occupied cell or the outside of the raster
+/// (outside the scene is occupied: a one-cell occupied border is added before the transform).
+Eigen::MatrixXf DistanceToObstacles(const OccupancyRaster& r) {
+  const int rows = static_cast<int>(r.cells.rows()), cols = static_cast<int>(r.cells.cols());
+  cv::Mat free(rows + 2, cols + 2, CV_8U, cv::Scalar(0));
+  for (int i = 0; i < rows; ++i)
+    for (int j = 0; j < cols; ++j) free.at<std::uint8_t>(i + 1, j + 1) = r.cells(i, j) ? 0 : 255;
+  cv::Mat dist;
+  cv::distanceTransform(free, dist, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  Eigen::MatrixXf out(rows, cols);
+  for (int i = 0; i < rows; ++i)
+    for (int j = 0; j < cols; ++j)
+      out(i, j) = dist.at<float>(i + 1, j + 1) * static_cast<float>(r.resolution);
+  return out;
+}
+
+bool CellOf(const OccupancyRaster& r, double x, double y, int* row, int* col) {
+  const double c = (x - r.extent[0]) / r.resolution, q = (r.extent[3] - y) / r.resolution;
+  if (!(c >= 0 && q >= 0 && c < r.cells.cols() && q < r.cells.rows())) return false;
+  *row = static_cast<int>(q);
+  *col = static_cast<int>(c);
+  return true;
+}
+
+/// Breadth-first search over raster cells with clearance > radius.
+bool Reachable(const NavigationResources& res, const Eigen::Vector2d& a, const Eigen::Vector2d& b,
+               double radius) {
+  int r0, c0, r1, c1;
+  if (!CellOf(res.raster, a.x(), a.y(), &r0, &c0) || !CellOf(res.raster, b.x(), b.y(), &r1, &c1))
+    return false;
+  const int rows = static_cast<int>(res.static_distance.rows()),
+            cols = static_cast<int>(res.static_distance.cols());
+  std::vector<std::uint8_t> seen(static_cast<std::size_t>(rows) * cols, 0);
+  std::queue<std::pair<int, int>> q;
+  q.push({r0, c0});
+  seen[static_cast<std::size_t>(r0) * cols + c0] = 1;
+  while (!q.empty()) {
+    const auto [r, c] = q.front();
+    q.pop();
+    if (r == r1 && c == c1) return true;
+    for (const auto& [dr, dc] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
+      const int nr = r + dr, nc = c + dc;
+      if (nr < 0 || nc < 0 || nr >= rows || nc >= cols) continue;
+      const std::size_t k = static_cast<std::size_t>(nr) * cols + nc;
+      if (seen[k] || res.static_distance(nr, nc) <= radius) continue;
+      seen[k] = 1;
+      q.push({nr, nc});
+    }
+  }
+  return false;
+}
+
+double Percentile(std::vector<double> v, double q) {
+  if (v.empty()) return std::nan("");
+  std::sort(v.begin(), v.end());
+  const double pos = q * static_cast<double>(v.size() - 1);
+  const auto lo = static_cast<std::size_t>(std::floor(pos));
+  const std::size_t hi = std::min(lo + 1, v.size() - 1);
+  return v[lo] + (pos - static_cast<double>(lo)) * (v[hi] - v[lo]);
+}
+
+std::unique_ptr<nav::NavigationController> MakeController(const NavigationExperimentConfig& c,
+                                                          const NavigationResources& res,
+                                                          NavigationMethod method,
+                                                          std::uint64_t seed) {
+  nav::ControlLimits limits{-c.v_max, c.v_max, c.omega_max};
+  nav::SpanControllerOptions o = c.span.options;
+  o.dt = c.dt;
+  o.robot_radius = c.scenario.robot_radius;
+  o.pedestrian_radius = c.scenario.pedestrian_radius;
+  o.limits = limits;
+  switch (method) {
+    case NavigationMethod::kSpan:
+      return std::make_unique<nav::SpanController>(res.predictor.get(), res.field.get(), o);
+    case NavigationMethod::kReactive:
+      return std::make_unique<nav::ReactiveController>(res.field.get(), o,
+                                                       c.reactive.heading_weight);
+    case NavigationMethod::kClRrtStar: {
+      nav::ClRrtStarOptions r = c.cl_rrt_star.options;
+      r.robot_radius = o.robot_radius;
+      r.pedestrian_radius = o.pedestrian_radius;
+      r.epsilon = o.epsilon;
+      r.limits = limits;
+      return std::make_unique<nav::ClRrtStarController>(res.field.get(), res.raster.extent, r,
+                                                        seed);
+    }
+  }
+  Fail("navigation: method ", static_cast<int>(method), " has no controller");
+}
+
+std::string Json(double v) {
+  if (!std::isfinite(v)) return "null";
+  std::ostringstream s;
+  s << std::setprecision(6) << v;
+  return s.str();
+}
+
+}  // namespace
+
+double NavigationResources::StaticDistance(double x, double y) const {
+  int r, c;
+  if (!CellOf(raster, x, y, &r, &c)) return 0.0;
+  return static_distance(r, c);
+}
+
+NavigationResources PrepareNavigation(const NavigationExperimentConfig& c,
+                                      const std::string& out_dir) {
+  c.Validate("navigation config");  // configs built in code get the same checks as loaded ones
+  NavigationResources res;
+  res.raster = ScenarioOccupancy(c.scenario, 0.05);
+  res.static_distance = DistanceToObstacles(res.raster);
+  std::string map_path = c.map.artifact;
+  if (map_path.empty()) {
+    map_path = out_dir + "/map.h5";
+    BuildScenarioMap(c, res.raster, map_path);
+  }
+  res.map = LoadOccupancyMap(map_path);
+  res.field = std::make_unique<nav::StaticCollisionField>(*res.map, c.scenario.robot_radius,
+                                                          c.map.field_resolution);
+  if (UsesPredictor(c)) {
+    FS_THROW_UNLESS(fs::exists(c.predictor.artifact), "predictor.artifact: ", c.predictor.artifact,
+                    " not found (train it with `foresight navigate` in a LibTorch build, or "
+                    "`foresight train`)");
+    res.predictor = std::make_unique<SpanPredictor>(SpanPredictor::Load(c.predictor.artifact));
+    const double ratio = res.predictor->seconds_per_step() / c.dt;
+    FS_THROW_UNLESS(std::abs(ratio - std::round(ratio)) < 1e-6 && ratio >= 1,
+                    "predictor.artifact: ", c.predictor.artifact, " observes every ",
+                    res.predictor->seconds_per_step(), " s, not a multiple of dt = ", c.dt, " s");
+  }
+  return res;
+}
+
+EpisodeResult RunEpisode(const NavigationExperimentConfig& c, const NavigationResources& res,
+                         NavigationMethod method, int episode, EpisodeRecorder* recorder) {
+  EpisodeResult out;
+  out.method = MethodName(method);
+  out.episode = episode;
+  out.seed = static_cast<std::uint64_t>(c.seed) + static_cast<std::uint64_t>(episode);
+  std::unique_ptr<Crowd> crowd = MakeCrowd(c.scenario, out.seed);
+  const EpisodeEndpoints ends = MakeEpisodeEndpoints(c.scenario, out.seed);
+  std::unique_ptr<nav::NavigationController> controller = MakeController(c, res, method, out.seed);
+  const nav::ControlLimits limits{-c.v_max, c.v_max, c.omega_max};
+
+  // Observation window: p points every `stride` steps, the last one now.
+  const int p = res.predictor ? res.predictor->observed() : 5;
+  const int stride =
+      res.predictor ? static_cast<int>(std::lround(res.predictor->seconds_per_step() / c.dt)) : 1;
+  const std::size_t keep = static_cast<std::size_t>((p - 1) * stride + 1);
+  std::unordered_map<std::int64_t, std::deque<Eigen::Vector2d>> history;
+  auto observe = [&] {
+    for (const CrowdAgent& a : crowd->agents()) {
+      if (!a.active) {
+        history.erase(a.id);
+        continue;
+      }
+      auto& h = history[a.id];
+      h.push_back(a.position);
+      if (h.size() > keep) h.pop_front();
+    }
+  };
+  observe();
+
+  nav::UnicycleState s{ends.start[0], ends.start[1], ends.start[2]};
+  const Eigen::Vector2d goal = ends.goal;
+  const double r_robot = c.scenario.robot_radius;
+  controller->Prepare(goal);  // per-goal set-up (distance field) outside the timed cycles
+  const int max_cycles = static_cast<int>(std::ceil(c.max_time / c.dt));
+  std::vector<Eigen::Vector2d> path{s.position()};
+  Eigen::MatrixXd rows;
+  auto clearance = [&] {
+    double clear = res.StaticDistance(s.x, s.y) - r_robot;
+    for (const CrowdAgent& a : crowd->agents())
+      if (a.active)
+        clear = std::min(clear, (a.position - s.position()).norm() - r_robot - a.radius);
+    return clear;
+  };
+  double t = 0.0, min_clear = clearance();
+  for (int cycle = 0; cycle < max_cycles; ++cycle) {
+    if ((s.position() - goal).norm() <= c.goal_tolerance) {
+      out.reached = true;
+      break;
+    }
+    // Observed pedestrians within the sensing range.
+    int n = 0;
+    rows.resize(static_cast<Eigen::Index>(crowd->agents().size()), 2 * p);
+    for (const CrowdAgent& a : crowd->agents()) {
+      if (!a.active || (a.position - s.position()).norm() > c.sensing_range) continue;
+      const auto& h = history.at(a.id);
+      for (int i = 0; i < p; ++i) {
+        const int back = (p - 1 - i) * stride;  // steps before now
+        const int idx = std::max(0, static_cast<int>(h.size()) - 1 - back);
+        rows.row(n).segment(2 * i, 2) = h[static_cast<std::size_t>(idx)].transpose();
+      }
+      ++n;
+    }
+    const Eigen::MatrixXd observed = rows.topRows(n);
+    nav::NavigationInput in;
+    in.robot = s;
+    in.goal = goal;
+    in.past_rows = &observed;
+    in.observation_step = stride * c.dt;
+    const auto t0 = std::chrono::steady_clock::now();
+    nav::ControlOutcome u;
+    try {
+      u = controller->Compute(in);
+    } catch (const std::exception& e) {  // controllers do not throw; count it if one ever does
+      u = nav::ControlOutcome::Stop(nav::ControlStatus::kError, e.what());
+    }
+    out.cycle_ms.push_back(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    if (!u.solved()) {
+      if (out.solve_failures == 0)
+        log::Info(out.method, " episode ", episode, ": first unsolved cycle at t = ", t,
+                  " s: ", nav::ToString(u.status), " (", u.message, ")");
+      ++out.solve_failures;
+    }
+    const nav::Control cmd = limits.Clamp(u.command);
+    const nav::UnicycleState next = nav::EulerStep(s, cmd, c.dt);
+    RobotAgent robot;
+    robot.position = next.position();
+    robot.velocity = (next.position() - s.position()) / c.dt;
+    robot.radius = r_robot;
+    crowd->Step(c.dt, robot);
+    out.path_length += (next.position() - s.position()).norm();
+    s = next;
+    t += c.dt;
+    observe();
+    path.push_back(s.position());
+    ++out.cycles;
+    // Metrics at the new state.
+    double clear = res.StaticDistance(s.x, s.y) - r_robot;
+    if (clear < 0) out.doc_static += c.dt;
+    for (const CrowdAgent& a : crowd->agents())
+      if (a.active)
+        clear = std::min(clear, (a.position - s.position()).norm() - r_robot - a.radius);
+    if (clear < 0) out.doc += c.dt;
+    min_clear = std::min(min_clear, clear);
+    if (recorder) try {
+        Eigen::Matrix2Xd so_far(2, static_cast<Eigen::Index>(path.size()));
+        for (std::size_t i = 0; i < path.size(); ++i)
+          so_far.col(static_cast<Eigen::Index>(i)) = path[i];
+        recorder->Frame(t, s, goal, crowd->agents(), controller->Predictions(),
+                        controller->PredictedPedestrians(), so_far);
+      } catch (const std::exception& e) {  // a video problem must not lose the episode
+        log::Warn("video: ", e.what(), "; no more frames");
+        recorder = nullptr;
+      }
+  }
+  if (!out.reached && (s.position() - goal).norm() <= c.goal_tolerance) out.reached = true;
+  out.ttg = out.reached ? t : c.max_time;
+  out.min_clearance = min_clear;
+  out.path.resize(2, static_cast<Eigen::Index>(path.size()));
+  for (std::size_t i = 0; i < path.size(); ++i)
+    out.path.col(static_cast<Eigen::Index>(i)) = path[i];
+  return out;
+}
+
+MethodSummary Summarise(const std::string& method, const std::vector<EpisodeResult>& results) {
+  MethodSummary m;
+  m.method = method;
+  std::vector<double> cycles, ttg;
+  double doc = 0, clear = 0, worst = kInf;
+  int reached = 0, free = 0;
+  for (const EpisodeResult& r : results) {
+    if (r.method != method) continue;
+    ++m.episodes;
+    reached += r.reached;
+    free += r.doc == 0.0;
+    if (r.reached) ttg.push_back(r.ttg);
+    doc += r.doc;
+    clear += r.min_clearance;
+    worst = std::min(worst, r.min_clearance);
+    m.solve_failures += r.solve_failures;
+    cycles.insert(cycles.end(), r.cycle_ms.begin(), r.cycle_ms.end());
+  }
+  if (m.episodes == 0) return m;
+  m.success_rate = static_cast<double>(reached) / m.episodes;
+  m.collision_free_rate = static_cast<double>(free) / m.episodes;
+  m.ttg_mean = ttg.empty()
+                   ? std::nan("")
+                   : std::accumulate(ttg.begin(), ttg.end(), 0.0) / static_cast<double>(ttg.size());
+  m.doc_mean = doc / m.episodes;
+  m.min_clearance_mean = clear / m.episodes;
+  m.min_clearance = worst;
+  m.cycle_ms_median = Percentile(cycles, 0.5);
+  m.cycle_ms_p99 = Percentile(cycles, 0.99);
+  m.cycle_ms_max = cycles.empty() ? std::nan("") : *std::max_element(cycles.begin(), cycles.end());
+  return m;
+}
+
+std::string SummaryJson(const NavigationExperimentConfig& c, int episodes,
+                        const std::vector<MethodSummary>& s) {
+  std::ostringstream j;
+  std::string name;
+  for (char ch : c.scenario.name) {
+    if (ch == '"' || ch == '\\') name += '\\';
+    if (static_cast<unsigned char>(ch) >= 0x20) name += ch;
+  }
+  j << "{\n  \"scenario\": \"" << name << "\",\n  \"episodes\": " << episodes
+    << ",\n  \"seed\": " << c.seed;
+  for (const MethodSummary& m : s) {
+    j << ",\n  \"" << m.method << "\": {\"success_rate\": " << Json(m.success_rate)
+      << ", \"collision_free_rate\": " << Json(m.collision_free_rate)
+      << ", \"ttg_mean\": " << Json(m.ttg_mean) << ", \"doc_mean\": " << Json(m.doc_mean)
+      << ", \"min_clearance\": " << Json(m.min_clearance)
+      << ", \"min_clearance_mean\": " << Json(m.min_clearance_mean)
+      << ", \"cycle_ms_median\": " << Json(m.cycle_ms_median)
+      << ", \"cycle_ms_p99\": " << Json(m.cycle_ms_p99)
+      << ", \"cycle_ms_max\": " << Json(m.cycle_ms_max)
+      << ", \"solve_failures\": " << m.solve_failures << ", \"episodes\": " << m.episodes << "}";
+  }
+  j << "\n}\n";
+  return j.str();
+}
+
+std::vector<MethodSummary> RunNavigation(const NavigationExperimentConfig& c,
+                                         const std::string& out_dir, int episodes) {
+  fs::create_directories(out_dir);
+  const int n = episodes > 0 ? episodes : c.episodes;
+  const NavigationResources res = PrepareNavigation(c, out_dir);
+  // Every episode's start and goal must be free and connected on the static map.
+  for (int e = 0; e < n; ++e) {
+    const EpisodeEndpoints ends =
+        MakeEpisodeEndpoints(c.scenario, static_cast<std::uint64_t>(c.seed) + e);
+    const Eigen::Vector2d start(ends.start[0], ends.start[1]);
+    const double r = c.scenario.robot_radius;
+    FS_THROW_UNLESS(res.StaticDistance(start.x(), start.y()) > r, "scenario.robot_start: (",
+                    start.transpose(), ") of episode ", e,
+                    " is in collision with a static obstacle");
+    FS_THROW_UNLESS(res.StaticDistance(ends.goal.x(), ends.goal.y()) > r, "scenario.robot_goal: (",
+                    ends.goal.transpose(), ") of episode ", e,
+                    " is inside or too close to a static obstacle");
+    FS_THROW_UNLESS(Reachable(res, start, ends.goal, r), "scenario.robot_goal: (",
+                    ends.goal.transpose(), ") of episode ", e,
+                    " is unreachable from the start on the static map");
+    // The controllers see the map artifact (through the swept field), not the raster: check there
+    // too.
+    MapWorkspace ws = res.field->MakeWorkspace();
+    const double eps = c.span.options.epsilon;
+    FS_THROW_UNLESS(!res.field->Collides(start.x(), start.y(), eps, &ws), "scenario.robot_start: (",
+                    start.transpose(), ") of episode ", e,
+                    " is in collision on the map artifact (swept occupancy above epsilon ", eps,
+                    ")");
+    FS_THROW_UNLESS(!res.field->Collides(ends.goal.x(), ends.goal.y(), eps, &ws),
+                    "scenario.robot_goal: (", ends.goal.transpose(), ") of episode ", e,
+                    " is occupied on the map artifact");
+    FS_THROW_UNLESS(nav::GoalDistanceField(*res.field, ends.goal, eps).Reaches(start),
+                    "scenario.robot_goal: (", ends.goal.transpose(), ") of episode ", e,
+                    " is unreachable from the start on the map artifact");
+  }
+  std::vector<EpisodeResult> results;
+  std::ofstream csv(out_dir + "/episodes.csv");
+  csv << "method,episode,seed,reached,ttg,doc,doc_static,min_clearance,path_length,cycles,solve_"
+         "failures,cycle_ms_median,cycle_ms_p99\n";
+  for (const NavigationMethod method : c.Methods()) {
+    for (int e = 0; e < n; ++e) {
+      std::unique_ptr<VideoRecorder> video;
+      if (c.video.enabled && MethodName(method) == c.video.method && e == c.video.episode)
+        video = std::make_unique<VideoRecorder>(out_dir + "/episode.avi", res.raster, c.video, c.dt,
+                                                c.seed);
+      EpisodeResult r = RunEpisode(c, res, method, e, video.get());
+      csv << r.method << ',' << r.episode << ',' << r.seed << ',' << r.reached << ',' << r.ttg
+          << ',' << r.doc << ',' << r.doc_static << ',' << r.min_clearance << ',' << r.path_length
+          << ',' << r.cycles << ',' << r.solve_failures << ',' << Percentile(r.cycle_ms, 0.5) << ','
+          << Percentile(r.cycle_ms, 0.99) << '\n';
+      csv.flush();
+      log::Info(r.method, " episode ", e, ": ", r.reached ? "reached" : "not reached", " ttg ",
+                r.ttg, " s, doc ", r.doc, " s, min clearance ", r.min_clearance,
+                " m, cycle median ", Percentile(r.cycle_ms, 0.5), " ms");
+      results.push_back(std::move(r));
+    }
+  }
+  std::vector<MethodSummary> summaries;
+  for (const std::string& method : c.methods) summaries.push_back(Summarise(method, results));
+  std::ofstream(out_dir + "/summary.json") << SummaryJson(c, n, summaries);
+  DrawPaths(out_dir + "/paths.png", res.raster, c, results);
+  return summaries;
+}
+
+}  // namespace foresight

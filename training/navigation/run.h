@@ -1,0 +1,97 @@
+#pragma once
+/// Navigation episodes in one harness (thesis ch 5, "Experimental Evaluation"): the crowd of the
+/// scenario (simulated or replayed), a unicycle robot stepped at dt, and a controller per method
+/// (SPAN, reactive, CL-RRT*) fed each cycle with the last observed pedestrian positions. Metrics:
+/// success, time-to-goal (TTG), duration of collision (DOC), minimum clearance and control-cycle
+/// compute time. Writes DIR/episodes.csv, DIR/summary.json, DIR/paths.png and DIR/episode.avi.
+
+#include <Eigen/Core>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "datasets/crowd_scenario.h"
+#include "inference/mapping/occupancy_map.h"
+#include "inference/navigation/static_clearance.h"
+#include "inference/prediction/span_predictor.h"
+#include "training/navigation/config.h"
+#include "training/run_dir.h"
+
+namespace foresight {
+
+/// What every episode shares: the static map (through its artifact), the swept field, the
+/// ground-truth obstacle raster (for collision metrics) and the predictor.
+struct NavigationResources {
+  std::unique_ptr<OccupancyMap> map;
+  std::unique_ptr<nav::StaticCollisionField> field;
+  OccupancyRaster raster;
+  Eigen::MatrixXf
+      static_distance;  ///< [rows x cols] of `raster`: distance to the nearest obstacle (m)
+  std::unique_ptr<SpanPredictor> predictor;  ///< null when no method needs it
+  double StaticDistance(double x, double y) const;
+};
+
+/// Builds DIR/map.h5 from the scenario (or loads map.artifact), and loads predictor.artifact when a
+/// method needs it. Wrong artifact kinds, a start or goal in collision or an unreachable goal (no
+/// free path on the static raster) are Errors naming the config key.
+NavigationResources PrepareNavigation(const NavigationExperimentConfig& config,
+                                      const std::string& out_dir);
+
+struct EpisodeResult {
+  std::string method;
+  int episode = 0;
+  std::uint64_t seed = 0;
+  bool reached = false;
+  double ttg = 0;            ///< s (time of arrival; max_time when not reached)
+  double doc = 0;            ///< s in collision with a pedestrian or a static obstacle
+  double doc_static = 0;     ///< s of `doc` in contact with a static obstacle
+  double min_clearance = 0;  ///< m, smallest gap to a pedestrian or obstacle (negative: overlap)
+  double path_length = 0;    ///< m
+  int cycles = 0, solve_failures = 0;
+  std::vector<double> cycle_ms;  ///< compute time of each control cycle
+  Eigen::Matrix2Xd path;         ///< robot positions, one per cycle
+};
+
+/// Draws frames of one episode (the video); null in RunEpisode for none.
+class EpisodeRecorder {
+ public:
+  virtual ~EpisodeRecorder() = default;
+  /// Called after each control cycle with the controller's predictions (SPAN; else empty).
+  virtual void Frame(double time, const nav::UnicycleState& robot, const Eigen::Vector2d& goal,
+                     const std::vector<CrowdAgent>& agents,
+                     const std::vector<TrajectoryDistribution>* predictions, int num_predictions,
+                     const Eigen::Matrix2Xd& path_so_far) = 0;
+};
+
+/// Runs one episode of `method` (span | reactive | cl_rrt_star). Never throws from the control
+/// loop.
+EpisodeResult RunEpisode(const NavigationExperimentConfig& config,
+                         const NavigationResources& resources, NavigationMethod method, int episode,
+                         EpisodeRecorder* recorder = nullptr);
+
+struct MethodSummary {
+  std::string method;
+  int episodes = 0;
+  double success_rate = 0, collision_free_rate = 0;
+  double ttg_mean = 0;  ///< over reached episodes (NaN -> null when none)
+  double doc_mean = 0;
+  double min_clearance = 0;       ///< m, smallest gap over all episodes (negative: overlap)
+  double min_clearance_mean = 0;  ///< m, mean over episodes of each episode's smallest gap
+  double cycle_ms_median = 0, cycle_ms_p99 = 0, cycle_ms_max = 0;
+  int solve_failures = 0;
+};
+MethodSummary Summarise(const std::string& method, const std::vector<EpisodeResult>& results);
+
+/// What shows a navigation run in a directory (episodes run in one pass: no resume).
+inline const RunDirectoryRules kNavigationRunRules{{"summary.json", "episodes.csv"}, false};
+
+/// Runs every method for `episodes` episodes (config.episodes when <= 0) into `out_dir`.
+/// @return the summaries, in config.methods order.
+std::vector<MethodSummary> RunNavigation(const NavigationExperimentConfig& config,
+                                         const std::string& out_dir, int episodes = 0);
+
+/// summary.json text: {"scenario": ..., "episodes": N, "<method>": {...}, ...}.
+std::string SummaryJson(const NavigationExperimentConfig& config, int episodes,
+                        const std::vector<MethodSummary>& s);
+
+}  // namespace foresight

@@ -1,0 +1,303 @@
+#include "training/occupancy/pipeline.h"
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+
+#include "core/error.h"
+#include "core/log.h"
+#include "datasets/carmen.h"
+#include "datasets/data_root.h"
+#include "inference/mapping/fusion.h"
+#include "inference/mapping/grid_map.h"
+#include "inference/mapping/hinge_map.h"
+#include "models/occupancy/bhm.h"
+#include "models/occupancy/fast_bhm.h"
+#include "models/occupancy/grid_builder.h"
+#include "models/occupancy/hilbert_map.h"
+#include "models/occupancy/scan_training.h"
+#include "training/occupancy/plots.h"
+
+namespace foresight {
+namespace fs = std::filesystem;
+
+namespace {
+
+double Seconds(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+std::string Json(double v) {
+  if (!std::isfinite(v)) return "null";
+  std::ostringstream s;
+  s << std::setprecision(6) << v;
+  return s.str();
+}
+
+std::string MetricsJson(const BinaryMetrics& m) {
+  return "{\"auc\": " + Json(m.auc) + ", \"precision\": " + Json(m.precision) +
+         ", \"recall\": " + Json(m.recall) + "}";
+}
+
+void WriteRoc(const OccupancyMap& map, const LabelledPoints& test, int points,
+              const std::string& path) {
+  MapWorkspace ws = map.MakeWorkspace();
+  std::vector<double> scores(test.size());
+  for (std::int64_t i = 0; i < test.size(); ++i)
+    scores[i] = map.Probability(test.xy(0, i), test.xy(1, i), &ws);
+  std::ofstream out(path);
+  out << "false_positive_rate,true_positive_rate\n";
+  for (const auto& [fpr, tpr] : RocCurve(scores, test.occupied, points))
+    out << fpr << "," << tpr << "\n";
+}
+
+}  // namespace
+
+std::vector<LaserScan> OccupancyData::TrainScanList() const {
+  std::vector<LaserScan> out;
+  out.reserve(train_scans.size());
+  for (const int s : train_scans) out.push_back(scans[s]);
+  return out;
+}
+
+OccupancyData LoadOccupancyData(const OccupancyExperimentConfig& c) {
+  const OccupancyDataConfig& d = c.data;
+  FS_THROW_UNLESS(d.test_offset < d.test_every, "data.test_offset ", d.test_offset,
+                  " must be smaller than data.test_every ", d.test_every);
+  OccupancyData data;
+  if (d.format == ScanSource::kCarmen) {
+    FS_THROW_UNLESS(!d.file.empty(), "data.file: no CARMEN log given (format: carmen)");
+    const std::string path = ResolveDataFile(d.root, d.file);
+    FS_THROW_UNLESS(fs::exists(path), path,
+                    ": CARMEN log not found (set data.root or $FORESIGHT_DATA)");
+    data.scans = ReadCarmenLog(path);
+  } else {
+    const FloorPlan plan = GenerateFloorPlan(d.synthetic, static_cast<std::uint64_t>(c.seed));
+    data.scans = SimulateRobots(plan, d.synthetic, static_cast<std::uint64_t>(c.seed));
+  }
+  data.points = SampleLabelledPoints(data.scans, d.points, static_cast<std::uint64_t>(c.seed));
+  const ScanSplit split =
+      SplitEveryKth(static_cast<int>(data.scans.size()), d.test_every, d.test_offset);
+  data.test_scans = split.test;
+  for (std::size_t i = 0; i < split.train.size(); i += d.train_scan_stride) {
+    const auto k = i / d.train_scan_stride;
+    if (d.val_every > 0 && k % d.val_every == static_cast<std::size_t>(d.val_every - 1)) {
+      data.val_scans.push_back(split.train[i]);
+    } else {
+      data.train_scans.push_back(split.train[i]);
+    }
+  }
+  FS_THROW_UNLESS(!data.train_scans.empty() && !data.test_scans.empty(),
+                  "data: ", data.scans.size(), " scans leave ", data.train_scans.size(),
+                  " training and ", data.test_scans.size(),
+                  " test scans; need at least one of each");
+  data.train = SelectScans(data.points, data.train_scans);
+  data.test = SelectScans(data.points, data.test_scans);
+  if (!data.val_scans.empty()) data.val = SelectScans(data.points, data.val_scans);
+  log::Info("occupancy data: ", data.scans.size(), " scans, ", data.points.size(),
+            " labelled points (", data.points.dropped_beams, " beams dropped); train ",
+            data.train_scans.size(), " scans / ", data.train.size(), " points, val ",
+            data.val_scans.size(), " scans, test ", data.test_scans.size(), " scans / ",
+            data.test.size(), " points");
+  return data;
+}
+
+std::unique_ptr<OccupancyMap> TrainOccupancyMap(const std::string& model,
+                                                const OccupancyExperimentConfig& c,
+                                                const OccupancyData& data, double* seconds) {
+  const auto start = std::chrono::steady_clock::now();
+  std::unique_ptr<OccupancyMap> map;
+  if (model == kFastBhmType) {
+    FastBhmLearner learner(HingeGrid(c.features), c.fast_bhm);
+    UpdateOnScans(&learner, data.train, FirstScans(data.train));
+    map = std::make_unique<HingeMap>(learner.ToMap());
+  } else if (model == kBhmType) {
+    BhmLearner learner(HingeGrid(c.features), c.fast_bhm);
+    UpdateOnScans(&learner, data.train, FirstScans(data.train));
+    map = std::make_unique<HingeMap>(learner.ToMap());
+  } else if (model == kHilbertMapType) {
+    map = std::make_unique<HingeMap>(TrainHilbertMap(HingeGrid(c.features), c.hilbert,
+                                                     data.train.xy, data.train.occupied.data(),
+                                                     static_cast<std::uint64_t>(c.seed)));
+  } else if (model == kGridMapType) {
+    map = std::make_unique<GridMap>(BuildGridMap(c.grid, data.TrainScanList()));
+  } else {
+    Fail("model '", model, "' is not an occupancy map kind (occupancy.fast_bhm, occupancy.bhm, ",
+         "occupancy.hilbert, occupancy.grid)");
+  }
+  if (seconds) *seconds = Seconds(start);
+  return map;
+}
+
+void SaveOccupancyMap(const OccupancyMap& map, const std::string& path,
+                      const OccupancyExperimentConfig& c) {
+  const std::string yaml = config::ToYaml(c);
+  if (const auto* h = dynamic_cast<const HingeMap*>(&map)) {
+    h->Save(path, yaml, c.seed, c.precision);
+  } else if (const auto* g = dynamic_cast<const GridMap*>(&map)) {
+    g->Save(path, yaml, c.seed);
+  } else {
+    Fail("cannot save a map of type ", map.model_type());
+  }
+}
+
+std::int64_t ArtifactBytes(const OccupancyMap& map, const OccupancyExperimentConfig& c) {
+  const fs::path tmp =
+      fs::temp_directory_path() /
+      ("foresight_artifact_size_" + std::to_string(reinterpret_cast<std::uintptr_t>(&map)) + ".h5");
+  SaveOccupancyMap(map, tmp.string(), c);
+  const auto bytes = static_cast<std::int64_t>(fs::file_size(tmp));
+  fs::remove(tmp);
+  return bytes;
+}
+
+BinaryMetrics EvaluateMap(const OccupancyMap& map, const LabelledPoints& points) {
+  MapWorkspace ws = map.MakeWorkspace();
+  std::vector<double> scores(points.size());
+  for (std::int64_t i = 0; i < points.size(); ++i)
+    scores[i] = map.Probability(points.xy(0, i), points.xy(1, i), &ws);
+  return EvaluateBinary(scores, points.occupied, 0.5);
+}
+
+FusionResult RunFusion(const OccupancyExperimentConfig& c, const OccupancyData& data) {
+  const HingeGrid grid(c.features);
+  FusionResult r;
+  // Robots: lists of indices into data.train's scans, in recording order.
+  std::vector<std::vector<int>> robots;
+  if (c.fusion.robots == FusionExperimentConfig::Robots::kQuadrants) {
+    const auto q =
+        QuadrantSplit(data.train, FirstScans(data.train), c.fusion.centre_x, c.fusion.centre_y);
+    for (const auto& list : q)
+      if (!list.empty()) robots.push_back(list);
+  } else {
+    int max_robot = 0;
+    for (const int id : data.train.robot) max_robot = std::max(max_robot, id);
+    robots.resize(max_robot + 1);
+    for (int s = 0; s < data.train.num_scans(); ++s) robots[data.train.robot[s]].push_back(s);
+    robots.erase(
+        std::remove_if(robots.begin(), robots.end(), [](const auto& l) { return l.empty(); }),
+        robots.end());
+  }
+  FS_THROW_UNLESS(robots.size() >= 2, "fusion: the training scans belong to ", robots.size(),
+                  " robot(s); need at least two (check fusion.robots / centre)");
+  for (const auto& l : robots) r.robot_scans.push_back(static_cast<int>(l.size()));
+
+  FastBhmLearner single(grid, c.fast_bhm);
+  UpdateOnScans(&single, data.train, FirstScans(data.train));
+  r.single = std::make_unique<HingeMap>(single.ToMap());
+
+  // Fuse once: independent local maps on all of each robot's data, one conflation.
+  std::vector<HingeMap> locals;
+  for (const auto& scans : robots) {
+    FastBhmLearner l(grid, c.fast_bhm);
+    UpdateOnScans(&l, data.train, scans);
+    locals.push_back(l.ToMap());
+  }
+  std::vector<const HingeMap*> ptrs;
+  std::vector<std::string> names;
+  for (std::size_t i = 0; i < locals.size(); ++i) {
+    ptrs.push_back(&locals[i]);
+    names.push_back("robot " + std::to_string(i));
+  }
+  r.fuse_once = std::make_unique<HingeMap>(FuseMaps(ptrs, names, c.fusion.options));
+
+  // Repeated fusion (thesis Algorithm "Fast-BHM Sequential Fusion"): after each 1/merges of every
+  // robot's data, each robot's copy is merged; copies restart from the new global map.
+  std::unique_ptr<HingeMap> global;
+  const int merges = c.fusion.merges;
+  for (int m = 0; m < merges; ++m) {
+    std::vector<HingeMap> copies;
+    for (const auto& scans : robots) {
+      const std::size_t b = scans.size() * m / merges, e = scans.size() * (m + 1) / merges;
+      const std::vector<int> chunk(scans.begin() + b, scans.begin() + e);
+      FastBhmLearner l =
+          global ? FastBhmLearner(*global, c.fast_bhm) : FastBhmLearner(grid, c.fast_bhm);
+      UpdateOnScans(&l, data.train, chunk);
+      copies.push_back(l.ToMap());
+    }
+    std::vector<const HingeMap*> cp;
+    for (const auto& x : copies) cp.push_back(&x);
+    global = std::make_unique<HingeMap>(FuseMaps(cp, names, c.fusion.options, global.get()));
+  }
+  r.repeated = std::move(global);
+  return r;
+}
+
+void TrainOccupancyRun(const OccupancyExperimentConfig& c, const std::string& run_dir) {
+  StartRunDirectory(run_dir, config::ToYaml(c), false, kOccupancyRunRules);
+  const OccupancyData data = LoadOccupancyData(c);
+  const std::string artifact = run_dir + "/model.h5";
+  const auto start = std::chrono::steady_clock::now();
+  if (c.model == "occupancy.fusion") {
+    const FusionResult r = RunFusion(c, data);
+    SaveOccupancyMap(*r.single, run_dir + "/single.h5", c);
+    SaveOccupancyMap(*r.fuse_once, run_dir + "/fuse_once.h5", c);
+    SaveOccupancyMap(*r.repeated, artifact, c);
+    std::ofstream out(run_dir + "/training_summary.json");
+    out << "{\"seconds\": " << Json(Seconds(start)) << ", \"robots\": " << r.robot_scans.size()
+        << ", \"robot_scans\": [";
+    for (std::size_t i = 0; i < r.robot_scans.size(); ++i)
+      out << (i ? ", " : "") << r.robot_scans[i];
+    out << "], \"merges\": " << c.fusion.merges << "}\n";
+  } else {
+    double secs = 0;
+    const std::unique_ptr<OccupancyMap> map = TrainOccupancyMap(c.model, c, data, &secs);
+    SaveOccupancyMap(*map, artifact, c);
+    std::ofstream(run_dir + "/training_summary.json") << "{\"seconds\": " << Json(secs) << "}\n";
+    log::Info(c.model, ": trained in ", secs, " s");
+  }
+}
+
+std::string EvaluateOccupancyRun(const OccupancyExperimentConfig& c, const std::string& run_dir) {
+  const std::string artifact = run_dir + "/model.h5";
+  FS_THROW_UNLESS(fs::exists(artifact), artifact, ": not found (train the map first)");
+  const OccupancyData data = LoadOccupancyData(c);
+  fs::create_directories(run_dir + "/plots");
+  std::ostringstream json;
+  json << "{\n  \"model\": \"" << c.model << "\",\n  \"train_scans\": " << data.train_scans.size()
+       << ",\n  \"test_scans\": " << data.test_scans.size()
+       << ",\n  \"train_points\": " << data.train.size()
+       << ",\n  \"test_points\": " << data.test.size() << ",\n";
+  if (c.model == "occupancy.fusion") {
+    // Evaluates what ships: the maps as loaded from their artifacts.
+    const auto single_map = LoadOccupancyMap(run_dir + "/single.h5");
+    const auto once_map = LoadOccupancyMap(run_dir + "/fuse_once.h5");
+    const auto repeated_map = LoadOccupancyMap(artifact);
+    const BinaryMetrics single = EvaluateMap(*single_map, data.test);
+    const BinaryMetrics once = EvaluateMap(*once_map, data.test);
+    const BinaryMetrics repeated = EvaluateMap(*repeated_map, data.test);
+    json << "  \"merges\": " << c.fusion.merges << ",\n  \"auc_single\": " << Json(single.auc)
+         << ",\n  \"auc_fuse_once\": " << Json(once.auc)
+         << ",\n  \"auc_repeated\": " << Json(repeated.auc)
+         << ",\n  \"single\": " << MetricsJson(single)
+         << ",\n  \"fuse_once\": " << MetricsJson(once)
+         << ",\n  \"repeated\": " << MetricsJson(repeated) << ",\n  \"auc\": " << Json(repeated.auc)
+         << ",\n  \"precision\": " << Json(repeated.precision)
+         << ",\n  \"recall\": " << Json(repeated.recall)
+         << ",\n  \"artifact_bytes\": " << fs::file_size(artifact) << "\n}\n";
+    WriteMapPanels({{"single map", single_map.get()},
+                    {"fused once", once_map.get()},
+                    {"repeatedly fused", repeated_map.get()}},
+                   c.eval.plot_resolution, run_dir + "/plots/map.png");
+    log::Info("fusion AUC: single ", single.auc, ", fuse once ", once.auc, ", repeated ",
+              repeated.auc);
+  } else {
+    const std::unique_ptr<OccupancyMap> loaded = LoadOccupancyMap(artifact);  // evaluate what ships
+    const BinaryMetrics m = EvaluateMap(*loaded, data.test);
+    json << "  \"auc\": " << Json(m.auc) << ",\n  \"precision\": " << Json(m.precision)
+         << ",\n  \"recall\": " << Json(m.recall)
+         << ",\n  \"artifact_bytes\": " << fs::file_size(artifact);
+    if (data.val.size() > 0)
+      json << ",\n  \"val\": " << MetricsJson(EvaluateMap(*loaded, data.val));
+    json << "\n}\n";
+    WriteRoc(*loaded, data.test, c.eval.roc_points, run_dir + "/roc.csv");
+    WriteMapPanels({{c.model, loaded.get()}}, c.eval.plot_resolution, run_dir + "/plots/map.png");
+    log::Info(c.model, ": AUC ", m.auc, ", precision ", m.precision, ", recall ", m.recall);
+  }
+  std::ofstream(run_dir + "/eval.json") << json.str();
+  return json.str();
+}
+
+}  // namespace foresight

@@ -1,0 +1,23 @@
+#include "training/span/config.h"
+
+namespace foresight {
+
+void SpanExperimentConfig::Validate(const std::string& source) const {
+  const SpanExperimentConfig& c = *this;
+  FS_THROW_UNLESS(c.model == "span_predictor", source, ": key 'model': value '", c.model,
+                  "' is not 'span_predictor'");
+  FS_THROW_UNLESS(c.data.synthetic.speed_max >= c.data.synthetic.speed_min, source,
+                  ": key 'data.synthetic.speed_max' must be >= data.synthetic.speed_min");
+  FS_THROW_UNLESS(c.data.synthetic.max_steps >= c.data.synthetic.min_steps, source,
+                  ": key 'data.synthetic.max_steps' must be >= data.synthetic.min_steps");
+  FS_THROW_UNLESS(c.data.val_fraction + c.data.test_fraction < 1.0, source,
+                  ": keys 'data.val_fraction' + 'data.test_fraction' must be < 1");
+  FS_THROW_UNLESS(
+      c.data.synthetic.min_steps >= c.windows.observed + c.windows.predicted ||
+          c.data.format != TrackFormat::kSynthetic,
+      source, ": key 'data.synthetic.min_steps' must be >= windows.observed + windows.predicted");
+  FS_THROW_UNLESS(!c.network.hidden.empty(), source,
+                  ": key 'network.hidden' must list at least one layer");
+}
+
+}  // namespace foresight

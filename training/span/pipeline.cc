@@ -1,0 +1,215 @@
+#include "training/span/pipeline.h"
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "core/error.h"
+#include "core/h5.h"
+#include "core/log.h"
+#include "inference/engine/artifact.h"
+#include "inference/prediction/span_predictor.h"
+#include "models/span/span_data.h"
+#include "models/span/span_net.h"
+#include "training/run_dir.h"
+
+namespace foresight {
+namespace fs = std::filesystem;
+
+namespace {
+
+HeadLayout LayoutOf(const SpanExperimentConfig& c) {
+  HeadLayout l;
+  l.basis = c.basis.num_centres;
+  l.components = c.network.components;
+  l.u_param = c.network.u_param;
+  return l;
+}
+
+torch::Tensor ToTensor(const Eigen::MatrixXd& m) {
+  Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> rm = m.cast<float>();
+  return torch::from_blob(rm.data(), {rm.rows(), rm.cols()}, torch::kFloat32).clone();
+}
+
+struct Normalisation {
+  Eigen::VectorXd mean, std;
+  Eigen::MatrixXd Apply(const Eigen::MatrixXd& x) const {
+    return (x.rowwise() - mean.transpose()).array().rowwise() / std.transpose().array();
+  }
+};
+
+Normalisation FitNormalisation(const Eigen::MatrixXd& x) {
+  Normalisation n;
+  n.mean = x.colwise().mean().transpose();
+  n.std = ((x.rowwise() - n.mean.transpose()).array().square().colwise().mean()).sqrt().transpose();
+  // Constant features (the ego origin) pass through. Nearly constant ones are floored at 1 cm:
+  // e.g. the ego y of the first point is 0 except in the rare windows too short to rotate (standing
+  // pedestrians), and dividing those by a micrometre-scale std feeds the network inputs of 1e3+
+  // (non-finite losses on crowd data with many standing pedestrians).
+  constexpr double kMinStd = 0.01;  // m
+  for (Eigen::Index i = 0; i < n.std.size(); ++i) {
+    if (!(n.std[i] > 1e-6))
+      n.std[i] = 1.0;
+    else
+      n.std[i] = std::max(n.std[i], kMinStd);
+  }
+  return n;
+}
+
+void WriteNormalisation(const std::string& path, const Normalisation& n) {
+  h5::WriteAtomically(path, [&](h5::File* f) {
+    f->WriteMatrix("/input_mean", n.mean);
+    f->WriteMatrix("/input_std", n.std);
+  });
+}
+
+Normalisation ReadNormalisation(const std::string& path) {
+  h5::File f = h5::File::Open(path);
+  return {f.ReadMatrixD("/input_mean").col(0), f.ReadMatrixD("/input_std").col(0)};
+}
+
+class SpanTask : public TrainingTask {
+ public:
+  SpanTask(SpanNet net, const HeadLayout& layout, torch::Tensor x_train, torch::Tensor w_train,
+           torch::Tensor x_val, torch::Tensor w_val)
+      : net_(std::move(net)),
+        layout_(layout),
+        x_train_(std::move(x_train)),
+        w_train_(std::move(w_train)),
+        x_val_(std::move(x_val)),
+        w_val_(std::move(w_val)) {}
+
+  torch::nn::Module& module() override { return *net_; }
+  std::int64_t num_train() const override { return x_train_.size(0); }
+
+  torch::Tensor BatchLoss(const torch::Tensor& idx) override {
+    const auto raw = net_->forward(x_train_.index_select(0, idx));
+    return MixtureNll(DecodeHead(raw, layout_), w_train_.index_select(0, idx), layout_).mean();
+  }
+
+  double ValidationLoss() override {
+    double sum = 0;
+    const std::int64_t n = x_val_.size(0);
+    FS_THROW_UNLESS(n > 0, "no validation windows to compute the validation loss on");
+    for (std::int64_t b = 0; b < n; b += 4096) {
+      const std::int64_t len = std::min<std::int64_t>(4096, n - b);
+      const auto raw = net_->forward(x_val_.narrow(0, b, len));
+      sum += MixtureNll(DecodeHead(raw, layout_), w_val_.narrow(0, b, len), layout_)
+                 .sum()
+                 .item<double>();
+    }
+    return sum / static_cast<double>(n);
+  }
+
+ private:
+  SpanNet net_;
+  HeadLayout layout_;
+  torch::Tensor x_train_, w_train_, x_val_, w_val_;
+};
+
+}  // namespace
+
+TrainingSummary TrainSpan(const SpanExperimentConfig& c, const std::string& run_dir, bool resume,
+                          const TrainHooks& hooks) {
+  StartRunDirectory(run_dir, config::ToYaml(c), resume, kSpanRunRules);
+  log::Info(resume ? "resuming" : "training", " span_predictor in ", run_dir, " (seed ", c.seed,
+            ")");
+
+  const TrackSplit split = LoadPedestrianSplits(c.data, static_cast<std::uint64_t>(c.seed));
+  const WindowSet train_w = MakeWindows(split.train, c.windows);
+  const WindowSet val_w = MakeWindows(split.val, c.windows);
+  log::Info("windows: ", train_w.size(), " train, ", val_w.size(), " val");
+  const int length = c.windows.observed + c.windows.predicted;
+  FS_THROW_UNLESS(train_w.size() > 0, "no training windows of ", length,
+                  " points in the training tracks");
+  // The validation loss chooses the best checkpoint and drives early stopping (train.patience).
+  FS_THROW_UNLESS(val_w.size() > 0,
+                  "no validation windows: no validation track has windows.observed + "
+                  "windows.predicted = ",
+                  length, " points (",
+                  c.data.val_files.empty() ? "raise data.val_fraction" : "check data.val_files",
+                  "); the validation loss chooses the best checkpoint and drives early stopping");
+  const TimeBasis basis = MakeFutureBasis(c.basis, c.windows.predicted, train_w.seconds_per_step);
+  const SpanSamples train_s = MakeSpanSamples(train_w, basis, c.basis, c.network.rotate_to_heading,
+                                              c.network.residual_to_constant_velocity);
+  const SpanSamples val_s = MakeSpanSamples(val_w, basis, c.basis, c.network.rotate_to_heading,
+                                            c.network.residual_to_constant_velocity);
+
+  const std::string norm_path = run_dir + "/normalisation.h5";
+  const Normalisation norm =
+      resume ? ReadNormalisation(norm_path) : FitNormalisation(train_s.inputs);
+  if (!resume) WriteNormalisation(norm_path, norm);
+
+  const HeadLayout layout = LayoutOf(c);
+  torch::manual_seed(static_cast<std::uint64_t>(c.seed));
+  SpanNet net(2 * c.windows.observed, c.network, layout);
+  const std::int64_t m = layout.basis;
+  auto w_train = ToTensor(train_s.targets).view({train_s.targets.rows(), m, 2});
+  auto w_val = ToTensor(val_s.targets).view({val_s.targets.rows(), m, 2});
+  SpanTask task(net, layout, ToTensor(norm.Apply(train_s.inputs)), w_train,
+                ToTensor(norm.Apply(val_s.inputs)), w_val);
+  return Train(&task, c.train, RunPaths{run_dir}, static_cast<std::uint64_t>(c.seed), resume,
+               hooks);
+}
+
+namespace {
+/// The engine's dense layers from the network's `names[i].weight` / `.bias` parameters (float).
+Mlp ToEngineMlp(torch::nn::Module& net, const std::vector<std::string>& names) {
+  const auto params = net.named_parameters();
+  std::vector<DenseLayer> layers;
+  for (const std::string& name : names) {
+    const torch::Tensor w = params[name + ".weight"].detach().contiguous().to(torch::kFloat32);
+    const torch::Tensor b = params[name + ".bias"].detach().contiguous().to(torch::kFloat32);
+    DenseLayer l;
+    l.weight =
+        Eigen::Map<const Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
+            w.data_ptr<float>(), w.size(0), w.size(1));
+    l.bias = Eigen::Map<const Eigen::VectorXf>(b.data_ptr<float>(), b.size(0));
+    layers.push_back(std::move(l));
+  }
+  return Mlp(std::move(layers));
+}
+}  // namespace
+
+void WriteSpanArtifact(const SpanExperimentConfig& c, const std::string& checkpoint,
+                       const std::string& normalisation_file, const std::string& artifact_path) {
+  const HeadLayout layout = LayoutOf(c);
+  SpanNet net(2 * c.windows.observed, c.network, layout);
+  LoadCheckpointModel(checkpoint, net.ptr().get());
+  const Normalisation norm = ReadNormalisation(normalisation_file);
+  const double dt = SecondsPerStep(c.data);
+  const TimeBasis basis = MakeFutureBasis(c.basis, c.windows.predicted, dt);
+  SpanPredictorWeights w;
+  w.observed = c.windows.observed;
+  w.predicted = c.windows.predicted;
+  w.seconds_per_step = dt;
+  w.rotate_to_heading = c.network.rotate_to_heading;
+  w.residual_to_constant_velocity = c.network.residual_to_constant_velocity;
+  w.layout = layout;
+  w.basis_centres = basis.centres();
+  w.basis_gamma = basis.gamma();
+  w.input_mean = norm.mean;
+  w.input_std = norm.std;
+  w.layer_names = net->DenseLayerNames();
+  w.mlp = ToEngineMlp(*net, w.layer_names);
+  SpanPredictor::Save(artifact_path, w, config::ToYaml(c), c.seed);
+}
+
+std::string ExportSpan(const std::string& run_dir) {
+  const std::string config_path = run_dir + "/config.yaml";
+  FS_THROW_UNLESS(fs::exists(config_path), run_dir, ": not a run directory (no config.yaml)");
+  const SpanExperimentConfig c =
+      config::LoadExperimentConfig<SpanExperimentConfig>(config_path, {});
+  RunPaths run{run_dir};
+  const std::string ckpt =
+      fs::exists(run.BestCheckpoint()) ? run.BestCheckpoint() : run.Checkpoint();
+  FS_THROW_UNLESS(fs::exists(ckpt), run_dir, ": no checkpoint to export (train first)");
+  const std::string out = run_dir + "/model.h5";
+  WriteSpanArtifact(c, ckpt, run_dir + "/normalisation.h5", out);
+  // Prove the artifact loads in the engine before reporting success.
+  (void)SpanPredictor::Load(out);
+  log::Info("exported ", ckpt, " -> ", out);
+  return out;
+}
+
+}  // namespace foresight

@@ -1,0 +1,16 @@
+#pragma once
+/// PNG figures of evaluations (OpenCV).
+
+#include <string>
+
+#include "datasets/windows.h"
+#include "training/span/config.h"
+
+namespace foresight {
+
+/// A grid of panels: observed past (blue), ground-truth future (green), sampled futures (red),
+/// predicted mean (dark red), for `eval.plot_tracks` windows spread over `test`.
+void PlotSpanSamples(const std::string& artifact, const WindowSet& test, const SpanEvalConfig& eval,
+                     const std::string& png_path);
+
+}  // namespace foresight
