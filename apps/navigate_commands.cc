@@ -6,6 +6,7 @@
 
 #include "apps/commands.h"
 #include "core/error.h"
+#include "core/log.h"
 #include "embedded_navigation_config.h"
 #include "training/navigation/config.h"
 #include "training/navigation/run.h"
@@ -72,6 +73,7 @@ void AddNavigateCommand(CLI::App* app) {
     if (needs_predictor && !fs::exists(c.predictor.artifact)) {
 #ifdef FORESIGHT_WITH_TORCH
       EnsureNavigationPredictor(c, kEmbeddedNavigationPredictorConfig);
+      log::SetFile(out + "/log.txt");  // the predictor's training logged into its own run directory
 #else
       Fail("predictor.artifact: ", c.predictor.artifact,
            " not found; this build has no LibTorch to train it (train it with a LibTorch build "

@@ -195,7 +195,7 @@ YAML::Node LoadYamlFile(const std::string& path) {
   ss << in.rdbuf();
   const YAML::Node node = ParseYaml(ss.str(), path);
   FS_THROW_UNLESS(node && !node.IsNull(), path,
-                  ": config file is empty; a config names at least its 'model'");
+                  ": config file is empty (nothing but comments or blank lines)");
   return node;
 }
 

@@ -26,9 +26,10 @@ void WriteFileBytes(const std::string& path, const char* data, std::size_t size)
     }
     done += static_cast<std::size_t>(n);
   }
-  const bool synced = ::fsync(fd) == 0;
-  const int err = errno;
-  FS_THROW_UNLESS(::close(fd) == 0 && synced, path, ": cannot write (", std::strerror(err), ")");
+  const int sync_error = ::fsync(fd) == 0 ? 0 : errno;
+  const int close_error = ::close(fd) == 0 ? 0 : errno;
+  const int err = sync_error ? sync_error : close_error;
+  FS_THROW_UNLESS(err == 0, path, ": cannot write (", std::strerror(err), ")");
 }
 
 void WriteFileAtomically(const std::string& path, const std::string& bytes) {
@@ -44,10 +45,14 @@ void WriteFileAtomically(const std::string& path, const std::string& bytes) {
     std::remove(tmp.c_str());
     Fail(path, ": cannot move the written file into place (", std::strerror(err), ")");
   }
+  SyncParentDirectory(path);
+}
+
+void SyncParentDirectory(const std::string& path) {
   const std::string dir = std::filesystem::path(path).parent_path().string();
   const int fd = ::open(dir.empty() ? "." : dir.c_str(), O_RDONLY);
   if (fd >= 0) {
-    ::fsync(fd);  // best effort: some file systems refuse to sync a directory
+    ::fsync(fd);
     ::close(fd);
   }
 }

@@ -10,6 +10,10 @@ namespace foresight {
 /// Writes `size` bytes to `path` (created or truncated) and flushes them to disk.
 void WriteFileBytes(const std::string& path, const char* data, std::size_t size);
 
+/// Flushes the directory entry of `path` (after a rename); best effort, as some file systems
+/// refuse to sync a directory.
+void SyncParentDirectory(const std::string& path);
+
 /// Writes `bytes` to path.tmp, flushes it, then renames it to `path` (the directory entry is
 /// flushed too); on failure the temporary file is removed and `path` is left as it was.
 void WriteFileAtomically(const std::string& path, const std::string& bytes);

@@ -145,9 +145,11 @@ void WriteAtomically(const std::string& path, const std::function<void(File*)>& 
     throw;
   }
   if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    const int err = errno;
     std::remove(tmp.c_str());
-    Fail(path, ": cannot move the written file into place");
+    Fail(path, ": cannot move the written file into place (", std::strerror(err), ")");
   }
+  SyncParentDirectory(path);
 }
 
 bool File::Exists(const std::string& object) const {

@@ -97,6 +97,13 @@ DirectionalMap DirectionalMap::Load(const std::string& path) {
   return m;
 }
 
+namespace {
+/// A 1-d float dataset [n] (biases; docs/artifact_schema.md).
+void WriteVector(h5::File* f, const std::string& name, const Eigen::VectorXf& v) {
+  f->Write(name, v.data(), {static_cast<std::size_t>(v.size())});
+}
+}  // namespace
+
 void DirectionalMap::Save(const std::string& path, const std::string& config_yaml,
                           std::int64_t seed) const {
   h5::WriteAtomically(path, [&](h5::File* f) {
@@ -125,15 +132,15 @@ void DirectionalMap::Save(const std::string& path, const std::string& config_yam
       const LstmWeights& w = lstm_.weights();
       f->WriteMatrix("/weights/lstm/weight_ih_l0", w.weight_ih);
       f->WriteMatrix("/weights/lstm/weight_hh_l0", w.weight_hh);
-      f->WriteMatrix("/weights/lstm/bias_ih_l0", w.bias_ih);
-      f->WriteMatrix("/weights/lstm/bias_hh_l0", w.bias_hh);
+      WriteVector(f, "/weights/lstm/bias_ih_l0", w.bias_ih);
+      WriteVector(f, "/weights/lstm/bias_hh_l0", w.bias_hh);
     }
     f->WriteMatrix("/weights/alpha/weight", heads_.alpha_w);
-    f->WriteMatrix("/weights/alpha/bias", heads_.alpha_b);
+    WriteVector(f, "/weights/alpha/bias", heads_.alpha_b);
     f->WriteMatrix("/weights/mu/weight", heads_.mu_w);
-    f->WriteMatrix("/weights/mu/bias", heads_.mu_b);
+    WriteVector(f, "/weights/mu/bias", heads_.mu_b);
     f->WriteMatrix("/weights/kappa/weight", heads_.kappa_w);
-    f->WriteMatrix("/weights/kappa/bias", heads_.kappa_b);
+    WriteVector(f, "/weights/kappa/bias", heads_.kappa_b);
   });
 }
 

@@ -41,7 +41,8 @@ void Mlp::Save(h5::File* file, const std::string& prefix,
                   " layer names for ", layers_.size(), " layers");
   for (std::size_t i = 0; i < layers_.size(); ++i) {
     file->WriteMatrix(prefix + names[i] + "/weight", layers_[i].weight);
-    file->WriteMatrix(prefix + names[i] + "/bias", layers_[i].bias);
+    const Eigen::VectorXf& b = layers_[i].bias;  // 1-d [out], as documented
+    file->Write(prefix + names[i] + "/bias", b.data(), {static_cast<std::size_t>(b.size())});
   }
 }
 

@@ -23,6 +23,7 @@ namespace {
 /// 2-D Gaussian N(mu, Sigma) through LogGaussian2; samples by its Cholesky factor.
 struct Gaussian2Case {
   static constexpr const char* kName = "Gaussian2";
+  static constexpr bool kProductionSampler = false;  // core/ has no Gaussian sampler of its own
   Eigen::Vector2d mu{0.7, -1.2};
   Eigen::Matrix2d cov = (Eigen::Matrix2d() << 0.8, 0.3, 0.3, 0.5).finished();
 
@@ -64,6 +65,7 @@ struct Gaussian2Case {
 /// quadrature can integrate; samples through MatrixNormal::Sample.
 struct MatrixNormalCase {
   static constexpr const char* kName = "MatrixNormal";
+  static constexpr bool kProductionSampler = true;
   MatrixNormal d = [] {
     MatrixNormal m;
     m.mean = (Eigen::MatrixXd(1, 2) << 0.4, -0.6).finished();
@@ -97,6 +99,7 @@ struct MatrixNormalCase {
 /// with A_1 = I1 / I0 (BesselRatioA1).
 struct VonMisesMixtureCase {
   static constexpr const char* kName = "VonMisesMixture";
+  static constexpr bool kProductionSampler = true;  // SampleVonMises per component
   Eigen::Vector3d alpha{0.5, 0.3, 0.2}, mu{-2.5, 0.4, 2.9}, kappa{4.0, 0.5, 30.0};
 
   int Dim() const { return 1; }
@@ -177,9 +180,17 @@ TYPED_TEST(DensitySuite, IntegratesToOne) {
 
 TYPED_TEST(DensitySuite, SamplesHaveTheImpliedMoments) {
   const auto& d = this->density;
+  const Eigen::VectorXd expected = d.ExpectedFeatures();
+  // The moments by quadrature of the density: the density has the law's moments.
+  for (Eigen::Index k = 0; k < expected.size(); ++k) {
+    const double by_quadrature = Integrate(
+        [&](const Eigen::VectorXd& x) { return d.Features(x)[k] * std::exp(d.LogPdf(x)); },
+        d.Lower(), d.Upper(), d.Dim() == 1 ? 20000 : 600);
+    EXPECT_NEAR(by_quadrature, expected[k], 1e-5) << "moment feature " << k;
+  }
+  if (!TypeParam::kProductionSampler) GTEST_SKIP() << "no sampler of this density in core/";
   std::mt19937_64 rng(11);
   const int n = 200000;
-  const Eigen::VectorXd expected = d.ExpectedFeatures();
   Eigen::VectorXd sum = Eigen::VectorXd::Zero(expected.size()),
                   sum_sq = Eigen::VectorXd::Zero(expected.size());
   for (int i = 0; i < n; ++i) {
@@ -197,13 +208,6 @@ TYPED_TEST(DensitySuite, SamplesHaveTheImpliedMoments) {
   const Eigen::VectorXd std_error = ((sum_sq / n - mean.cwiseProduct(mean)) / n).cwiseSqrt();
   for (Eigen::Index k = 0; k < expected.size(); ++k)
     EXPECT_NEAR(mean[k], expected[k], 5.0 * std_error[k] + 1e-12) << "moment feature " << k;
-  // The same moments by quadrature of the density: sampling and density describe one law.
-  for (Eigen::Index k = 0; k < expected.size(); ++k) {
-    const double by_quadrature = Integrate(
-        [&](const Eigen::VectorXd& x) { return d.Features(x)[k] * std::exp(d.LogPdf(x)); },
-        d.Lower(), d.Upper(), d.Dim() == 1 ? 20000 : 600);
-    EXPECT_NEAR(by_quadrature, expected[k], 1e-5) << "moment feature " << k;
-  }
 }
 
 TYPED_TEST(DensitySuite, MixtureIsTheLogSumExpOfItsComponents) {
@@ -213,7 +217,7 @@ TYPED_TEST(DensitySuite, MixtureIsTheLogSumExpOfItsComponents) {
       EXPECT_NEAR(d.LogPdf(Eigen::VectorXd::Constant(1, theta)),
                   LogSumExp(d.WeightedComponentLogs(Eigen::VectorXd::Constant(1, theta))), 1e-12);
   } else {
-    EXPECT_FALSE(d.IsMixture());
+    GTEST_SKIP() << TypeParam::kName << " is not a mixture";
   }
 }
 

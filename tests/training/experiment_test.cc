@@ -152,6 +152,11 @@ TEST(Experiment, EveryBuiltinKindRunsThroughTrainExportAndEval) {
     EXPECT_FALSE(json.empty());
     EXPECT_EQ(json, testing::ReadText(run + "/eval.json")) << "eval writes what it returns";
     EXPECT_EQ(json, first) << "evaluating the exported artifact again gives the same figures";
+    // Where the data lives may differ at evaluation (data.root); the figures do not, and the
+    // run's config.yaml stays the one it was trained with.
+    const std::string config_before = testing::ReadText(run + "/config.yaml");
+    EXPECT_EQ(kind.evaluate(run, {"data.root=" + dir.path()}), first);
+    EXPECT_EQ(testing::ReadText(run + "/config.yaml"), config_before);
     EXPECT_TRUE(fs::exists(run + "/config.yaml") && fs::exists(run + "/log.txt"));
   }
 }

@@ -129,13 +129,20 @@ TEST(Trainer, ResumeKeepsANegativeBestValidationLoss) {
   EXPECT_TRUE(torch::equal(a.module().parameters()[0], b.module().parameters()[0]));
 }
 
-/// Everything an artifact holds that a run determines (weights, normalisation, basis, config);
-/// HDF5 object timestamps aside, two equal digests mean the same exported model.
+/// What a span_predictor artifact holds (weights, normalisation, basis, the /model attributes of
+/// its schema, config, seed); HDF5 timestamps aside, two equal digests mean the same model.
 std::string ArtifactDigest(const std::string& path) {
   const h5::File f = h5::File::Open(path);
   std::ostringstream os;
   os.precision(17);
-  os << f.ReadString("/config") << "\n";
+  os << f.ReadString("/config") << "\n" << f.GetIntAttr("/", "seed") << "\n";
+  for (const char* name : {"observed", "predicted", "rotate_to_heading",
+                           "residual_to_constant_velocity", "basis_size", "components"})
+    os << name << " " << f.GetIntAttr("/model", name) << "\n";
+  for (const char* name : {"seconds_per_step", "basis_gamma"})
+    os << name << " " << f.GetDoubleAttr("/model", name) << "\n";
+  for (const char* name : {"u_param", "dense_layers"})
+    os << name << " " << f.GetStringAttr("/model", name) << "\n";
   for (const std::string group : {"/weights", "/normalisation", "/model"}) {
     std::vector<std::string> pending{group};
     while (!pending.empty()) {

@@ -35,9 +35,9 @@ ExperimentKind DirectionalKind() {
   };
   k.export_run = ExportDirectionalRun;
   k.evaluate = [](const std::string& run_dir, const std::vector<std::string>& overrides) {
-    // Re-evaluates every fold with its trained networks (resume skips finished training).
+    // Every fold again with its trained networks; the run's config.yaml is left as it was.
     const auto c = LoadRunConfig<DirectionalExperimentConfig>(run_dir, overrides);
-    return RunDirectionalExperiment(c, run_dir, true).report.ToJson();
+    return EvaluateDirectionalRun(c, run_dir).ToJson();
   };
   return k;
 }

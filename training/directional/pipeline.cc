@@ -463,13 +463,40 @@ std::string ExportDirectionalRun(const std::string& run_dir) {
   return run_dir + "/model.h5";
 }
 
+namespace {
+/// Every fold: train what is not trained yet (nothing, when evaluating a finished run), query
+/// the networks and fit the grids; then eval.json, eval.csv, the run's artifacts and plots.
+DirectionalRunResult RunFolds(const DirectionalExperimentConfig& c, const std::string& run_dir,
+                              const TrainHooks& hooks);
+}  // namespace
+
 DirectionalRunResult RunDirectionalExperiment(const DirectionalExperimentConfig& c,
                                               const std::string& run_dir, bool resume,
                                               const TrainHooks& hooks) {
   StartRunDirectory(run_dir, config::ToYaml(c), resume, kDirectionalRunRules);
   log::Info(resume ? "resuming" : "training", " directional maps in ", run_dir, " (seed ", c.seed,
             ")");
+  return RunFolds(c, run_dir, hooks);
+}
 
+DirectionalEvalReport EvaluateDirectionalRun(const DirectionalExperimentConfig& c,
+                                             const std::string& run_dir) {
+  const int folds = c.eval.max_folds > 0 ? c.eval.max_folds : c.eval.folds;
+  for (int k = 0; k < folds; ++k)
+    for (const char* variant : {"spatiotemporal", "spatial"}) {
+      const bool used = std::string(variant) == "spatial" ? c.eval.spatial : c.eval.spatiotemporal;
+      const std::string dir = run_dir + "/folds/" + std::to_string(k) + "/" + variant;
+      FS_THROW_UNLESS(!used || fs::exists(dir + "/model.h5"), dir,
+                      ": no model.h5 (the run is not finished; continue it with train --resume)");
+    }
+  log::SetFile(run_dir + "/log.txt");
+  log::Info("evaluating directional maps in ", run_dir);
+  return RunFolds(c, run_dir, {}).report;
+}
+
+namespace {
+DirectionalRunResult RunFolds(const DirectionalExperimentConfig& c, const std::string& run_dir,
+                              const TrainHooks& hooks) {
   const DirectionalSamples data = LoadDirectionalSamples(c);
   const DirectionalFeatureConfig f = ResolveExtent(c.features, data.x, data.y, data.t);
   (void)DirectionalFeatures(f);  // checks the resolved extent
@@ -530,5 +557,7 @@ DirectionalRunResult RunDirectionalExperiment(const DirectionalExperimentConfig&
   log::Info(report.BriefReport());
   return result;
 }
+
+}  // namespace
 
 }  // namespace foresight

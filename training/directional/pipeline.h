@@ -86,6 +86,12 @@ DirectionalRunResult RunDirectionalExperiment(const DirectionalExperimentConfig&
                                               const std::string& run_dir, bool resume,
                                               const TrainHooks& hooks = {});
 
+/// Evaluates a finished run again (every fold network exists; an Error names the first missing
+/// one) with `config`, which may differ from the run's in where the data is (data.root): writes
+/// eval.json, eval.csv and the plots; trains nothing and does not touch config.yaml.
+DirectionalEvalReport EvaluateDirectionalRun(const DirectionalExperimentConfig& config,
+                                             const std::string& run_dir);
+
 /// Rewrites every fold network's model.h5 from its best checkpoint and the run's model.h5 (fold 0).
 /// A fold without a checkpoint is an Error naming it. @return the run's artifact path.
 std::string ExportDirectionalRun(const std::string& run_dir);
