@@ -9,6 +9,7 @@
 #include <csignal>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <numeric>
 #include <random>
 #include <sstream>
@@ -126,6 +127,45 @@ struct State {
   int bad_epochs = 0;
 };
 
+// A checkpoint is LibTorch's archive followed by a 16-byte trailer: "FSCKPT01" and the FNV-1a
+// hash of the archive (little-endian). LibTorch's reader does not notice flipped bytes inside
+// tensor data; the trailer does, before anything is loaded.
+constexpr char kChecksumMagic[8] = {'F', 'S', 'C', 'K', 'P', 'T', '0', '1'};
+
+std::uint64_t Fnv1a(const char* data, std::size_t size) {
+  std::uint64_t h = 1469598103934665603ULL;
+  for (std::size_t i = 0; i < size; ++i) {
+    h ^= static_cast<unsigned char>(data[i]);
+    h *= 1099511628211ULL;
+  }
+  return h;
+}
+
+std::string WithChecksum(std::string bytes) {
+  const std::uint64_t h = Fnv1a(bytes.data(), bytes.size());
+  bytes.append(kChecksumMagic, sizeof(kChecksumMagic));
+  for (int i = 0; i < 8; ++i) bytes.push_back(static_cast<char>((h >> (8 * i)) & 0xFF));
+  return bytes;
+}
+
+/// The archive of a checkpoint file's bytes; a wrong checksum is an Error naming the file.
+std::string WithoutChecksum(const std::string& path, const std::string& bytes) {
+  const std::size_t n = bytes.size();
+  const bool has_trailer = n >= 16 && bytes.compare(n - 16, 8, kChecksumMagic, 8) == 0;
+  if (!has_trailer) {
+    log::Warn(path,
+              ": checkpoint has no checksum (written by an older build); loading it unchecked");
+    return bytes;
+  }
+  std::uint64_t stored = 0;
+  for (int i = 0; i < 8; ++i)
+    stored |= static_cast<std::uint64_t>(static_cast<unsigned char>(bytes[n - 8 + i])) << (8 * i);
+  FS_THROW_UNLESS(Fnv1a(bytes.data(), n - 16) == stored, path,
+                  ": checkpoint checksum does not match its contents (corrupted on disk); "
+                  "delete it to start again, or restore a copy");
+  return bytes.substr(0, n - 16);
+}
+
 void SaveCheckpoint(const std::string& path, torch::nn::Module& module,
                     torch::optim::Optimizer& opt, const State& s) {
   torch::serialize::OutputArchive archive;
@@ -143,7 +183,7 @@ void SaveCheckpoint(const std::string& path, torch::nn::Module& module,
   std::ostringstream bytes;
   archive.save_to(bytes);
   try {
-    WriteFileAtomically(path, bytes.str());
+    WriteFileAtomically(path, WithChecksum(bytes.str()));
   } catch (const Error& e) {
     Fail(e.what(), "; the previous checkpoint is kept");
   }
@@ -151,9 +191,13 @@ void SaveCheckpoint(const std::string& path, torch::nn::Module& module,
 
 torch::serialize::InputArchive OpenCheckpoint(const std::string& path) {
   FS_THROW_UNLESS(fs::exists(path), path, ": checkpoint not found");
+  std::ifstream in(path, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  FS_THROW_UNLESS(in.good() || in.eof(), path, ": cannot read the checkpoint");
+  std::istringstream archive_bytes(WithoutChecksum(path, bytes));
   torch::serialize::InputArchive archive;
   try {
-    archive.load_from(path);
+    archive.load_from(archive_bytes);
   } catch (const std::exception& e) {
     Fail(path, ": corrupt or truncated checkpoint (", Brief(e), ")");
   }

@@ -395,6 +395,26 @@ TEST(Trainer, CorruptOrMissingCheckpointIsAClearError) {
                                {"no config.yaml to resume from"});
 }
 
+// Issue 18, defect 6: a checkpoint with flipped bytes loaded, went non-finite and still exported.
+// Its checksum now refuses it before anything is read, for resume and for export alike.
+TEST(Trainer, CheckpointWithFlippedBytesIsRefused) {
+  testing::TempDir dir;
+  SpanExperimentConfig c = TinyConfig();
+  c.train.epochs = 1;
+  TrainSpan(c, dir.path(), false);
+  for (const char* name : {"checkpoints/last.pt", "checkpoints/best.pt"}) {
+    std::string bytes = testing::ReadText(dir.File(name));
+    ASSERT_GT(bytes.size(), 1000u);
+    bytes[bytes.size() / 2] = static_cast<char>(bytes[bytes.size() / 2] ^ 0x5A);
+    std::ofstream out(dir.File(name), std::ios::binary | std::ios::trunc);
+    out << bytes;
+  }
+  testing::ExpectErrorContains([&] { TrainSpan(c, dir.path(), true); },
+                               {dir.File("checkpoints/last.pt"), "checksum does not match"});
+  testing::ExpectErrorContains([&] { ExportSpan(dir.path()); },
+                               {dir.File("checkpoints/best.pt"), "checksum does not match"});
+}
+
 TEST(Trainer, LearningRateSchedules) {
   TrainConfig c;
   c.epochs = 11;
