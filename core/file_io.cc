@@ -32,10 +32,24 @@ void WriteFileBytes(const std::string& path, const char* data, std::size_t size)
   FS_THROW_UNLESS(err == 0, path, ": cannot write (", std::strerror(err), ")");
 }
 
-void WriteFileAtomically(const std::string& path, const std::string& bytes) {
+namespace {
+/// Flushes the directory entry of `path` after a rename; best effort, as some file systems
+/// refuse to sync a directory.
+void SyncParentDirectory(const std::string& path) {
+  const std::string dir = std::filesystem::path(path).parent_path().string();
+  const int fd = ::open(dir.empty() ? "." : dir.c_str(), O_RDONLY);
+  if (fd >= 0) {
+    ::fsync(fd);
+    ::close(fd);
+  }
+}
+}  // namespace
+
+void WriteThroughTemporary(const std::string& path,
+                           const std::function<void(const std::string& tmp)>& write) {
   const std::string tmp = path + ".tmp";
   try {
-    WriteFileBytes(tmp, bytes.data(), bytes.size());
+    write(tmp);
   } catch (...) {
     std::remove(tmp.c_str());
     throw;
@@ -48,13 +62,9 @@ void WriteFileAtomically(const std::string& path, const std::string& bytes) {
   SyncParentDirectory(path);
 }
 
-void SyncParentDirectory(const std::string& path) {
-  const std::string dir = std::filesystem::path(path).parent_path().string();
-  const int fd = ::open(dir.empty() ? "." : dir.c_str(), O_RDONLY);
-  if (fd >= 0) {
-    ::fsync(fd);
-    ::close(fd);
-  }
+void WriteFileAtomically(const std::string& path, const std::string& bytes) {
+  WriteThroughTemporary(
+      path, [&](const std::string& tmp) { WriteFileBytes(tmp, bytes.data(), bytes.size()); });
 }
 
 }  // namespace foresight

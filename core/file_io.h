@@ -3,6 +3,7 @@
 /// naming the file, and nothing half-written is left where a complete file is expected.
 
 #include <cstddef>
+#include <functional>
 #include <string>
 
 namespace foresight {
@@ -10,12 +11,13 @@ namespace foresight {
 /// Writes `size` bytes to `path` (created or truncated) and flushes them to disk.
 void WriteFileBytes(const std::string& path, const char* data, std::size_t size);
 
-/// Flushes the directory entry of `path` (after a rename); best effort, as some file systems
-/// refuse to sync a directory.
-void SyncParentDirectory(const std::string& path);
+/// `write` fills the temporary file it is given (path.tmp), which is then renamed to `path` and
+/// the directory entry flushed; on any failure the temporary file is removed, `path` is left as
+/// it was and the Error propagates. Every atomic writer goes through this.
+void WriteThroughTemporary(const std::string& path,
+                           const std::function<void(const std::string& tmp)>& write);
 
-/// Writes `bytes` to path.tmp, flushes it, then renames it to `path` (the directory entry is
-/// flushed too); on failure the temporary file is removed and `path` is left as it was.
+/// WriteThroughTemporary of `bytes` with WriteFileBytes.
 void WriteFileAtomically(const std::string& path, const std::string& bytes);
 
 }  // namespace foresight

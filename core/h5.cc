@@ -135,21 +135,11 @@ void File::Close() {
 }
 
 void WriteAtomically(const std::string& path, const std::function<void(File*)>& write) {
-  const std::string tmp = path + ".tmp";
-  try {
+  WriteThroughTemporary(path, [&](const std::string& tmp) {
     File f = File::Create(tmp);
     write(&f);
     f.Close();
-  } catch (...) {
-    std::remove(tmp.c_str());
-    throw;
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    const int err = errno;
-    std::remove(tmp.c_str());
-    Fail(path, ": cannot move the written file into place (", std::strerror(err), ")");
-  }
-  SyncParentDirectory(path);
+  });
 }
 
 bool File::Exists(const std::string& object) const {

@@ -18,11 +18,25 @@
 #include "models/directional/directional_grid_map.h"
 #include "training/directional/plots.h"
 #include "training/run_dir.h"
+#include "training/tensor_eigen.h"
 
 namespace foresight {
 namespace fs = std::filesystem;
 
 namespace {
+
+/// The networks a config trains: spatiotemporal and/or spatial.
+std::vector<DirectionalVariant> TrainedVariants(const DirectionalExperimentConfig& c) {
+  std::vector<DirectionalVariant> variants;
+  if (c.eval.spatiotemporal) variants.push_back(DirectionalVariant::kSpatiotemporal);
+  if (c.eval.spatial) variants.push_back(DirectionalVariant::kSpatial);
+  return variants;
+}
+
+/// How many of the K folds a run evaluates (eval.max_folds, 0: all).
+int EvaluatedFolds(const DirectionalExperimentConfig& c) {
+  return c.eval.max_folds > 0 ? c.eval.max_folds : c.eval.folds;
+}
 
 using RowMatrixF = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
@@ -238,16 +252,8 @@ void WriteDirectionalArtifact(DirectionalNetImpl& net, const DirectionalFeatureC
   FS_THROW_UNLESS(!fc.auto_extent && !fc.auto_time_range,
                   "WriteDirectionalArtifact: unresolved feature extent");
   const auto params = net.named_parameters();
-  auto matrix = [&](const std::string& name) {
-    const torch::Tensor t = params[name].detach().contiguous().to(torch::kFloat32);
-    return Eigen::MatrixXf(
-        Eigen::Map<const Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
-            t.data_ptr<float>(), t.size(0), t.size(1)));
-  };
-  auto vector = [&](const std::string& name) {
-    const torch::Tensor t = params[name].detach().contiguous().to(torch::kFloat32);
-    return Eigen::VectorXf(Eigen::Map<const Eigen::VectorXf>(t.data_ptr<float>(), t.size(0)));
-  };
+  auto matrix = [&](const std::string& name) { return ToEigenMatrix(params[name]); };
+  auto vector = [&](const std::string& name) { return ToEigenVector(params[name]); };
   Lstm lstm;
   if (net.variant() == DirectionalVariant::kSpatiotemporal)
     lstm = Lstm(LstmWeights{matrix("lstm.weight_ih_l0"), matrix("lstm.weight_hh_l0"),
@@ -331,9 +337,7 @@ std::vector<std::pair<std::string, std::pair<double, double>>> EvaluateDirection
   VonMisesMixtureBatch batch;
   const auto [train, val] =
       SplitVal(train_all, c.eval.val_fraction, static_cast<std::uint64_t>(c.seed) + 17);
-  std::vector<DirectionalVariant> variants;
-  if (c.eval.spatiotemporal) variants.push_back(DirectionalVariant::kSpatiotemporal);
-  if (c.eval.spatial) variants.push_back(DirectionalVariant::kSpatial);
+  const std::vector<DirectionalVariant> variants = TrainedVariants(c);
   for (const DirectionalVariant v : variants) {
     const std::string dir = work_dir + "/" + VariantName(v);
     const TrainingSummary s = TrainDirectionalNet(c, f, v, train, val, dir, true, hooks);
@@ -439,10 +443,8 @@ std::string ExportDirectionalRun(const std::string& run_dir) {
       config::LoadExperimentConfig<DirectionalExperimentConfig>(run_dir + "/config.yaml");
   const DirectionalSamples data = LoadDirectionalSamples(c);
   const DirectionalFeatureConfig f = ResolveExtent(c.features, data.x, data.y, data.t);
-  std::vector<DirectionalVariant> variants;
-  if (c.eval.spatiotemporal) variants.push_back(DirectionalVariant::kSpatiotemporal);
-  if (c.eval.spatial) variants.push_back(DirectionalVariant::kSpatial);
-  const int folds = c.eval.max_folds > 0 ? c.eval.max_folds : c.eval.folds;
+  const std::vector<DirectionalVariant> variants = TrainedVariants(c);
+  const int folds = EvaluatedFolds(c);
   for (int k = 0; k < folds; ++k) {
     for (const DirectionalVariant v : variants) {
       const std::string dir = run_dir + "/folds/" + std::to_string(k) + "/" + VariantName(v);
@@ -481,12 +483,10 @@ DirectionalRunResult RunDirectionalExperiment(const DirectionalExperimentConfig&
 
 DirectionalEvalReport EvaluateDirectionalRun(const DirectionalExperimentConfig& c,
                                              const std::string& run_dir) {
-  const int folds = c.eval.max_folds > 0 ? c.eval.max_folds : c.eval.folds;
-  for (int k = 0; k < folds; ++k)
-    for (const char* variant : {"spatiotemporal", "spatial"}) {
-      const bool used = std::string(variant) == "spatial" ? c.eval.spatial : c.eval.spatiotemporal;
-      const std::string dir = run_dir + "/folds/" + std::to_string(k) + "/" + variant;
-      FS_THROW_UNLESS(!used || fs::exists(dir + "/model.h5"), dir,
+  for (int k = 0; k < EvaluatedFolds(c); ++k)
+    for (const DirectionalVariant v : TrainedVariants(c)) {
+      const std::string dir = run_dir + "/folds/" + std::to_string(k) + "/" + VariantName(v);
+      FS_THROW_UNLESS(fs::exists(dir + "/model.h5"), dir,
                       ": no model.h5 (the run is not finished; continue it with train --resume)");
     }
   log::SetFile(run_dir + "/log.txt");
@@ -505,7 +505,7 @@ DirectionalRunResult RunFolds(const DirectionalExperimentConfig& c, const std::s
             f.y_max, "], ", f.time_points, " temporal over [", f.t_min, ", ", f.t_max, "] s");
   const auto folds =
       KFoldTestIndices(data.size(), c.eval.folds, static_cast<std::uint64_t>(c.seed));
-  const int evaluate = c.eval.max_folds > 0 ? c.eval.max_folds : c.eval.folds;
+  const int evaluate = EvaluatedFolds(c);
 
   DirectionalRunResult result;
   DirectionalEvalReport& report = result.report;

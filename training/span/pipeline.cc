@@ -12,6 +12,7 @@
 #include "models/span/span_data.h"
 #include "models/span/span_net.h"
 #include "training/run_dir.h"
+#include "training/tensor_eigen.h"
 
 namespace foresight {
 namespace fs = std::filesystem;
@@ -157,16 +158,9 @@ namespace {
 Mlp ToEngineMlp(torch::nn::Module& net, const std::vector<std::string>& names) {
   const auto params = net.named_parameters();
   std::vector<DenseLayer> layers;
-  for (const std::string& name : names) {
-    const torch::Tensor w = params[name + ".weight"].detach().contiguous().to(torch::kFloat32);
-    const torch::Tensor b = params[name + ".bias"].detach().contiguous().to(torch::kFloat32);
-    DenseLayer l;
-    l.weight =
-        Eigen::Map<const Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
-            w.data_ptr<float>(), w.size(0), w.size(1));
-    l.bias = Eigen::Map<const Eigen::VectorXf>(b.data_ptr<float>(), b.size(0));
-    layers.push_back(std::move(l));
-  }
+  for (const std::string& name : names)
+    layers.push_back(
+        {ToEigenMatrix(params[name + ".weight"]), ToEigenVector(params[name + ".bias"])});
   return Mlp(std::move(layers));
 }
 }  // namespace
