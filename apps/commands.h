@@ -20,5 +20,10 @@ void AddBenchMapCommand(CLI::App* bench);  // bench map (under `bench`)
 void AddBenchDirectionalCommand(CLI::App* bench);
 /// `navigate CONFIG --run-dir DIR [--episodes N]` (SPAN and baselines in a crowd scenario).
 void AddNavigateCommand(CLI::App* app);
+/// `plan CONFIG [--problems A-B] --run-dir DIR` (GFCS, fabric and planners on manipulation
+/// problems).
+void AddPlanCommand(CLI::App* app);
+/// `bench fabric [--json]` (under `bench`): FK, fabric step and rollout times, KDL alongside.
+void AddBenchFabricCommand(CLI::App* bench);
 
 }  // namespace foresight::app

@@ -19,6 +19,8 @@ int main(int argc, char** argv) {
 #endif
     foresight::app::AddMapCommands(&app);
     foresight::app::AddNavigateCommand(&app);
+    foresight::app::AddPlanCommand(&app);
+    foresight::app::AddBenchFabricCommand(app.get_subcommand("bench"));
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);

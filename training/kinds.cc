@@ -16,6 +16,7 @@ ExperimentRegistry BuiltinKinds() {
   r.Add(DirectionalKind());
 #endif
   r.Add(NavigationKind());
+  r.Add(ManipulationKind());
 #ifdef FORESIGHT_WITH_TORCH
   r.SetDefault("span_predictor");
 #endif

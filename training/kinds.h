@@ -17,6 +17,7 @@ ExperimentRegistry BuiltinKinds();
 // One function per method, each in its <method>_kind.cc.
 ExperimentKind OccupancyKind();
 ExperimentKind NavigationKind();
+ExperimentKind ManipulationKind();
 #ifdef FORESIGHT_WITH_TORCH
 ExperimentKind SpanKind(const std::string& embedded_default);
 ExperimentKind DirectionalKind();

@@ -1,0 +1,146 @@
+// `foresight bench fabric [CONFIG] [--json]`: manipulation runtime figures measured in one run on
+// one thread (except the GFCS solve, which uses the config's threads): forward kinematics of every
+// collision sphere (positions; with Jacobians and J' q_d), one fabric step, a full rollout to the
+// goal, and a GFCS solve (one batch, uniform sampler). Medians of repeated runs over the config's
+// problems. KDL side by side: the bench_kinematics benchmark (experiments/manipulation).
+
+#include <algorithm>
+#include <chrono>
+#include <iomanip>
+#include <iostream>
+#include <random>
+#include <sstream>
+
+#include "apps/commands.h"
+#include "core/error.h"
+#include "embedded_manipulation_config.h"
+#include "experiments/manipulation/plan.h"
+#include "inference/manipulation/fabric.h"
+#include "inference/manipulation/gfcs.h"
+#include "inference/manipulation/validity.h"
+
+namespace foresight::app {
+namespace {
+using Clock = std::chrono::steady_clock;
+using namespace manipulation;  // NOLINT: a manipulation benchmark
+
+struct BenchFabricArgs {
+  std::string config = "default";
+  std::vector<std::string> overrides;
+  bool json = false;
+  int repeats = 7;
+};
+
+double Median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+/// Median over `repeats` of the mean time per call of `f` over `calls` calls (seconds).
+template <class F>
+double PerCall(int repeats, int calls, F&& f) {
+  std::vector<double> t;
+  for (int r = 0; r < repeats; ++r) {
+    const auto s = Clock::now();
+    for (int i = 0; i < calls; ++i) f(i);
+    t.push_back(std::chrono::duration<double>(Clock::now() - s).count() / calls);
+  }
+  return Median(t);
+}
+
+void RunFabricBench(const BenchFabricArgs& a) {
+  const ManipulationExperimentConfig c =
+      a.config == "default"
+          ? config::ExperimentConfigFromYaml<ManipulationExperimentConfig>(
+                kEmbeddedManipulationConfig, "<embedded configs/manipulation/synthetic.yaml>",
+                a.overrides)
+          : config::LoadExperimentConfig<ManipulationExperimentConfig>(a.config, a.overrides);
+  const RobotModel robot = LoadExperimentRobot(c);
+  const std::vector<ManipulationProblem> problems = LoadExperimentProblems(c, robot);
+  FS_THROW_UNLESS(!problems.empty(), "bench fabric: the config has no problems");
+
+  // Random configurations within the limits, shared by ours and KDL.
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> unit(0, 1);
+  const JointLimits& limits = robot.limits();
+  std::vector<JointVector> qs(256), qds(256);
+  for (std::size_t i = 0; i < qs.size(); ++i)
+    for (int j = 0; j < kDof; ++j) {
+      qs[i][j] = limits.lower[j] + unit(rng) * (limits.upper[j] - limits.lower[j]);
+      qds[i][j] = 2 * unit(rng) - 1;
+    }
+  const int calls = 2000;
+  KinematicsData data = robot.MakeData();
+  const double fk = PerCall(a.repeats, calls, [&](int i) {
+    ForwardKinematics(robot, qs[static_cast<std::size_t>(i) % qs.size()], &data);
+  });
+  const double fk_jac = PerCall(a.repeats, calls, [&](int i) {
+    const std::size_t k = static_cast<std::size_t>(i) % qs.size();
+    ForwardKinematicsWithJacobians(robot, qs[k], qds[k], &data);
+  });
+
+  // Fabric step and rollout on each problem's world (valid start states).
+  std::vector<double> steps, rollouts, rollout_times, solves;
+  for (const ManipulationProblem& problem : problems) {
+    const ValidityChecker checker(robot, problem.world);
+    if (checker.Check(problem.start, &data) != Validity::kValid) continue;
+    const Fabric fabric(robot, problem.world, c.fabric);
+    FabricWorkspace ws = fabric.MakeWorkspace();
+    JointVector qdd;
+    steps.push_back(PerCall(a.repeats, calls, [&](int i) {
+      fabric.Acceleration(problem.start, 0.1 * qds[static_cast<std::size_t>(i) % qds.size()],
+                          problem.goal, &ws, &qdd);
+    }));
+    RolloutResult r;
+    rollouts.push_back(PerCall(a.repeats, 1, [&](int) {
+      r = fabric.Rollout(problem.start, JointVector::Zero(), problem.goal, &ws);
+    }));
+    rollout_times.push_back(r.t);
+    UniformSampler sampler(limits.lower, limits.upper);
+    GfcsParams params = c.gfcs;
+    params.batches = 1;
+    GfcsQuery query;
+    query.start = problem.start;
+    query.goal = problem.goal;
+    solves.push_back(
+        PerCall(a.repeats, 1, [&](int) { SolveGfcop(fabric, query, &sampler, params); }));
+  }
+  FS_THROW_UNLESS(!steps.empty(), "bench fabric: no problem has a valid start");
+  const double step = Median(steps), rollout = Median(rollouts), solve = Median(solves);
+  const double integrated = Median(rollout_times);
+
+  if (a.json) {
+    std::cout << std::setprecision(6) << "{\"spheres\": " << robot.num_spheres()
+              << ", \"fk_us\": " << fk * 1e6 << ", \"fk_jacobians_us\": " << fk_jac * 1e6
+              << ", \"fabric_step_us\": " << step * 1e6 << ", \"rollout_ms\": " << rollout * 1e3
+              << ", \"rollout_integrated_s\": " << integrated << ", \"gfcs_solve_s\": " << solve
+              << ", \"gfcs_batch_size\": " << c.gfcs.batch_size
+              << ", \"problems\": " << steps.size() << "}\n";
+    return;
+  }
+  std::cout << std::fixed << std::setprecision(2) << "robot: " << robot.num_spheres()
+            << " spheres; " << steps.size() << " problems; medians of " << a.repeats
+            << " repeats, one thread unless stated\n"
+            << "FK, sphere centres                " << std::setw(8) << fk * 1e6 << " us\n"
+            << "FK + Jacobians + J' q_d           " << std::setw(8) << fk_jac * 1e6 << " us\n"
+            << "fabric step                       " << std::setw(8) << step * 1e6 << " us\n"
+            << "rollout to the goal               " << std::setw(8) << rollout * 1e3 << " ms   ("
+            << integrated << " s integrated)\n"
+            << "GFCS solve, 1 batch of " << c.gfcs.batch_size << "       " << std::setw(8) << solve
+            << " s   (" << (c.gfcs.threads > 0 ? c.gfcs.threads : 0) << " threads; 0: all cores)\n";
+}
+}  // namespace
+
+void AddBenchFabricCommand(CLI::App* bench) {
+  auto args = std::make_shared<BenchFabricArgs>();
+  auto* cmd = bench->add_subcommand(
+      "fabric", "FK, fabric step, rollout and GFCS solve times on manipulation problems");
+  cmd->add_option("config", args->config,
+                  "manipulation config (default: the embedded synthetic quickstart)");
+  cmd->add_option("overrides", args->overrides, "key.path=value overrides of the config");
+  cmd->add_flag("--json", args->json, "print one JSON object");
+  cmd->add_option("--repeats", args->repeats, "repeats (median)")->check(CLI::Range(1, 1000));
+  cmd->callback([args] { RunFabricBench(*args); });
+}
+
+}  // namespace foresight::app

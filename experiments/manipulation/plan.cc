@@ -1,0 +1,356 @@
+#include "experiments/manipulation/plan.h"
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <random>
+#include <sstream>
+
+#include "core/error.h"
+#include "core/file_io.h"
+#include "core/log.h"
+#include "datasets/data_root.h"
+#include "experiments/manipulation/render.h"
+#include "inference/manipulation/builtin_panda.h"
+#include "inference/manipulation/fabric.h"
+#include "inference/manipulation/gfcs.h"
+#include "inference/manipulation/planners.h"
+#include "inference/manipulation/synthetic_problems.h"
+#include "inference/manipulation/validity.h"
+
+namespace foresight {
+namespace fs = std::filesystem;
+using namespace manipulation;  // NOLINT: this file is the manipulation harness
+
+namespace {
+
+double Seconds(std::chrono::steady_clock::time_point since) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
+/// A method's trajectory before judging: joint states at a fixed step, or nothing.
+struct Trajectory {
+  bool reached = false;
+  std::string status;
+  TimedPath joints;
+  double generation_time_s = 0;
+};
+
+TimedPath ToTimedPath(const std::vector<JointVector>& states, double dt) {
+  TimedPath path;
+  path.dt = dt;
+  path.positions.resize(kDof, static_cast<Eigen::Index>(states.size()));
+  for (std::size_t i = 0; i < states.size(); ++i)
+    path.positions.col(static_cast<Eigen::Index>(i)) = states[i];
+  return path;
+}
+
+Trajectory RunGfcs(const Fabric& fabric, const ManipulationProblem& problem,
+                   const ManipulationExperimentConfig& c, const PlanMethodConfig& method,
+                   std::uint64_t seed, GfcsCandidate* best) {
+  GfcsParams params = c.gfcs;
+  params.batches = method.batches;
+  params.seed = static_cast<std::int64_t>(seed);
+  const JointLimits& limits = fabric.robot().limits();
+  UniformSampler sampler(limits.lower, limits.upper);
+  GfcsQuery query;
+  query.start = problem.start;
+  query.goal = problem.goal;
+  const auto started = std::chrono::steady_clock::now();
+  const GfcsSolution solution = SolveGfcop(fabric, query, &sampler, params);
+  Trajectory t;
+  t.generation_time_s = Seconds(started);
+  if (solution.status == GfcsStatus::kError) {
+    t.status = "error: " + solution.message;
+    return t;
+  }
+  if (!solution.solved()) {
+    t.status = solution.top.empty() ? "not_solved" : ToString(solution.top.front().last_status);
+    return t;
+  }
+  // Re-roll the best sequence to record its states (deterministic: same as during the solve).
+  FabricWorkspace ws = fabric.MakeWorkspace();
+  std::vector<JointVector> states;
+  *best = EvaluateCommandSequence(fabric, query, solution.top.front().commands, params.penalty, &ws,
+                                  &states);
+  t.reached = best->reached;
+  t.status = t.reached ? "solved" : ToString(best->last_status);
+  t.joints = ToTimedPath(states, fabric.params().dt);
+  return t;
+}
+
+Trajectory RunFabric(const Fabric& fabric, const ManipulationProblem& problem) {
+  FabricWorkspace ws = fabric.MakeWorkspace();
+  std::vector<JointVector> states{problem.start};
+  const auto started = std::chrono::steady_clock::now();
+  const RolloutResult r =
+      fabric.Rollout(problem.start, JointVector::Zero(), problem.goal, &ws, &states);
+  Trajectory t;
+  t.generation_time_s = Seconds(started);
+  t.reached = r.status == RolloutStatus::kReached;
+  t.status = t.reached ? "solved" : ToString(r.status);
+  t.joints = ToTimedPath(states, fabric.params().dt);
+  return t;
+}
+
+Trajectory RunPlanner(PlannerKind kind, const ValidityChecker& checker,
+                      const ManipulationProblem& problem, const ManipulationExperimentConfig& c,
+                      const PlanMethodConfig& method, std::uint64_t seed) {
+  KinematicsData data = checker.robot().MakeData();
+  auto is_valid = [&](const JointVector& q) { return checker.Check(q, &data) == Validity::kValid; };
+  PlannerOptions options;
+  options.time_budget_s = method.time_budget;
+  options.resolution_rad = c.resolution;
+  options.seed = static_cast<std::uint32_t>(seed % 4294967291u) + 1;  // OMPL seeds are >= 1
+  const JointLimits& limits = checker.robot().limits();
+  const PlannerResult r =
+      Plan(kind, problem.start, problem.goal, limits.lower, limits.upper, is_valid, options);
+  Trajectory t;
+  t.generation_time_s = r.planning_time_s;
+  t.reached = r.status == PlannerStatus::kSolved;
+  t.status = t.reached ? "solved" : std::string(ToString(r.status));
+  if (t.reached)
+    t.joints = TimeParameterise(r.waypoints, JointVector::Constant(c.max_joint_speed), c.fabric.dt);
+  return t;
+}
+
+/// Every consecutive pair of states valid at `resolution`, and the last state at the goal.
+std::string JudgePath(const TimedPath& joints, const JointVector& goal,
+                      const ValidityChecker& checker, double resolution, double goal_tolerance) {
+  KinematicsData data = checker.robot().MakeData();
+  const Eigen::Index n = joints.positions.cols();
+  if (n == 0) return "empty_path";
+  for (Eigen::Index i = 0; i + 1 < n; ++i) {
+    const Validity v = checker.CheckMotion(joints.positions.col(i), joints.positions.col(i + 1),
+                                           resolution, &data);
+    if (v != Validity::kValid) return std::string("invalid_path: ") + ToString(v);
+  }
+  if (n == 1 && checker.Check(joints.positions.col(0), &data) != Validity::kValid)
+    return "invalid_path";
+  if ((joints.positions.col(n - 1) - goal).norm() > goal_tolerance) return "goal_not_reached";
+  return "";
+}
+
+/// Adds `count` small cylinders centred on end-effector points of the solved trajectory, outside
+/// its last second, that do not collide with the start configuration (thesis "reactivity").
+bool AddObstaclesOnPath(const Eigen::Matrix3Xd& ee_path, double dt, const ReactivityConfig& r,
+                        const ValidityChecker& start_checker, const JointVector& start,
+                        std::mt19937_64* rng, World* world) {
+  const Eigen::Index usable = ee_path.cols() - static_cast<Eigen::Index>(std::ceil(1.0 / dt));
+  if (usable < 2) return false;
+  std::uniform_int_distribution<Eigen::Index> pick(1, usable - 1);
+  int added = 0;
+  for (int attempt = 0; attempt < r.attempts * r.obstacles && added < r.obstacles; ++attempt) {
+    Cylinder cyl;
+    cyl.X_WC.translation() = ee_path.col(pick(*rng));
+    cyl.radius = r.radius;
+    cyl.half_height = r.radius;
+    World trial = *world;
+    trial.AddCylinder("reactive_" + std::to_string(added), cyl);
+    const ValidityChecker checker(start_checker.robot(), trial);
+    KinematicsData data = checker.robot().MakeData();
+    if (checker.Check(start, &data) != Validity::kValid) continue;
+    *world = trial;
+    ++added;
+  }
+  return added == r.obstacles;
+}
+
+std::string CsvNumber(const std::optional<double>& v) {
+  if (!v) return "";
+  std::ostringstream os;
+  os << std::setprecision(6) << *v;
+  return os.str();
+}
+
+void WriteProblemsCsv(const std::string& path, const PlanReport& report) {
+  std::ostringstream os;
+  os << "problem,method,status,success,time_s,ee_length,cspace_length,duration_s,ee_ldj,"
+        "cspace_ldj\n";
+  for (const PlanAttempt& a : report.attempts) {
+    const PathMetrics& m = a.metrics;
+    os << a.problem << ",\"" << a.method << "\"," << a.status << "," << (m.success ? 1 : 0) << ","
+       << m.time_s << "," << CsvNumber(m.ee_length) << "," << CsvNumber(m.cspace_length) << ","
+       << CsvNumber(m.duration_s) << "," << CsvNumber(m.ee_ldj.value) << ","
+       << CsvNumber(m.cspace_ldj.value) << "\n";
+  }
+  WriteFileAtomically(path, os.str());
+}
+
+void WriteSummaryJson(const std::string& path, const ManipulationExperimentConfig& c,
+                      const PlanReport& report) {
+  std::ostringstream os;
+  os << "{\n  \"family\": \""
+     << (c.problems.source == ProblemSource::kSynthetic ? "synthetic" : c.problems.family)
+     << "\",\n  \"problems\": " << report.problems << ",\n  \"invalid_problems\": [";
+  for (std::size_t i = 0; i < report.invalid_problems.size(); ++i)
+    os << (i ? ", " : "") << report.invalid_problems[i];
+  os << "],\n  \"methods\": [\n";
+  for (std::size_t i = 0; i < report.methods.size(); ++i) {
+    os << "    {\"name\": \"" << report.methods[i].method
+       << "\", \"metrics\": " << report.methods[i].summary.ToJson() << "}"
+       << (i + 1 < report.methods.size() ? "," : "") << "\n";
+  }
+  os << "  ]";
+  if (c.reactivity.enabled)
+    os << ",\n  \"reactivity\": {\"trials\": " << report.reactivity_trials
+       << ", \"successes\": " << report.reactivity_successes << ", \"success_rate\": "
+       << (report.reactivity_trials
+               ? static_cast<double>(report.reactivity_successes) / report.reactivity_trials
+               : 0.0)
+       << "}";
+  os << "\n}\n";
+  WriteFileAtomically(path, os.str());
+}
+
+}  // namespace
+
+RobotModel LoadExperimentRobot(const ManipulationExperimentConfig& c) {
+  if (c.robot == "builtin") return BuiltinPanda();
+  return RobotModel::LoadPanda(ResolveDataFile(c.problems.root, c.robot));
+}
+
+std::vector<ManipulationProblem> LoadExperimentProblems(const ManipulationExperimentConfig& c,
+                                                        const RobotModel& robot) {
+  const ManipulationProblemsConfig& p = c.problems;
+  if (p.source == ProblemSource::kMotionBenchMaker)
+    return LoadMbmFamily(ResolveDataFile(p.root, "motionbenchmaker_panda/problems"), p.family,
+                         p.first, p.last);
+  std::vector<ManipulationProblem> out;
+  const auto is_valid = [&robot](const World& world, const JointVector& q) {
+    const ValidityChecker checker(robot, world);
+    KinematicsData data = robot.MakeData();
+    return checker.Check(q, &data) == Validity::kValid;
+  };
+  for (int i = 0; i < p.synthetic_count; ++i) {
+    out.push_back(MakeSyntheticProblem(p.scene, p.start_goal, robot.limits().lower,
+                                       robot.limits().upper, is_valid,
+                                       static_cast<std::uint64_t>(p.synthetic_seed + i)));
+    out.back().index = i + 1;
+  }
+  return out;
+}
+
+PlanReport RunPlanExperiment(const ManipulationExperimentConfig& c, const std::string& run_dir) {
+  const RobotModel robot = LoadExperimentRobot(c);
+  const std::vector<ManipulationProblem> problems = LoadExperimentProblems(c, robot);
+  PlanReport report;
+  report.problems = static_cast<int>(problems.size());
+  std::vector<std::vector<PathMetrics>> per_method(c.methods.size());
+  std::vector<PlanProblemPicture> pictures;
+  KinematicsData ee_data = robot.MakeData();
+  const EndEffectorFn ee = [&](const JointVector& q) {
+    ForwardKinematics(robot, q, &ee_data);
+    return Eigen::Vector3d(ee_data.p_WE);
+  };
+
+  // Reactivity is measured on the first GFCS method's solutions.
+  int reactive_method = -1;
+  for (std::size_t m = 0; m < c.methods.size() && reactive_method < 0; ++m)
+    if (c.methods[m].kind == PlanMethodKind::kGfcs) reactive_method = static_cast<int>(m);
+
+  for (const ManipulationProblem& problem : problems) {
+    const ValidityChecker checker(robot, problem.world);
+    KinematicsData data = robot.MakeData();
+    const Validity start_ok = checker.Check(problem.start, &data);
+    const Validity goal_ok = checker.Check(problem.goal, &data);
+    if (start_ok != Validity::kValid || goal_ok != Validity::kValid) {
+      log::Info("problem ", problem.index, ": start ", ToString(start_ok), ", goal ",
+                ToString(goal_ok), " for this robot model: skipped");
+      report.invalid_problems.push_back(problem.index);
+      continue;
+    }
+    const Fabric fabric(robot, problem.world, c.fabric);
+    const std::uint64_t seed = static_cast<std::uint64_t>(c.seed + problem.index);
+    PlanProblemPicture picture;
+    picture.problem = problem.index;
+    picture.world = &problem.world;
+    std::ostringstream line;
+    line << "problem " << problem.index << ":";
+    for (std::size_t m = 0; m < c.methods.size(); ++m) {
+      const PlanMethodConfig& method = c.methods[m];
+      Trajectory t;
+      GfcsCandidate best;
+      try {
+        switch (method.kind) {
+          case PlanMethodKind::kGfcs:
+            t = RunGfcs(fabric, problem, c, method, seed, &best);
+            break;
+          case PlanMethodKind::kFabric:
+            t = RunFabric(fabric, problem);
+            break;
+          case PlanMethodKind::kBiEst:
+            t = RunPlanner(PlannerKind::kBiEst, checker, problem, c, method, seed);
+            break;
+          case PlanMethodKind::kBitStar:
+            t = RunPlanner(PlannerKind::kBitStar, checker, problem, c, method, seed);
+            break;
+          case PlanMethodKind::kRrtConnect:
+            t = RunPlanner(PlannerKind::kRrtConnect, checker, problem, c, method, seed);
+            break;
+        }
+      } catch (const std::exception& e) {
+        t = Trajectory{};
+        t.status = std::string("error: ") + e.what();
+      }
+      PlanAttempt attempt;
+      attempt.method = method.name;
+      attempt.problem = problem.index;
+      attempt.status = t.status;
+      if (t.reached) {
+        const std::string verdict = JudgePath(t.joints, problem.goal, checker, c.resolution,
+                                              c.fabric.goal_tolerance + 1e-9);
+        if (!verdict.empty()) {
+          t.reached = false;
+          attempt.status = verdict;
+        }
+      }
+      if (t.reached) {
+        attempt.ee_path = EndEffectorPath(t.joints, ee);
+        attempt.metrics = EvaluatePath(t.joints, attempt.ee_path, t.generation_time_s);
+        attempt.metrics.success = true;
+      } else {
+        attempt.metrics = PathMetrics::Failure(t.generation_time_s);
+      }
+      line << " " << method.name << "=" << attempt.status;
+      per_method[m].push_back(attempt.metrics);
+
+      // Reactivity: GFCS's commands re-run by the fabric with obstacles on the solved path.
+      if (c.reactivity.enabled && static_cast<int>(m) == reactive_method &&
+          attempt.metrics.success) {
+        World changed = problem.world;
+        std::mt19937_64 rng(seed);
+        if (AddObstaclesOnPath(attempt.ee_path, c.fabric.dt, c.reactivity, checker, problem.start,
+                               &rng, &changed)) {
+          const Fabric reactive(robot, changed, c.fabric);
+          FabricWorkspace ws = reactive.MakeWorkspace();
+          GfcsQuery query;
+          query.start = problem.start;
+          query.goal = problem.goal;
+          const GfcsCandidate again =
+              EvaluateCommandSequence(reactive, query, best.commands, c.gfcs.penalty, &ws);
+          ++report.reactivity_trials;
+          report.reactivity_successes += again.reached;
+        }
+      }
+      if (static_cast<int>(pictures.size()) < c.plot_problems)
+        picture.paths.push_back({method.name, attempt.ee_path});
+      report.attempts.push_back(std::move(attempt));
+    }
+    log::Info(line.str());
+    if (static_cast<int>(pictures.size()) < c.plot_problems) pictures.push_back(picture);
+  }
+  for (std::size_t m = 0; m < c.methods.size(); ++m)
+    report.methods.push_back({c.methods[m].name, Summarise(per_method[m])});
+
+  WriteSummaryJson((fs::path(run_dir) / "summary.json").string(), c, report);
+  WriteProblemsCsv((fs::path(run_dir) / "problems.csv").string(), report);
+  if (!pictures.empty()) {
+    // Pictures keep pointers to the problems' worlds, alive until here.
+    RenderEndEffectorPaths((fs::path(run_dir) / "ee_paths.png").string(), pictures);
+  }
+  return report;
+}
+
+}  // namespace foresight

@@ -1,0 +1,57 @@
+#pragma once
+/// The manipulation harness (thesis ch 9, "Experimental Evaluation"): every method of a config
+/// (GFCS, the single-attractor geometric fabric, Bi-EST, BIT*, RRT-Connect) over a family of
+/// problems, judged by one validity checker at one resolution and one metrics module. Writes
+/// DIR/summary.json, DIR/problems.csv and DIR/ee_paths.png. Torch-free.
+
+#include <string>
+#include <vector>
+
+#include "inference/manipulation/mbm_problem.h"
+#include "inference/manipulation/metrics.h"
+#include "inference/manipulation/robot_model.h"
+#include "inference/manipulation/world.h"
+#include "training/manipulation/config.h"
+#include "training/run_dir.h"
+
+namespace foresight {
+
+/// A plan run directory holds these; `plan` refuses to write into another run's directory.
+inline const RunDirectoryRules kManipulationRunRules{{"summary.json", "problems.csv"}, false};
+
+/// The config's robot: `builtin`, or a folder (panda.urdf, spheres_vamp.csv, panda.srdf) under the
+/// data root.
+manipulation::RobotModel LoadExperimentRobot(const ManipulationExperimentConfig& config);
+
+/// The config's problems (MotionBenchMaker family range, or synthetic scenes for `robot`).
+std::vector<manipulation::ManipulationProblem> LoadExperimentProblems(
+    const ManipulationExperimentConfig& config, const manipulation::RobotModel& robot);
+
+/// One method on one problem.
+struct PlanAttempt {
+  std::string method;
+  int problem = 0;
+  std::string status;  ///< solved, or why not (timeout, collision, invalid_path, planner status)
+  manipulation::PathMetrics metrics;
+  Eigen::Matrix3Xd ee_path;  ///< end-effector positions of the trajectory (empty on failure)
+};
+
+struct PlanMethodResult {
+  std::string method;
+  manipulation::MetricSummary summary;
+};
+
+struct PlanReport {
+  int problems = 0;
+  std::vector<int> invalid_problems;  ///< start or goal invalid for this robot model: skipped
+  std::vector<PlanMethodResult> methods;
+  std::vector<PlanAttempt> attempts;
+  int reactivity_trials = 0, reactivity_successes = 0;
+};
+
+/// Runs the config's methods on its problems and writes the outputs into `run_dir` (which exists).
+/// Never throws from inside a method's run: failures are statuses in the report.
+PlanReport RunPlanExperiment(const ManipulationExperimentConfig& config,
+                             const std::string& run_dir);
+
+}  // namespace foresight

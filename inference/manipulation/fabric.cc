@@ -1,0 +1,227 @@
+#include "inference/manipulation/fabric.h"
+
+#include <Eigen/Cholesky>
+#include <cmath>
+
+#include "core/error.h"
+
+namespace foresight::manipulation {
+namespace {
+
+using Matrix7 = Eigen::Matrix<double, kDof, kDof>;
+
+/// Step of the central difference of the distance gradient along the sphere velocity, used for
+/// the curvature part of J' q_d of the obstacle terms (m).
+constexpr double kCurvatureStep = 1e-5;
+
+/// Adds J'M J and J'M (h - J' q_d) of one barrier term; returns whether it was active.
+bool AddBarrierTerm(const BarrierParams& p, const ScalarTask& t, Matrix7* M, JointVector* f) {
+  const double m = BarrierMetric(p, t.x, t.xd);
+  if (m == 0) return false;
+  const double h = p.gain * t.xd * t.xd / t.x;
+  M->noalias() += m * t.J.transpose() * t.J;
+  f->noalias() += (m * (h - t.jdq)) * t.J.transpose();
+  return true;
+}
+
+}  // namespace
+
+double BarrierMetric(const BarrierParams& p, double x, double xd) {
+  if (xd >= 0 || x >= p.range || x <= 0) return 0;
+  return p.metric * (1.0 / x - 1.0 / p.range);
+}
+
+ScalarTask SphereObstacleTask(const World& world, const Eigen::Vector3d& p_W, double radius,
+                              const PointJacobian& J_p, const Eigen::Vector3d& jdq_p,
+                              const JointVector& qd) {
+  ScalarTask t;
+  Eigen::Vector3d n;
+  t.x = world.SignedDistance(p_W, &n) - radius;
+  t.J = n.transpose() * J_p;
+  const Eigen::Vector3d v = J_p * qd;
+  t.xd = n.dot(v);
+  double curvature = 0;
+  const double speed = v.norm();
+  if (speed > 0) {
+    const Eigen::Vector3d u = v / speed;
+    Eigen::Vector3d n_plus, n_minus;
+    world.SignedDistance(p_W + kCurvatureStep * u, &n_plus);
+    world.SignedDistance(p_W - kCurvatureStep * u, &n_minus);
+    curvature = speed * speed * u.dot(n_plus - n_minus) / (2 * kCurvatureStep);
+  }
+  t.jdq = n.dot(jdq_p) + curvature;
+  return t;
+}
+
+ScalarTask SpherePairTask(const Eigen::Vector3d& p_a, double r_a, const PointJacobian& J_a,
+                          const Eigen::Vector3d& jdq_a, const Eigen::Vector3d& p_b, double r_b,
+                          const PointJacobian& J_b, const Eigen::Vector3d& jdq_b,
+                          const JointVector& qd) {
+  ScalarTask t;
+  const Eigen::Vector3d diff = p_a - p_b;
+  const double dist = diff.norm();
+  t.x = dist - r_a - r_b;
+  if (dist <= 0) return t;  // coincident centres: no direction (x < 0 anyway: a collision)
+  const Eigen::Vector3d n = diff / dist;
+  const PointJacobian J_rel = J_a - J_b;
+  const Eigen::Vector3d v = J_rel * qd;
+  t.J = n.transpose() * J_rel;
+  t.xd = n.dot(v);
+  t.jdq = n.dot(jdq_a - jdq_b) + (v.squaredNorm() - t.xd * t.xd) / dist;
+  return t;
+}
+
+const char* ToString(RolloutStatus status) {
+  switch (status) {
+    case RolloutStatus::kReached:
+      return "reached";
+    case RolloutStatus::kTimeout:
+      return "timeout";
+    case RolloutStatus::kCollision:
+      return "collision";
+    case RolloutStatus::kJointLimit:
+      return "joint_limit";
+    case RolloutStatus::kNonFinite:
+      return "non_finite";
+  }
+  return "unknown";
+}
+
+Fabric::Fabric(const RobotModel& robot, const World& world, const FabricParams& params)
+    : robot_(robot), world_(world), params_(params) {
+  FS_THROW_UNLESS(params.dt > 0 && params.t_max >= params.dt,
+                  "fabric: dt must be positive and at most t_max (dt ", params.dt, ", t_max ",
+                  params.t_max, ")");
+  FS_THROW_UNLESS(params.goal_tolerance > 0, "fabric: goal_tolerance must be positive, got ",
+                  params.goal_tolerance);
+  FS_THROW_UNLESS(params.base_inertia > 0, "fabric: base_inertia must be positive, got ",
+                  params.base_inertia);
+}
+
+FabricWorkspace Fabric::MakeWorkspace() const { return FabricWorkspace{robot_.MakeData(), {}}; }
+
+bool Fabric::Acceleration(const JointVector& q, const JointVector& qd, const JointVector& command,
+                          FabricWorkspace* ws, JointVector* qdd) const {
+  const FabricParams& p = params_;
+  KinematicsData& kin = ws->kinematics;
+  ForwardKinematicsWithJacobians(robot_, q, qd, &kin);
+
+  Matrix7 M = p.base_inertia * Matrix7::Identity();
+  JointVector f = JointVector::Zero();
+  FabricProbe& probe = ws->probe;
+  probe = FabricProbe{};
+  probe.min_obstacle_clearance = std::numeric_limits<double>::infinity();
+  probe.min_self_clearance = std::numeric_limits<double>::infinity();
+
+  // Joint limits: x = q_j - lower_j (J = e_j) and x = upper_j - q_j (J = -e_j); J' q_d = 0.
+  const JointLimits& limits = robot_.limits();
+  for (int j = 0; j < kDof; ++j) {
+    const double m_lo = BarrierMetric(p.limits, q[j] - limits.lower[j], qd[j]);
+    if (m_lo > 0) {
+      const double x = q[j] - limits.lower[j];
+      M(j, j) += m_lo;
+      f[j] += m_lo * p.limits.gain * qd[j] * qd[j] / x;
+    }
+    const double m_hi = BarrierMetric(p.limits, limits.upper[j] - q[j], -qd[j]);
+    if (m_hi > 0) {
+      const double x = limits.upper[j] - q[j];
+      M(j, j) += m_hi;
+      f[j] -= m_hi * p.limits.gain * qd[j] * qd[j] / x;
+    }
+  }
+
+  // Body spheres vs the world (closest obstacle) and checked sphere pairs. The cheap distance
+  // test comes first; the pull-back only for terms within range.
+  const auto& spheres = robot_.spheres();
+  const int num_spheres = static_cast<int>(spheres.size());
+  for (int s = 0; s < num_spheres; ++s) {
+    const double x = world_.SignedDistance(kin.p_WS.col(s), nullptr) - spheres[s].radius;
+    probe.min_obstacle_clearance = std::min(probe.min_obstacle_clearance, x);
+    if (!(x < p.obstacles.range) || x <= 0) continue;
+    const ScalarTask t = SphereObstacleTask(world_, kin.p_WS.col(s), spheres[s].radius, kin.J_WS[s],
+                                            kin.Jdot_qdot_WS[s], qd);
+    probe.active_obstacle_terms += AddBarrierTerm(p.obstacles, t, &M, &f);
+  }
+  for (const auto& [a, b] : robot_.self_collision_pairs()) {
+    const double reach = spheres[a].radius + spheres[b].radius;
+    const double x = (kin.p_WS.col(a) - kin.p_WS.col(b)).norm() - reach;
+    probe.min_self_clearance = std::min(probe.min_self_clearance, x);
+    if (!(x < p.self.range) || x <= 0) continue;
+    const ScalarTask t =
+        SpherePairTask(kin.p_WS.col(a), spheres[a].radius, kin.J_WS[a], kin.Jdot_qdot_WS[a],
+                       kin.p_WS.col(b), spheres[b].radius, kin.J_WS[b], kin.Jdot_qdot_WS[b], qd);
+    probe.active_self_terms += AddBarrierTerm(p.self, t, &M, &f);
+  }
+
+  // Attractor: metric, forcing and damping towards the command.
+  const JointVector x_c = q - command;
+  const double r = x_c.norm();
+  const double m_psi = p.attractor_metric_far + (p.attractor_metric_near - p.attractor_metric_far) *
+                                                    std::exp(-(r / p.attractor_metric_width) *
+                                                             (r / p.attractor_metric_width));
+  M.diagonal().array() += m_psi;
+  JointVector grad_psi = JointVector::Zero();
+  if (r > 0) grad_psi = (p.attractor_gain * std::tanh(p.attractor_sharpness * r) / r) * x_c;
+  const double beta = p.damping + p.damping_near / (1.0 + (r / p.damping_near_radius) *
+                                                              (r / p.damping_near_radius));
+
+  probe.metric = M;
+  const Eigen::LLT<Matrix7> llt(M);
+  if (llt.info() != Eigen::Success) return false;
+  JointVector a_geometry = llt.solve(f);
+  const double speed_sq = qd.squaredNorm();
+  if (speed_sq > 1e-12) a_geometry -= qd * (qd.dot(a_geometry) / speed_sq);  // Energize, M_e = I
+  probe.energized = a_geometry;
+  const JointVector result = a_geometry - llt.solve(grad_psi) - beta * qd;
+  if (!result.allFinite()) return false;
+  *qdd = result;
+  return true;
+}
+
+RolloutResult Fabric::Rollout(const JointVector& q0, const JointVector& qd0,
+                              const JointVector& command, FabricWorkspace* ws,
+                              std::vector<JointVector>* path) const {
+  const FabricParams& p = params_;
+  const JointLimits& limits = robot_.limits();
+  const int max_steps = static_cast<int>(std::llround(p.t_max / p.dt));
+  RolloutResult result;
+  result.q = q0;
+  result.qd = qd0;
+  if (!q0.allFinite() || !qd0.allFinite() || !command.allFinite()) {
+    result.status = RolloutStatus::kNonFinite;
+    return result;
+  }
+  JointVector qdd;
+  for (int step = 0;; ++step) {
+    result.steps = step;
+    result.t = step * p.dt;
+    if (!Acceleration(result.q, result.qd, command, ws, &qdd)) {
+      result.status = RolloutStatus::kNonFinite;
+      return result;
+    }
+    if (ws->probe.min_obstacle_clearance < 0 || ws->probe.min_self_clearance < 0) {
+      result.status = RolloutStatus::kCollision;
+      return result;
+    }
+    if ((result.q - command).norm() < p.goal_tolerance) {
+      result.status = RolloutStatus::kReached;
+      return result;
+    }
+    if (step >= max_steps) {
+      result.status = RolloutStatus::kTimeout;
+      return result;
+    }
+    result.qd += p.dt * qdd;
+    result.q += p.dt * result.qd;
+    if (path) path->push_back(result.q);
+    if ((result.q.array() < limits.lower.array()).any() ||
+        (result.q.array() > limits.upper.array()).any()) {
+      result.steps = step + 1;
+      result.t = result.steps * p.dt;
+      result.status = RolloutStatus::kJointLimit;
+      return result;
+    }
+  }
+}
+
+}  // namespace foresight::manipulation

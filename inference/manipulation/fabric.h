@@ -1,0 +1,201 @@
+#pragma once
+/// A geometric fabric for the Panda (thesis ch 9, "Preliminaries: Geometric Fabrics"; Ratliff,
+/// Van Wyk et al., "Geometric Fabrics: Generalizing Classical Mechanics to Capture the Physics of
+/// Behavior", RA-L 2022). Terms, each a task map phi_i(q) with Jacobian J_i, curvature J_i' q_d,
+/// a priority metric M_i and a geometry x_dd_i = h_i(x, x_d):
+///
+///   base        x = q                       M = base_inertia I,            h = 0
+///   limits      x = q_j - lower_j, upper_j - q_j (14 scalars)
+///   obstacles   x = d_W(p_s(q)) - r_s       one per body sphere s (closest obstacle)
+///   self        x = |p_a - p_b| - r_a - r_b one per checked sphere pair
+///
+/// The three barrier families share one scalar form (homogeneous of degree 2 in x_d, repulsive
+/// only while approaching):
+///   h(x, x_d) = k x_d^2 / x,  M(x, x_d) = lambda max(0, 1/x - 1/range) [x_d < 0]
+/// (the metric falls to zero at `range`, so terms switch on continuously).
+///
+/// Fusion (thesis eq. in "Fusion"): q_dd_g = (sum J'MJ)^-1 sum J'M(h - J' q_d).
+/// Energisation with the Euclidean kinetic energy L_e = |q_d|^2 / 2 keeps the speed the geometry
+/// would change: q_dd_e = q_dd_g - q_d (q_d . q_dd_g) / |q_d|^2 (Ratliff et al.'s Energize with
+/// M_e = I; the geometry only bends paths).
+/// Forcing by a C-space attractor to the command c, potential psi(x) = k (|x| + log(1 + exp(-2 a
+/// |x|)) / a), x = q - c, so grad psi = k tanh(a |x|) x / |x| (smooth at the goal), with metric
+/// M_psi = (m_far + (m_near - m_far) exp(-(|x| / w)^2)) I, and damping beta(|x|):
+///   q_dd = q_dd_e - M^-1 grad psi - beta q_d,  M = base + sum J'MJ + M_psi.
+/// Near obstacles the barrier metrics dominate M, so the forcing towards them is suppressed and
+/// the motion slows down (the thesis's reason why GFCOP solutions keep clear of obstacles).
+///
+/// Integration (thesis eq. "integrate"): semi-implicit Euler at `dt`; rollout_t is the first time
+/// |q_t - c|_2 < goal_tolerance, capped at t_max. A rollout also stops when a sphere penetrates an
+/// obstacle or another sphere, a joint leaves its limits, or the state becomes non-finite: these
+/// are statuses, never exceptions, and NaN never propagates.
+///
+/// Model/workspace contract: a Fabric holds references to the robot and world (both must outlive
+/// it) and is immutable; each thread uses its own FabricWorkspace. Acceleration() and Rollout()
+/// do not allocate.
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "core/config.h"
+#include "inference/manipulation/joint_types.h"
+#include "inference/manipulation/robot_model.h"
+#include "inference/manipulation/world.h"
+
+namespace foresight::manipulation {
+
+/// A repulsive barrier family: h = gain x_d^2 / x, M = metric max(0, 1/x - 1/range) [x_d < 0].
+struct BarrierParams {
+  double gain = 1.0;    ///< k of the geometry (1)
+  double metric = 1.0;  ///< lambda of the metric (m or rad)
+  double range = 0.2;   ///< distance beyond which the term is off (m or rad)
+
+  template <class A>
+  void Serialize(A* a) {
+    a->Visit("gain", &gain, config::Range::NonNegative(), "geometry gain k in h = k xd^2 / x");
+    a->Visit("metric", &metric, config::Range::NonNegative(),
+             "metric scale lambda in M = lambda (1/x - 1/range) while approaching");
+    a->Visit("range", &range, config::Range::Positive(), "activation distance");
+  }
+};
+
+struct FabricParams {
+  double base_inertia = 0.2;                   ///< metric of the C-space base term
+  BarrierParams limits{1.0, 0.5, 0.3};         ///< joint-limit repulsion (rad)
+  BarrierParams obstacles{5.0, 2.0, 0.25};     ///< body sphere vs world (m)
+  BarrierParams self{5.0, 1.0, 0.08};          ///< sphere pairs (m)
+  double attractor_gain = 5.0;                 ///< k of psi (rad/s^2)
+  double attractor_sharpness = 10.0;           ///< a of psi (1/rad)
+  double attractor_metric_far = 0.3;           ///< m_far
+  double attractor_metric_near = 2.0;          ///< m_near
+  double attractor_metric_width = 1.0 / 0.75;  ///< w (rad)
+  double damping = 3.0;                        ///< beta far from the command (1/s)
+  double damping_near = 6.0;                   ///< extra beta close to the command (1/s)
+  double damping_near_radius = 0.1;            ///< |x| where the extra damping is half on (rad)
+  double dt = 0.01;                            ///< integration step (s), thesis 0.01
+  double t_max = 7.0;                          ///< time budget per command (s), thesis 7
+  double goal_tolerance = 0.05;                ///< epsilon of rollout_t (rad, 2-norm)
+
+  template <class A>
+  void Serialize(A* a) {
+    a->Visit("base_inertia", &base_inertia, config::Range::Positive(), "metric of the base term");
+    a->Visit("limits", &limits, config::Range::Any(), "joint-limit repulsion (rad)");
+    a->Visit("obstacles", &obstacles, config::Range::Any(), "body-sphere obstacle repulsion (m)");
+    a->Visit("self", &self, config::Range::Any(), "self-collision repulsion (m)");
+    a->Visit("attractor_gain", &attractor_gain, config::Range::Positive(),
+             "attractor potential gain k (rad/s^2)");
+    a->Visit("attractor_sharpness", &attractor_sharpness, config::Range::Positive(),
+             "attractor smoothing a (1/rad)");
+    a->Visit("attractor_metric_far", &attractor_metric_far, config::Range::Positive(),
+             "attractor metric far from the command");
+    a->Visit("attractor_metric_near", &attractor_metric_near, config::Range::Positive(),
+             "attractor metric at the command");
+    a->Visit("attractor_metric_width", &attractor_metric_width, config::Range::Positive(),
+             "width of the attractor metric's transition (rad)");
+    a->Visit("damping", &damping, config::Range::NonNegative(),
+             "damping far from the command (1/s)");
+    a->Visit("damping_near", &damping_near, config::Range::NonNegative(),
+             "extra damping close to the command (1/s)");
+    a->Visit("damping_near_radius", &damping_near_radius, config::Range::Positive(),
+             "distance where the extra damping is half on (rad)");
+    a->Visit("dt", &dt, config::Range::OpenClosed(0.0, 0.1), "integration step (s)");
+    a->Visit("t_max", &t_max, config::Range::OpenClosed(0.0, 600.0), "time budget per command (s)");
+    a->Visit("goal_tolerance", &goal_tolerance, config::Range::Positive(),
+             "rollout_t tolerance on |q - command| (rad)");
+  }
+};
+
+/// A scalar task variable of a barrier term and its pull-back: x, x_d = J q_d, J, and J' q_d
+/// (the curvature, so that x_dd = J q_dd + J' q_d).
+struct ScalarTask {
+  double x = 0, xd = 0;
+  Eigen::Matrix<double, 1, kDof> J = Eigen::Matrix<double, 1, kDof>::Zero();
+  double jdq = 0;
+};
+
+/// Clearance of a body sphere: x = d_W(p) - radius, J = n' J_p,
+/// J' q_d = n' (J_p' q_d) + p_d' H_d p_d (H_d, the distance Hessian, by a central difference of
+/// the exact gradient along p_d). @param p_W [3] centre (m), @param J_p [3x7] its Jacobian,
+/// @param jdq_p [3] its J' q_d, @param qd [7] joint velocities.
+ScalarTask SphereObstacleTask(const World& world, const Eigen::Vector3d& p_W, double radius,
+                              const PointJacobian& J_p, const Eigen::Vector3d& jdq_p,
+                              const JointVector& qd);
+
+/// Distance between two spheres' surfaces: x = |p_a - p_b| - r_a - r_b, n = (p_a - p_b)/|.|,
+/// J = n'(J_a - J_b), J' q_d = n'(jdq_a - jdq_b) + (|v|^2 - (n'v)^2) / |p_a - p_b|, v = (J_a -
+/// J_b) q_d.
+ScalarTask SpherePairTask(const Eigen::Vector3d& p_a, double r_a, const PointJacobian& J_a,
+                          const Eigen::Vector3d& jdq_a, const Eigen::Vector3d& p_b, double r_b,
+                          const PointJacobian& J_b, const Eigen::Vector3d& jdq_b,
+                          const JointVector& qd);
+
+/// Metric of a barrier term at (x, x_d): lambda max(0, 1/x - 1/range) while approaching, else 0.
+double BarrierMetric(const BarrierParams& p, double x, double xd);
+
+/// How a rollout towards one command ended.
+enum class RolloutStatus {
+  kReached,     ///< |q - command| < goal_tolerance before t_max
+  kTimeout,     ///< t_max elapsed; the state at t_max is returned
+  kCollision,   ///< a sphere penetrated an obstacle or another sphere
+  kJointLimit,  ///< a joint left its limits
+  kNonFinite,   ///< the acceleration became non-finite (the last finite state is returned)
+};
+const char* ToString(RolloutStatus status);
+
+struct RolloutResult {
+  RolloutStatus status = RolloutStatus::kTimeout;
+  double t = 0;                          ///< integration time used (s); t_max on timeout
+  JointVector q = JointVector::Zero();   ///< terminal configuration
+  JointVector qd = JointVector::Zero();  ///< terminal velocity
+  int steps = 0;
+  bool ok() const { return status == RolloutStatus::kReached || status == RolloutStatus::kTimeout; }
+};
+
+/// What the last Acceleration() saw: clearances for the rollout's collision checks, and the fused
+/// metric and energised geometry for tests.
+struct FabricProbe {
+  Eigen::Matrix<double, kDof, kDof> metric = Eigen::Matrix<double, kDof, kDof>::Zero();  ///< M
+  JointVector energized = JointVector::Zero();  ///< q_dd_e (before forcing and damping)
+  double min_obstacle_clearance = 0;            ///< min over spheres of d_W(p_s) - r_s (m)
+  double min_self_clearance = 0;                ///< min over checked pairs (m)
+  int active_obstacle_terms = 0;
+  int active_self_terms = 0;
+};
+
+/// Work buffers of one caller (one per thread).
+struct FabricWorkspace {
+  KinematicsData kinematics;
+  FabricProbe probe;
+};
+
+class Fabric {
+ public:
+  /// `robot` and `world` must outlive the fabric. Throws Error for invalid params.
+  Fabric(const RobotModel& robot, const World& world, const FabricParams& params);
+
+  const FabricParams& params() const { return params_; }
+  const RobotModel& robot() const { return robot_; }
+  const World& world() const { return world_; }
+  FabricWorkspace MakeWorkspace() const;
+
+  /// q_dd of the forced, energised, damped fabric at (q, q_d) towards `command`.
+  /// @param q [7] joint angles (rad), @param qd [7] joint velocities (rad/s),
+  /// @param command [7] attractor configuration (rad). Returns false (qdd untouched) when the
+  /// result is non-finite or the metric is not positive definite.
+  bool Acceleration(const JointVector& q, const JointVector& qd, const JointVector& command,
+                    FabricWorkspace* ws, JointVector* qdd) const;
+
+  /// Integrates from (q0, qd0) towards `command` until rollout_t (thesis), a collision, a limit
+  /// violation or a non-finite state. When `path` is given, every state's q is appended to it
+  /// (this allocates; leave it null in optimisation loops).
+  RolloutResult Rollout(const JointVector& q0, const JointVector& qd0, const JointVector& command,
+                        FabricWorkspace* ws, std::vector<JointVector>* path = nullptr) const;
+
+ private:
+  const RobotModel& robot_;
+  const World& world_;
+  FabricParams params_;
+};
+
+}  // namespace foresight::manipulation

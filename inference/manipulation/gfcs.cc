@@ -1,0 +1,153 @@
+#include "inference/manipulation/gfcs.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <thread>
+
+#include "core/error.h"
+#include "inference/optim/cmaes.h"
+
+namespace foresight::manipulation {
+namespace {
+
+/// Evaluates the columns of `candidates` on `workspaces.size()` threads into `out`.
+void EvaluateBatch(const Fabric& fabric, const GfcsQuery& query, const Eigen::MatrixXd& candidates,
+                   double penalty, std::vector<FabricWorkspace>* workspaces,
+                   std::vector<GfcsCandidate>* out) {
+  const int count = static_cast<int>(candidates.cols());
+  out->resize(count);
+  std::atomic<int> next{0};
+  auto work = [&](FabricWorkspace* ws) {
+    for (int i = next++; i < count; i = next++)
+      (*out)[i] = EvaluateCommandSequence(fabric, query, candidates.col(i), penalty, ws);
+  };
+  const int threads = std::min<int>(static_cast<int>(workspaces->size()), count);
+  std::vector<std::thread> pool;
+  pool.reserve(std::max(0, threads - 1));
+  for (int t = 1; t < threads; ++t) pool.emplace_back(work, &(*workspaces)[t]);
+  work(&(*workspaces)[0]);
+  for (std::thread& th : pool) th.join();
+}
+
+}  // namespace
+
+const char* ToString(GfcsStatus status) {
+  switch (status) {
+    case GfcsStatus::kSolved:
+      return "solved";
+    case GfcsStatus::kNotSolved:
+      return "not_solved";
+    case GfcsStatus::kError:
+      return "error";
+  }
+  return "unknown";
+}
+
+UniformSampler::UniformSampler(const JointVector& lower, const JointVector& upper)
+    : lower_(lower), upper_(upper) {
+  FS_THROW_UNLESS((lower.array() < upper.array()).all(),
+                  "uniform sampler: every lower joint limit must be below the upper one");
+}
+
+void UniformSampler::Sample(const GfcsQuery& /*query*/, int intermediate_commands, int count,
+                            std::mt19937_64* rng, Eigen::MatrixXd* out) {
+  out->resize(kDof * intermediate_commands, count);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (int c = 0; c < count; ++c)
+    for (int k = 0; k < intermediate_commands; ++k)
+      for (int j = 0; j < kDof; ++j)
+        (*out)(k * kDof + j, c) = lower_[j] + unit(*rng) * (upper_[j] - lower_[j]);
+}
+
+GfcsCandidate EvaluateCommandSequence(const Fabric& fabric, const GfcsQuery& query,
+                                      const Eigen::VectorXd& commands, double penalty,
+                                      FabricWorkspace* ws, std::vector<JointVector>* path) {
+  const int intermediate = static_cast<int>(commands.size() / kDof);
+  GfcsCandidate c;
+  c.commands = commands;
+  JointVector q = query.start, qd = query.start_velocity;
+  if (path) path->push_back(q);
+  for (int i = 0; i <= intermediate; ++i) {
+    const JointVector command =
+        i < intermediate ? JointVector(commands.segment<kDof>(i * kDof)) : query.goal;
+    const RolloutResult r = fabric.Rollout(q, qd, command, ws, path);
+    c.time += r.t;
+    c.last_status = r.status;
+    if (!r.ok()) {  // collision, joint limit or non-finite: infeasible, worse than any timeout
+      c.feasible = false;
+      c.cost = (intermediate + 1) * fabric.params().t_max + penalty;
+      return c;
+    }
+    q = r.q;
+    qd = r.qd;
+    if (i == intermediate) c.reached = r.status == RolloutStatus::kReached;
+  }
+  c.cost = c.time + (c.reached ? 0.0 : penalty);
+  return c;
+}
+
+GfcsSolution SolveGfcop(const Fabric& fabric, const GfcsQuery& query, CommandSampler* sampler,
+                        const GfcsParams& params) {
+  const auto started = std::chrono::steady_clock::now();
+  GfcsSolution solution;
+  const JointLimits& limits = fabric.robot().limits();
+  const int intermediate = params.commands - 1;
+  auto fail = [&](const std::string& message) {
+    solution.status = GfcsStatus::kError;
+    solution.message = message;
+    return solution;
+  };
+  if (!query.start.allFinite() || !query.start_velocity.allFinite() || !query.goal.allFinite())
+    return fail("non-finite start, start velocity or goal");
+  if (params.commands < 1 || params.batch_size < 2 || params.batches < 1 || params.top_m < 1)
+    return fail("commands, batch_size, batches and top_m must be >= 1 (batch_size >= 2)");
+
+  std::vector<FabricWorkspace> workspaces;
+  const int threads = params.threads > 0
+                          ? params.threads
+                          : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  for (int t = 0; t < threads; ++t) workspaces.push_back(fabric.MakeWorkspace());
+
+  std::vector<GfcsCandidate> all, batch;
+  std::mt19937_64 rng(static_cast<std::uint64_t>(params.seed));
+  Eigen::MatrixXd candidates;
+  if (intermediate == 0) {  // a single command: the goal itself; nothing to optimise
+    candidates.resize(0, 1);
+    EvaluateBatch(fabric, query, candidates, params.penalty, &workspaces, &batch);
+    all = batch;
+  } else {
+    sampler->Sample(query, intermediate, params.batch_size, &rng, &candidates);
+    optim::CmaEsOptions options;
+    options.population = params.batch_size;
+    options.sigma0 = params.sigma0;
+    options.seed = static_cast<std::uint64_t>(params.seed);
+    options.lower = limits.lower.replicate(intermediate, 1);
+    options.upper = limits.upper.replicate(intermediate, 1);
+    const Eigen::VectorXd mean0 = 0.5 * (options.lower + options.upper);
+    optim::CmaEs es(mean0, options);
+    es.Inject(candidates);
+    for (int b = 0; b < params.batches; ++b) {
+      const Eigen::MatrixXd& asked = es.Ask();
+      EvaluateBatch(fabric, query, asked, params.penalty, &workspaces, &batch);
+      Eigen::VectorXd costs(static_cast<Eigen::Index>(batch.size()));
+      for (std::size_t i = 0; i < batch.size(); ++i)
+        costs[static_cast<Eigen::Index>(i)] = batch[i].cost;
+      all.insert(all.end(), batch.begin(), batch.end());
+      if (b + 1 < params.batches && es.Tell(costs) != optim::CmaEsStatus::kRunning) break;
+    }
+  }
+  solution.evaluations = static_cast<int>(all.size());
+  std::sort(all.begin(), all.end(),
+            [](const GfcsCandidate& a, const GfcsCandidate& b) { return a.cost < b.cost; });
+  if (static_cast<int>(all.size()) > params.top_m)
+    all.resize(static_cast<std::size_t>(params.top_m));
+  solution.top = std::move(all);
+  solution.status = !solution.top.empty() && solution.top.front().reached ? GfcsStatus::kSolved
+                                                                          : GfcsStatus::kNotSolved;
+  solution.solve_time_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  return solution;
+}
+
+}  // namespace foresight::manipulation

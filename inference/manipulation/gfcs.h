@@ -1,0 +1,118 @@
+#pragma once
+/// Geometric Fabric Command Sequences (thesis ch 9, "Geometric Fabrics Command Optimisation"):
+/// the GFCOP cost of a command sequence and SolveGFCOP (thesis Algorithm "SolveGFCOP with
+/// warm-started CMA-ES"), with candidates rolled out in parallel.
+///
+/// A candidate y = [q_g^1; ...; q_g^n] (7n) holds the intermediate commands; the (n+1)-th command
+/// is the global goal (errata: the final command is the goal). Rollouts run in sequence, each
+/// starting from the terminal state of the previous one (thesis "intermediate continuity"):
+///   cost(y) = sum_{i=1}^{n+1} t*_i + M [t*_{n+1} >= t_max]      (thesis eq. "Cost").
+/// A rollout that collides, leaves the joint limits or becomes non-finite makes the candidate
+/// infeasible: its cost is (n+1) t_max + M, above every collision-free candidate (the thesis's
+/// cost has no collision term because its fabric never collides; ours reports when it does).
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "core/config.h"
+#include "inference/manipulation/fabric.h"
+#include "inference/manipulation/joint_types.h"
+
+namespace foresight::manipulation {
+
+struct GfcsParams {
+  int commands = 2;       ///< n + 1 (thesis: two commands per problem)
+  int batch_size = 20;    ///< candidates per batch (thesis at test time: 20)
+  int batches = 1;        ///< batches evaluated (thesis reports 1 and 5)
+  int top_m = 4;          ///< candidates returned (thesis: top-4 into the training buffer)
+  double penalty = 100;   ///< M, added when the last command times out (s)
+  double sigma0 = 0.5;    ///< CMA-ES initial step size after the first batch (rad)
+  int threads = 0;        ///< rollout threads; 0: the hardware's
+  std::int64_t seed = 0;  ///< sampler and CMA-ES seed
+
+  template <class A>
+  void Serialize(A* a) {
+    a->Visit("commands", &commands, config::Range::Closed(1, 10),
+             "commands in the sequence, the last being the goal (n + 1)");
+    a->Visit("batch_size", &batch_size, config::Range::Closed(2, 10000), "candidates per batch");
+    a->Visit("batches", &batches, config::Range::Closed(1, 1000), "batches evaluated");
+    a->Visit("top_m", &top_m, config::Range::Closed(1, 10000), "best candidates returned");
+    a->Visit("penalty", &penalty, config::Range::NonNegative(),
+             "M: cost added when the last command times out (s)");
+    a->Visit("sigma0", &sigma0, config::Range::Positive(), "CMA-ES initial step size (rad)");
+    a->Visit("threads", &threads, config::Range::Closed(0, 256), "rollout threads (0: all cores)");
+    a->Visit("seed", &seed, config::Range::Any(), "seed of the sampler and CMA-ES");
+  }
+};
+
+/// Start state and goal of one motion problem.
+struct GfcsQuery {
+  JointVector start = JointVector::Zero();
+  JointVector start_velocity = JointVector::Zero();
+  JointVector goal = JointVector::Zero();
+};
+
+/// Draws the first batch of candidates (thesis f_sampler). Uniform within the joint limits now;
+/// the learned energy-model sampler plugs in here.
+class CommandSampler {
+ public:
+  virtual ~CommandSampler() = default;
+  virtual std::string name() const = 0;
+  /// Fills `out` [7 (commands - 1) x count] with candidates for `query`.
+  virtual void Sample(const GfcsQuery& query, int intermediate_commands, int count,
+                      std::mt19937_64* rng, Eigen::MatrixXd* out) = 0;
+};
+
+class UniformSampler : public CommandSampler {
+ public:
+  UniformSampler(const JointVector& lower, const JointVector& upper);
+  std::string name() const override { return "uniform"; }
+  void Sample(const GfcsQuery& query, int intermediate_commands, int count, std::mt19937_64* rng,
+              Eigen::MatrixXd* out) override;
+
+ private:
+  JointVector lower_, upper_;
+};
+
+/// One evaluated command sequence.
+struct GfcsCandidate {
+  Eigen::VectorXd commands;  ///< y [7n]
+  double cost = 0;           ///< GFCOP cost (s)
+  double time = 0;           ///< sum of rollout times (s)
+  bool reached = false;      ///< the goal was reached (within t_max) without collision
+  bool feasible = true;      ///< no rollout collided, left the limits or became non-finite
+  RolloutStatus last_status = RolloutStatus::kTimeout;  ///< status of the last rollout run
+};
+
+/// Rolls out `commands` [7n] (then the goal) from the query's start state and prices the sequence
+/// (`penalty` = M). When `path` is given every integration state is appended, the start included.
+GfcsCandidate EvaluateCommandSequence(const Fabric& fabric, const GfcsQuery& query,
+                                      const Eigen::VectorXd& commands, double penalty,
+                                      FabricWorkspace* ws,
+                                      std::vector<JointVector>* path = nullptr);
+
+enum class GfcsStatus {
+  kSolved,     ///< the best candidate reaches the goal
+  kNotSolved,  ///< no candidate reached the goal
+  kError,      ///< bad input (see message); nothing was evaluated
+};
+const char* ToString(GfcsStatus status);
+
+struct GfcsSolution {
+  GfcsStatus status = GfcsStatus::kNotSolved;
+  std::string message;
+  std::vector<GfcsCandidate> top;  ///< best first, at most top_m
+  int evaluations = 0;
+  double solve_time_s = 0;  ///< wall time of SolveGfcop
+  bool solved() const { return status == GfcsStatus::kSolved; }
+};
+
+/// SolveGFCOP: the first batch from `sampler`, later batches from CMA-ES (which is told the first
+/// batch's costs), candidates of a batch rolled out on `params.threads` threads.
+GfcsSolution SolveGfcop(const Fabric& fabric, const GfcsQuery& query, CommandSampler* sampler,
+                        const GfcsParams& params);
+
+}  // namespace foresight::manipulation

@@ -1,0 +1,297 @@
+// The geometric fabric: each term's pull-back (x, J, J' q_d) against finite differences along a
+// trajectory, the fused metric (symmetric, positive definite), energisation (speed-preserving
+// geometry), rollouts (reach the command, never penetrate, statuses for bad states) and the
+// GFCOP cost and solver (thesis ch 9).
+
+#include "inference/manipulation/fabric.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
+#include <cmath>
+#include <random>
+
+#include "inference/manipulation/builtin_panda.h"
+#include "inference/manipulation/gfcs.h"
+#include "inference/manipulation/synthetic_problems.h"
+#include "inference/manipulation/validity.h"
+
+namespace foresight::manipulation {
+namespace {
+
+const RobotModel& Panda() {
+  static const RobotModel robot = BuiltinPanda();
+  return robot;
+}
+
+JointVector RandomConfiguration(std::mt19937_64* rng) {
+  const JointLimits& l = Panda().limits();
+  std::uniform_real_distribution<double> unit(0, 1);
+  JointVector q;
+  for (int j = 0; j < kDof; ++j)
+    q[j] = l.lower[j] + 0.1 + unit(*rng) * (l.upper[j] - l.lower[j] - 0.2);
+  return q;
+}
+
+JointVector RandomVector(std::mt19937_64* rng, double scale) {
+  std::normal_distribution<double> normal(0, scale);
+  JointVector v;
+  for (int j = 0; j < kDof; ++j) v[j] = normal(*rng);
+  return v;
+}
+
+/// One box in front of the robot and one upright cylinder beside it.
+World TwoObstacleWorld() {
+  World world;
+  Box box;
+  box.X_WB.translation() = Eigen::Vector3d(0.55, 0.0, 0.35);
+  box.X_WB.linear() = Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  box.half_size = Eigen::Vector3d(0.1, 0.25, 0.02);
+  world.AddBox("shelf", box);
+  Cylinder cyl;
+  cyl.X_WC.translation() = Eigen::Vector3d(0.3, 0.45, 0.4);
+  cyl.radius = 0.04;
+  cyl.half_height = 0.15;
+  world.AddCylinder("can", cyl);
+  return world;
+}
+
+/// x(t) of a task along q(t) = q + v t + a t^2 / 2; checks x_d = J v and x_dd = J a + J' v by
+/// central differences (the curvature J' q_d is what the fabric subtracts).
+template <class TaskAt>
+void ExpectPullBackMatchesFiniteDifferences(const TaskAt& task_at, const JointVector& q,
+                                            const JointVector& v, const JointVector& a) {
+  const double h = 1e-4;
+  const auto x = [&](double t) { return task_at(q + v * t + 0.5 * a * t * t, v + a * t).x; };
+  const ScalarTask t0 = task_at(q, v);
+  const double xd_fd = (x(h) - x(-h)) / (2 * h);
+  const double xdd_fd = (x(h) - 2 * x(0) + x(-h)) / (h * h);
+  EXPECT_NEAR(t0.xd, (t0.J * v)(0), 1e-12);
+  EXPECT_NEAR(t0.xd, xd_fd, 1e-6 * (1 + std::abs(xd_fd)));
+  EXPECT_NEAR((t0.J * a)(0) + t0.jdq, xdd_fd, 2e-4 * (1 + std::abs(xdd_fd)));
+}
+
+TEST(FabricTerms, SphereObstacleTaskMatchesFiniteDifferences) {
+  const World world = TwoObstacleWorld();
+  KinematicsData data = Panda().MakeData();
+  std::mt19937_64 rng(11);
+  int checked = 0;
+  for (int trial = 0; trial < 200 && checked < 40; ++trial) {
+    const JointVector q = RandomConfiguration(&rng);
+    const JointVector v = RandomVector(&rng, 0.8), a = RandomVector(&rng, 1.0);
+    for (int s = 0; s < Panda().num_spheres(); s += 3) {
+      const auto task_at = [&](const JointVector& qq, const JointVector& vv) {
+        ForwardKinematicsWithJacobians(Panda(), qq, vv, &data);
+        return SphereObstacleTask(world, data.p_WS.col(s), Panda().spheres()[s].radius,
+                                  data.J_WS[s], data.Jdot_qdot_WS[s], vv);
+      };
+      const ScalarTask t = task_at(q, v);
+      if (t.x <= 0.01 || t.x > 0.3) continue;  // the terms act within range, outside obstacles
+      SCOPED_TRACE(testing::Message() << "trial " << trial << " sphere " << s << " x " << t.x);
+      ExpectPullBackMatchesFiniteDifferences(task_at, q, v, a);
+      ++checked;
+    }
+  }
+  EXPECT_GE(checked, 20);
+}
+
+TEST(FabricTerms, SpherePairTaskMatchesFiniteDifferences) {
+  KinematicsData data = Panda().MakeData();
+  std::mt19937_64 rng(12);
+  const auto& pairs = Panda().self_collision_pairs();
+  ASSERT_FALSE(pairs.empty());
+  for (int trial = 0; trial < 30; ++trial) {
+    const JointVector q = RandomConfiguration(&rng);
+    const JointVector v = RandomVector(&rng, 0.8), a = RandomVector(&rng, 1.0);
+    const auto [i, j] = pairs[static_cast<std::size_t>(trial * 7919) % pairs.size()];
+    const auto task_at = [&, i = i, j = j](const JointVector& qq, const JointVector& vv) {
+      ForwardKinematicsWithJacobians(Panda(), qq, vv, &data);
+      return SpherePairTask(data.p_WS.col(i), Panda().spheres()[i].radius, data.J_WS[i],
+                            data.Jdot_qdot_WS[i], data.p_WS.col(j), Panda().spheres()[j].radius,
+                            data.J_WS[j], data.Jdot_qdot_WS[j], vv);
+    };
+    SCOPED_TRACE(testing::Message() << "pair " << i << "," << j);
+    ExpectPullBackMatchesFiniteDifferences(task_at, q, v, a);
+  }
+}
+
+TEST(FabricTerms, BarrierMetricIsOnOnlyWhileApproachingWithinRange) {
+  const BarrierParams p{1.0, 0.5, 0.2};
+  EXPECT_EQ(BarrierMetric(p, 0.1, 0.3), 0.0);     // moving away
+  EXPECT_EQ(BarrierMetric(p, 0.25, -0.3), 0.0);   // beyond range
+  EXPECT_EQ(BarrierMetric(p, -0.01, -0.3), 0.0);  // penetrating: the rollout stops instead
+  EXPECT_NEAR(BarrierMetric(p, 0.1, -0.3), 0.5 * (1 / 0.1 - 1 / 0.2), 1e-15);
+  EXPECT_NEAR(BarrierMetric(p, 0.2 - 1e-9, -0.3), 0.0, 1e-7);  // continuous at the range
+}
+
+TEST(Fabric, MetricIsSymmetricPositiveDefiniteAndGeometryKeepsTheSpeed) {
+  const World world = TwoObstacleWorld();
+  const Fabric fabric(Panda(), world, FabricParams{});
+  FabricWorkspace ws = fabric.MakeWorkspace();
+  std::mt19937_64 rng(13);
+  int active = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    const JointVector q = RandomConfiguration(&rng), qd = RandomVector(&rng, 1.0);
+    JointVector qdd;
+    if (!fabric.Acceleration(q, qd, RandomConfiguration(&rng), &ws, &qdd)) continue;
+    const auto& M = ws.probe.metric;
+    EXPECT_LT((M - M.transpose()).norm(), 1e-12 * M.norm());
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, kDof, kDof>> eig(M);
+    EXPECT_GE(eig.eigenvalues().minCoeff(), fabric.params().base_inertia * (1 - 1e-9));
+    // Energised geometry: q_d' q_dd_e = 0 (the Euclidean kinetic energy is kept).
+    EXPECT_NEAR(qd.dot(ws.probe.energized), 0.0, 1e-9 * (1 + ws.probe.energized.norm()));
+    active += ws.probe.active_obstacle_terms + ws.probe.active_self_terms;
+  }
+  EXPECT_GT(active, 0) << "no barrier term was ever active: the test did not test them";
+}
+
+TEST(Fabric, RolloutReachesTheCommandInAnEmptyWorld) {
+  const World world;
+  const Fabric fabric(Panda(), world, FabricParams{});
+  FabricWorkspace ws = fabric.MakeWorkspace();
+  JointVector start, goal;
+  start << 0, -0.785, 0, -2.356, 0, 1.571, 0.785;
+  goal << 0.8, 0.2, -0.3, -1.8, 0.4, 2.0, 0.2;
+  std::vector<JointVector> path;
+  const RolloutResult r = fabric.Rollout(start, JointVector::Zero(), goal, &ws, &path);
+  EXPECT_EQ(r.status, RolloutStatus::kReached) << ToString(r.status);
+  EXPECT_LT((r.q - goal).norm(), fabric.params().goal_tolerance);
+  EXPECT_GT(r.t, 0.1);
+  EXPECT_LT(r.t, fabric.params().t_max);
+  EXPECT_EQ(static_cast<int>(path.size()), r.steps);
+  EXPECT_NEAR(r.t, r.steps * fabric.params().dt, 1e-12);
+}
+
+TEST(Fabric, RolloutsNeverPenetrateTheObstacles) {
+  const World world = TwoObstacleWorld();
+  const Fabric fabric(Panda(), world, FabricParams{});
+  const ValidityChecker checker(Panda(), world);
+  FabricWorkspace ws = fabric.MakeWorkspace();
+  KinematicsData data = Panda().MakeData();
+  std::mt19937_64 rng(14);
+  int rollouts = 0, collisions = 0;
+  for (int trial = 0; trial < 200 && rollouts < 30; ++trial) {
+    const JointVector start = RandomConfiguration(&rng), goal = RandomConfiguration(&rng);
+    if (checker.Check(start, &data) != Validity::kValid ||
+        checker.Check(goal, &data) != Validity::kValid)
+      continue;
+    std::vector<JointVector> path;
+    const RolloutResult r = fabric.Rollout(start, JointVector::Zero(), goal, &ws, &path);
+    ++rollouts;
+    collisions += r.status == RolloutStatus::kCollision;
+    if (r.status != RolloutStatus::kCollision) {
+      for (const JointVector& q : path)
+        ASSERT_NE(checker.Check(q, &data), Validity::kWorldCollision);
+    }
+  }
+  EXPECT_EQ(rollouts, 30);
+  // Measured with the default params (seed 14): 0 of 30 (and 0 of 100 in a longer run).
+  EXPECT_LE(collisions, 1) << "the barrier terms should keep the rollouts clear";
+}
+
+TEST(Fabric, NonFiniteStatesStopWithAStatus) {
+  const World world = TwoObstacleWorld();
+  const Fabric fabric(Panda(), world, FabricParams{});
+  FabricWorkspace ws = fabric.MakeWorkspace();
+  JointVector q = JointVector::Zero();
+  q[3] = -1.5;
+  JointVector bad = q;
+  bad[2] = std::nan("");
+  EXPECT_EQ(fabric.Rollout(bad, JointVector::Zero(), q, &ws).status, RolloutStatus::kNonFinite);
+  EXPECT_EQ(fabric.Rollout(q, JointVector::Constant(INFINITY), q, &ws).status,
+            RolloutStatus::kNonFinite);
+  EXPECT_EQ(fabric.Rollout(q, JointVector::Zero(), bad, &ws).status, RolloutStatus::kNonFinite);
+  JointVector qdd = JointVector::Constant(7);
+  EXPECT_FALSE(fabric.Acceleration(bad, JointVector::Zero(), q, &ws, &qdd));
+  EXPECT_EQ(qdd, JointVector::Constant(7));  // untouched
+}
+
+TEST(Fabric, RejectsInvalidParams) {
+  const World world;
+  FabricParams p;
+  p.dt = 0;
+  EXPECT_THROW(Fabric(Panda(), world, p), Error);
+  p = FabricParams{};
+  p.t_max = 0.001;
+  EXPECT_THROW(Fabric(Panda(), world, p), Error);
+}
+
+/// A synthetic problem of the generator with the built-in Panda.
+ManipulationProblem SyntheticProblem(std::uint64_t seed) {
+  const auto is_valid = [](const World& world, const JointVector& q) {
+    const ValidityChecker checker(Panda(), world);
+    KinematicsData data = Panda().MakeData();
+    return checker.Check(q, &data) == Validity::kValid;
+  };
+  return MakeSyntheticProblem(SyntheticSceneConfig{}, StartGoalConfig{}, Panda().limits().lower,
+                              Panda().limits().upper, is_valid, seed);
+}
+
+TEST(Gfcs, CostIsTheSumOfRolloutTimesPlusThePenaltyOnTimeout) {
+  const ManipulationProblem problem = SyntheticProblem(3);
+  const Fabric fabric(Panda(), problem.world, FabricParams{});
+  FabricWorkspace ws = fabric.MakeWorkspace();
+  GfcsQuery query;
+  query.start = problem.start;
+  query.goal = problem.goal;
+  const JointVector mid = 0.5 * (problem.start + problem.goal);
+  const GfcsCandidate c = EvaluateCommandSequence(fabric, query, mid, 100.0, &ws);
+  // The same two rollouts by hand.
+  const RolloutResult r1 = fabric.Rollout(problem.start, JointVector::Zero(), mid, &ws);
+  ASSERT_TRUE(r1.ok());
+  const RolloutResult r2 = fabric.Rollout(r1.q, r1.qd, problem.goal, &ws);
+  EXPECT_NEAR(c.time, r1.t + r2.t, 1e-12);
+  if (r2.ok()) {
+    EXPECT_EQ(c.reached, r2.status == RolloutStatus::kReached);
+    EXPECT_NEAR(c.cost, r1.t + r2.t + (c.reached ? 0.0 : 100.0), 1e-12);
+  }
+  // A budget too short to arrive: the penalty applies.
+  FabricParams tight;
+  tight.t_max = 0.05;
+  const Fabric hurried(Panda(), problem.world, tight);
+  FabricWorkspace ws2 = hurried.MakeWorkspace();
+  const GfcsCandidate late = EvaluateCommandSequence(hurried, query, mid, 100.0, &ws2);
+  EXPECT_FALSE(late.reached);
+  EXPECT_NEAR(late.cost, late.time + 100.0, 1e-12);
+}
+
+TEST(Gfcs, SolveIsDeterministicSortedAndBeatsOrMatchesItsFirstBatch) {
+  const ManipulationProblem problem = SyntheticProblem(5);
+  const Fabric fabric(Panda(), problem.world, FabricParams{});
+  GfcsQuery query;
+  query.start = problem.start;
+  query.goal = problem.goal;
+  GfcsParams params;
+  params.batch_size = 8;
+  params.batches = 2;
+  params.threads = 2;
+  params.seed = 4;
+  UniformSampler sampler(Panda().limits().lower, Panda().limits().upper);
+  const GfcsSolution a = SolveGfcop(fabric, query, &sampler, params);
+  const GfcsSolution b = SolveGfcop(fabric, query, &sampler, params);
+  ASSERT_NE(a.status, GfcsStatus::kError) << a.message;
+  EXPECT_EQ(a.evaluations, 16);
+  ASSERT_EQ(a.top.size(), b.top.size());
+  for (std::size_t i = 0; i < a.top.size(); ++i) {
+    EXPECT_EQ(a.top[i].commands, b.top[i].commands);
+    EXPECT_EQ(a.top[i].cost, b.top[i].cost);
+    if (i) {
+      EXPECT_LE(a.top[i - 1].cost, a.top[i].cost);
+    }
+  }
+  EXPECT_EQ(a.solved(), !a.top.empty() && a.top.front().reached);
+}
+
+TEST(Gfcs, BadQueriesAreStatusesNotExceptions) {
+  const World world;
+  const Fabric fabric(Panda(), world, FabricParams{});
+  UniformSampler sampler(Panda().limits().lower, Panda().limits().upper);
+  GfcsQuery query;
+  query.goal[0] = std::nan("");
+  const GfcsSolution s = SolveGfcop(fabric, query, &sampler, GfcsParams{});
+  EXPECT_EQ(s.status, GfcsStatus::kError);
+  EXPECT_NE(s.message.find("non-finite"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace foresight::manipulation

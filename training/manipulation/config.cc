@@ -1,0 +1,38 @@
+#include "training/manipulation/config.h"
+
+#include <set>
+
+#include "core/error.h"
+
+namespace foresight {
+
+std::vector<PlanMethodConfig> DefaultPlanMethods() {
+  return {{"GF", PlanMethodKind::kFabric, 1, 1.2},
+          {"Bi-EST", PlanMethodKind::kBiEst, 1, 60},
+          {"BIT* (1.2s)", PlanMethodKind::kBitStar, 1, 1.2},
+          {"BIT* (6s)", PlanMethodKind::kBitStar, 1, 6},
+          {"RRT-Connect", PlanMethodKind::kRrtConnect, 1, 60},
+          {"GFCS (1 batch)", PlanMethodKind::kGfcs, 1, 1.2},
+          {"GFCS (5 batches)", PlanMethodKind::kGfcs, 5, 1.2}};
+}
+
+void ManipulationExperimentConfig::Validate(const std::string& path) const {
+  FS_THROW_UNLESS(model == "manipulation", path, ": model: '", model, "', expected 'manipulation'");
+  FS_THROW_UNLESS(!methods.empty(), path, ": methods: empty list");
+  std::set<std::string> names;
+  for (const PlanMethodConfig& m : methods) {
+    FS_THROW_UNLESS(!m.name.empty(), path, ": methods: a method has an empty name");
+    FS_THROW_UNLESS(names.insert(m.name).second, path, ": methods: '", m.name, "' listed twice");
+  }
+  FS_THROW_UNLESS(problems.first <= problems.last, path, ": problems: first (", problems.first,
+                  ") is after last (", problems.last, ")");
+  FS_THROW_UNLESS(problems.source != ProblemSource::kMotionBenchMaker || !problems.family.empty(),
+                  path, ": problems.family: empty");
+  if (problems.source == ProblemSource::kSynthetic)
+    problems.scene.Validate(path + ": problems.scene");
+  FS_THROW_UNLESS(!robot.empty(), path, ": robot: empty (a folder or 'builtin')");
+  FS_THROW_UNLESS(fabric.t_max >= fabric.dt, path, ": fabric.t_max (", fabric.t_max,
+                  ") is below fabric.dt (", fabric.dt, ")");
+}
+
+}  // namespace foresight

@@ -1,0 +1,136 @@
+#pragma once
+/// The config of a manipulation experiment (thesis ch 9): which problems, which methods, the
+/// fabric, GFCS and planner parameters. Run by `foresight plan CONFIG` (experiments/manipulation).
+/// Torch-free.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/config.h"
+#include "inference/manipulation/fabric.h"
+#include "inference/manipulation/gfcs.h"
+#include "inference/manipulation/synthetic_problems.h"
+
+namespace foresight {
+
+/// Where the problems come from.
+enum class ProblemSource { kMotionBenchMaker, kSynthetic };
+
+struct ManipulationProblemsConfig {
+  ProblemSource source = ProblemSource::kMotionBenchMaker;
+  /// Data root (empty: $FORESIGHT_DATA, else ../shared/data; datasets/data_root.h).
+  std::string root;
+  std::string family = "table_under_pick_panda";  ///< MotionBenchMaker family (mbm)
+  int first = 51, last = 75;  ///< problem numbers, inclusive (thesis: 1-50 develop, 51-75 report)
+  std::int64_t synthetic_seed = 0;           ///< synthetic scenes: seed of problem i is seed + i
+  int synthetic_count = 4;                   ///< synthetic scenes generated
+  manipulation::SyntheticSceneConfig scene;  ///< synthetic scenes
+  manipulation::StartGoalConfig start_goal;  ///< synthetic start and goal draws
+
+  template <class A>
+  void Serialize(A* a) {
+    a->VisitEnum("source", &source,
+                 config::EnumNames<ProblemSource>{{ProblemSource::kMotionBenchMaker, "mbm"},
+                                                  {ProblemSource::kSynthetic, "synthetic"}},
+                 "mbm: MotionBenchMaker problems under root; synthetic: generated scenes");
+    a->Visit("root", &root, config::Range::Any(),
+             "data root (empty: $FORESIGHT_DATA, else ../shared/data)");
+    a->Visit("family", &family, config::Range::Any(), "MotionBenchMaker family, e.g. box_panda");
+    a->Visit("first", &first, config::Range::Closed(1, 100000), "first problem number");
+    a->Visit("last", &last, config::Range::Closed(1, 100000), "last problem number (inclusive)");
+    a->Visit("synthetic_seed", &synthetic_seed, config::Range::Any(), "seed of synthetic scenes");
+    a->Visit("synthetic_count", &synthetic_count, config::Range::Closed(1, 100000),
+             "synthetic scenes generated");
+    a->Visit("scene", &scene, config::Range::Any(), "synthetic scenes: what they hold");
+    a->Visit("start_goal", &start_goal, config::Range::Any(), "synthetic start and goal draws");
+  }
+};
+
+/// What kind of method a row of the comparison is.
+enum class PlanMethodKind { kGfcs, kFabric, kBiEst, kBitStar, kRrtConnect };
+
+/// One row of the comparison table.
+struct PlanMethodConfig {
+  std::string name = "GFCS (1 batch)";  ///< label in summary.json and the table
+  PlanMethodKind kind = PlanMethodKind::kGfcs;
+  int batches = 1;           ///< gfcs: batches evaluated
+  double time_budget = 1.2;  ///< planners: seconds
+
+  template <class A>
+  void Serialize(A* a) {
+    a->Visit("name", &name, config::Range::Any(), "label of the method in the outputs");
+    a->VisitEnum("kind", &kind,
+                 config::EnumNames<PlanMethodKind>{{PlanMethodKind::kGfcs, "gfcs"},
+                                                   {PlanMethodKind::kFabric, "gf"},
+                                                   {PlanMethodKind::kBiEst, "biest"},
+                                                   {PlanMethodKind::kBitStar, "bitstar"},
+                                                   {PlanMethodKind::kRrtConnect, "rrtconnect"}},
+                 "gfcs | gf (one attractor to the goal) | biest | bitstar | rrtconnect");
+    a->Visit("batches", &batches, config::Range::Closed(1, 1000), "gfcs: batches evaluated");
+    a->Visit("time_budget", &time_budget, config::Range::OpenClosed(0, 3600),
+             "planners: time budget (s)");
+  }
+};
+
+/// Obstacles added on the solved path after solving (thesis "reactivity").
+struct ReactivityConfig {
+  bool enabled = false;
+  int obstacles = 1;     ///< added per problem
+  double radius = 0.05;  ///< m, cylinders' radius (and half height)
+  int attempts = 50;     ///< samples tried per obstacle before giving up on the problem
+
+  template <class A>
+  void Serialize(A* a) {
+    a->Visit("enabled", &enabled, config::Range::Any(),
+             "re-run GFCS's commands with new obstacles");
+    a->Visit("obstacles", &obstacles, config::Range::Closed(1, 20), "obstacles added per problem");
+    a->Visit("radius", &radius, config::Range::Closed(0.005, 0.5), "obstacle radius (m)");
+    a->Visit("attempts", &attempts, config::Range::Closed(1, 100000),
+             "placements tried per obstacle");
+  }
+};
+
+/// The thesis's comparison (Table "Evaluated metrics"): GF, Bi-EST, BIT* (1.2 s, 6 s), GFCS (1
+/// and 5 batches), plus RRT-Connect (VAMP's published reference on these problems).
+std::vector<PlanMethodConfig> DefaultPlanMethods();
+
+struct ManipulationExperimentConfig {
+  std::string model = "manipulation";
+  std::int64_t seed = 0;
+  /// Robot folder with panda.urdf, spheres_vamp.csv, panda.srdf, relative to the data root;
+  /// "builtin": the built-in Panda (no data needed).
+  std::string robot = "franka_panda";
+  ManipulationProblemsConfig problems;
+  std::vector<PlanMethodConfig> methods = DefaultPlanMethods();
+  manipulation::FabricParams fabric;
+  manipulation::GfcsParams gfcs;
+  double resolution = 0.05;      ///< rad, C-space step of the path validity checks (every method)
+  double max_joint_speed = 1.0;  ///< rad/s, timing of planner paths (metrics)
+  ReactivityConfig reactivity;
+  int plot_problems = 3;  ///< problems drawn in ee_paths.png
+
+  template <class A>
+  void Serialize(A* a) {
+    a->Visit("model", &model, config::Range::Any(), "experiment type (manipulation)");
+    a->Visit("seed", &seed, config::Range::Any(), "seed of the methods (problem i uses seed + i)");
+    a->Visit("robot", &robot, config::Range::Any(),
+             "robot folder under the data root (panda.urdf, spheres_vamp.csv, panda.srdf), or "
+             "builtin");
+    a->Visit("problems", &problems, config::Range::Any(), "motion problems");
+    a->Visit("methods", &methods, config::Range::Any(), "methods compared");
+    a->Visit("fabric", &fabric, config::Range::Any(), "geometric fabric");
+    a->Visit("gfcs", &gfcs, config::Range::Any(), "geometric fabric command sequences");
+    a->Visit("resolution", &resolution, config::Range::Closed(1e-4, 1.0),
+             "C-space step of path validity checks (rad)");
+    a->Visit("max_joint_speed", &max_joint_speed, config::Range::Positive(),
+             "joint speed used to time planner paths (rad/s)");
+    a->Visit("reactivity", &reactivity, config::Range::Any(), "obstacles added on solved paths");
+    a->Visit("plot_problems", &plot_problems, config::Range::Closed(0, 100),
+             "problems drawn in ee_paths.png");
+  }
+  /// Cross-field checks; errors name `path` and the key.
+  void Validate(const std::string& path) const;
+};
+
+}  // namespace foresight
