@@ -393,10 +393,16 @@ std::string ReferenceTable() {
   value.Serialize(&c);
   std::ostringstream os;
   os << "| key | type | default | allowed | description |\n|---|---|---|---|---|\n";
+  // A '|' inside a cell (enum choices "a | b") is escaped so the Markdown table keeps its columns.
+  const auto cell = [](std::string text) {
+    for (std::size_t at = text.find('|'); at != std::string::npos; at = text.find('|', at + 2))
+      text.replace(at, 1, "\\|");
+    return text;
+  };
   for (const auto& r : rows)
     os << "| `" << r.path << "` | " << r.type << " | "
-       << (r.default_value.empty() ? "" : "`" + r.default_value + "`") << " | " << r.allowed
-       << " | " << r.doc << " |\n";
+       << (r.default_value.empty() ? "" : "`" + r.default_value + "`") << " | " << cell(r.allowed)
+       << " | " << cell(r.doc) << " |\n";
   return os.str();
 }
 

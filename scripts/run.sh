@@ -4,7 +4,9 @@
 #    the SPAN predictor on simulated crowd tracks, build the map, navigate sim1 with SPAN and the
 #    reactive and CL-RRT* baselines, write summary.json, paths.png and a video;
 # 2. the SPAN predictor quickstart on synthetic tracks (train, export, engine eval and bench);
-# 3. Fast-BHM occupancy maps of a simulated floor plan, fused between two robots.
+# 3. Fast-BHM occupancy maps of a simulated floor plan, fused between two robots;
+# 4. the manipulation quickstart (`foresight plan default` = configs/manipulation/synthetic.yaml):
+#    GFCS, the geometric fabric and RRT-Connect on generated scenes with the built-in Panda.
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/setup.sh"
 install_missing
@@ -22,3 +24,7 @@ rm -rf runs/navigate_quickstart
 # Occupancy maps on the simulated two-robot floor plan: Fast-BHMs, fused once and repeatedly.
 rm -rf runs/occupancy_synthetic_fusion
 ./build/bin/foresight train configs/occupancy/synthetic_fusion.yaml --run-dir runs/occupancy_synthetic_fusion
+# Manipulation (thesis ch 9): GFCS, the single-attractor fabric and RRT-Connect on synthetic scenes.
+rm -rf runs/plan_quickstart
+./build/bin/foresight plan default --run-dir runs/plan_quickstart
+./build/bin/foresight bench fabric

@@ -92,6 +92,27 @@ expect_error "'navigation' has no export step" export "$NAV"
 expect_error "'navigation' has no eval step" eval "$NAV"
 expect_error "robot_goal" navigate configs/navigation/sim2.yaml "methods=[reactive]" "scenario.robot_goal=[30, 0]" --run-dir "$TMP/nav3"
 expect_error "'max_time'" navigate configs/navigation/sim2.yaml max_time=3e8 --run-dir "$TMP/nav6"
+# Manipulation (torch-free): the synthetic quickstart with the built-in Panda, and bad input.
+PLAN="$TMP/plan"
+"$BIN" plan default problems.synthetic_count=1 --run-dir "$PLAN" >/dev/null 2>"$TMP/plan.log" || { cat "$TMP/plan.log"; fail "plan"; }
+for f in summary.json problems.csv ee_paths.png config.yaml log.txt; do
+  [ -s "$PLAN/$f" ] || fail "plan output lacks $f"
+done
+check_json "$PLAN/summary.json"
+for k in '"GFCS (1 batch)"' '"GF"' '"RRT-Connect"' success_rate ee_length cspace_length time_s ee_ldj cspace_ldj; do
+  grep -q "$k" "$PLAN/summary.json" || fail "plan summary.json lacks $k"
+done
+[ "$(wc -l < "$PLAN/problems.csv")" -eq 4 ] || fail "plan problems.csv: expected a header and 3 rows"
+expect_error "already holds a run (summary.json)" plan default --run-dir "$PLAN"
+expect_error "'manipulation' has no export step" export "$PLAN"
+expect_error "--problems: '9-3'" plan default --problems 9-3 --run-dir "$TMP/plan2"
+expect_error "problems.source" plan default problems.source=lidar --run-dir "$TMP/plan3"
+expect_error "teleport" plan default "methods=[{name: x, kind: teleport}]" --run-dir "$TMP/plan4"
+expect_error "methods: 'GF' listed twice" plan default "methods=[{name: GF, kind: gf}, {name: GF, kind: gfcs}]" \
+  --run-dir "$TMP/plan5"
+expect_error "missing MBM problems directory" plan configs/manipulation/box.yaml problems.family=no_such_family robot=builtin \
+  problems.root="$TMP" --run-dir "$TMP/plan6"
+"$BIN" bench fabric --repeats 1 --json | grep -q '"fabric_step_us"' || fail "bench fabric --json"
 printf 'model: occupancy.fast_bhm\nseed: 1\nseed: 2\n' > "$TMP/twice.yaml"
 expect_error "key 'seed' is repeated" train "$TMP/twice.yaml" --run-dir "$TMP/r_twice"
 printf '# empty\n' > "$TMP/empty.yaml"

@@ -62,10 +62,10 @@ struct BarrierParams {
 
 struct FabricParams {
   double base_inertia = 0.2;                   ///< metric of the C-space base term
-  BarrierParams limits{1.0, 0.5, 0.3};         ///< joint-limit repulsion (rad)
-  BarrierParams obstacles{5.0, 2.0, 0.25};     ///< body sphere vs world (m)
-  BarrierParams self{5.0, 1.0, 0.08};          ///< sphere pairs (m)
-  double attractor_gain = 5.0;                 ///< k of psi (rad/s^2)
+  BarrierParams limits{1.0, 0.5, 0.1};         ///< joint-limit repulsion (rad)
+  BarrierParams obstacles{5.0, 2.0, 0.05};     ///< body sphere vs world (m)
+  BarrierParams self{1.0, 0.5, 0.03};          ///< sphere pairs (m)
+  double attractor_gain = 10.0;                ///< k of psi (rad/s^2)
   double attractor_sharpness = 10.0;           ///< a of psi (1/rad)
   double attractor_metric_far = 0.3;           ///< m_far
   double attractor_metric_near = 2.0;          ///< m_near

@@ -138,8 +138,8 @@ GfcsSolution SolveGfcop(const Fabric& fabric, const GfcsQuery& query, CommandSam
     }
   }
   solution.evaluations = static_cast<int>(all.size());
-  std::sort(all.begin(), all.end(),
-            [](const GfcsCandidate& a, const GfcsCandidate& b) { return a.cost < b.cost; });
+  std::stable_sort(all.begin(), all.end(),
+                   [](const GfcsCandidate& a, const GfcsCandidate& b) { return a.cost < b.cost; });
   if (static_cast<int>(all.size()) > params.top_m)
     all.resize(static_cast<std::size_t>(params.top_m));
   solution.top = std::move(all);

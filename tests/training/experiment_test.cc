@@ -115,6 +115,7 @@ const std::map<std::string, std::string>& TinyConfigs() {
        "train: {epochs: 2, batch_size: 128, progress: none}\neval: {folds: 2, max_folds: 1, plots: "
        "false}\n"},
       {"navigation", "model: navigation\n"},
+      {"manipulation", "model: manipulation\nrobot: builtin\nproblems: {source: synthetic}\n"},
   };
   return configs;
 }
@@ -135,7 +136,8 @@ TEST(Experiment, EveryBuiltinKindRunsThroughTrainExportAndEval) {
     EXPECT_FALSE(kind.summary.empty());
     ASSERT_TRUE(kind.reference) << "every kind documents its config";
     if (!kind.train) {
-      // A kind without steps says so in one line for each (navigation is run by `navigate`).
+      // A kind without steps says so in one line for each (navigation is run by `navigate`,
+      // manipulation by `plan`).
       EXPECT_FALSE(kind.export_run || kind.evaluate);
       testing::ExpectErrorContains([&] { kind.NoSuchStep("train"); },
                                    {"'" + kind.tag + "' has no train step"});

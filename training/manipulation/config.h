@@ -66,7 +66,7 @@ struct PlanMethodConfig {
                                                    {PlanMethodKind::kBiEst, "biest"},
                                                    {PlanMethodKind::kBitStar, "bitstar"},
                                                    {PlanMethodKind::kRrtConnect, "rrtconnect"}},
-                 "gfcs | gf (one attractor to the goal) | biest | bitstar | rrtconnect");
+                 "gfcs, gf (one attractor to the goal), biest, bitstar or rrtconnect");
     a->Visit("batches", &batches, config::Range::Closed(1, 1000), "gfcs: batches evaluated");
     a->Visit("time_budget", &time_budget, config::Range::OpenClosed(0, 3600),
              "planners: time budget (s)");
