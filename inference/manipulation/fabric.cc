@@ -134,7 +134,14 @@ bool Fabric::Acceleration(const JointVector& q, const JointVector& qd, const Joi
   // test comes first; the pull-back only for terms within range.
   const auto& spheres = robot_.spheres();
   const int num_spheres = static_cast<int>(spheres.size());
+  // A sphere whose centre is farther than range + radius from the box around every obstacle
+  // can neither collide nor have an active term: its exact distance is not needed.
+  const Eigen::AlignedBox3d& bounds = world_.bounds();
+  const bool any_obstacle = world_.num_obstacles() > 0;
   for (int s = 0; s < num_spheres; ++s) {
+    if (!any_obstacle) break;
+    const double cutoff = p.obstacles.range + spheres[s].radius;
+    if (bounds.exteriorDistance(Eigen::Vector3d(kin.p_WS.col(s))) > cutoff) continue;
     const double x = world_.SignedDistance(kin.p_WS.col(s), nullptr) - spheres[s].radius;
     probe.min_obstacle_clearance = std::min(probe.min_obstacle_clearance, x);
     if (!(x < p.obstacles.range) || x <= 0) continue;

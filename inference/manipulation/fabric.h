@@ -157,8 +157,10 @@ struct RolloutResult {
 struct FabricProbe {
   Eigen::Matrix<double, kDof, kDof> metric = Eigen::Matrix<double, kDof, kDof>::Zero();  ///< M
   JointVector energized = JointVector::Zero();  ///< q_dd_e (before forcing and damping)
-  double min_obstacle_clearance = 0;            ///< min over spheres of d_W(p_s) - r_s (m)
-  double min_self_clearance = 0;                ///< min over checked pairs (m)
+  /// min over spheres of d_W(p_s) - r_s (m); spheres farther than obstacles.range from the box
+  /// around all obstacles are left out (+inf when all are)
+  double min_obstacle_clearance = 0;
+  double min_self_clearance = 0;  ///< min over checked pairs (m)
   int active_obstacle_terms = 0;
   int active_self_terms = 0;
 };
