@@ -2,7 +2,7 @@
 // one thread (except the GFCS solve, which uses the config's threads): forward kinematics of every
 // collision sphere (positions; with Jacobians and J' q_d), one fabric step, a full rollout to the
 // goal, and a GFCS solve (one batch, uniform sampler). Medians of repeated runs over the config's
-// problems. KDL side by side: the bench_kinematics benchmark (experiments/manipulation).
+// problems. KDL side by side: the bench_kinematics benchmark (experiments/).
 
 #include <algorithm>
 #include <chrono>
@@ -14,10 +14,10 @@
 #include "apps/commands.h"
 #include "core/error.h"
 #include "embedded_manipulation_config.h"
-#include "experiments/manipulation/plan.h"
 #include "inference/manipulation/fabric.h"
 #include "inference/manipulation/gfcs.h"
 #include "inference/manipulation/validity.h"
+#include "training/manipulation/plan.h"
 
 namespace foresight::app {
 namespace {

@@ -8,8 +8,8 @@
 #include "apps/commands.h"
 #include "core/error.h"
 #include "embedded_manipulation_config.h"
-#include "experiments/manipulation/plan.h"
 #include "training/manipulation/config.h"
+#include "training/manipulation/plan.h"
 #include "training/run_dir.h"
 
 namespace foresight::app {

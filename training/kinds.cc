@@ -18,6 +18,7 @@ ExperimentRegistry BuiltinKinds() {
   r.Add(NavigationKind());
   r.Add(ManipulationKind());
 #ifdef FORESIGHT_WITH_TORCH
+  r.Add(GfcsKind());
   r.SetDefault("span_predictor");
 #endif
   return r;

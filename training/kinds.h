@@ -21,6 +21,7 @@ ExperimentKind ManipulationKind();
 #ifdef FORESIGHT_WITH_TORCH
 ExperimentKind SpanKind(const std::string& embedded_default);
 ExperimentKind DirectionalKind();
+ExperimentKind GfcsKind();
 #endif
 
 /// The config of a train request: the file, or `embedded_default` (named `default_name` in

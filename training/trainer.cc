@@ -18,6 +18,7 @@
 #include "core/file_io.h"
 #include "core/log.h"
 #include "core/parse.h"
+#include "training/distributed.h"
 #include "training/progress.h"
 
 namespace foresight {
@@ -189,12 +190,19 @@ void SaveCheckpoint(const std::string& path, torch::nn::Module& module,
   }
 }
 
-torch::serialize::InputArchive OpenCheckpoint(const std::string& path) {
+/// The archive bytes of the checkpoint file `path` (checksum verified).
+std::string ReadCheckpointBytes(const std::string& path) {
   FS_THROW_UNLESS(fs::exists(path), path, ": checkpoint not found");
   std::ifstream in(path, std::ios::binary);
   std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   FS_THROW_UNLESS(in.good() || in.eof(), path, ": cannot read the checkpoint");
-  std::istringstream archive_bytes(WithoutChecksum(path, bytes));
+  return WithoutChecksum(path, bytes);
+}
+
+/// The archive of checkpoint bytes read from `path`.
+torch::serialize::InputArchive OpenCheckpointBytes(const std::string& path,
+                                                   const std::string& bytes) {
+  std::istringstream archive_bytes(bytes);
   torch::serialize::InputArchive archive;
   try {
     archive.load_from(archive_bytes);
@@ -202,6 +210,10 @@ torch::serialize::InputArchive OpenCheckpoint(const std::string& path) {
     Fail(path, ": corrupt or truncated checkpoint (", Brief(e), ")");
   }
   return archive;
+}
+
+torch::serialize::InputArchive OpenCheckpoint(const std::string& path) {
+  return OpenCheckpointBytes(path, ReadCheckpointBytes(path));
 }
 
 void ReadModel(const std::string& path, torch::serialize::InputArchive& archive,
@@ -227,9 +239,10 @@ torch::Tensor ReadStateScalar(const std::string& path, torch::serialize::InputAr
   return t;
 }
 
-State LoadCheckpoint(const std::string& path, torch::nn::Module* module,
-                     torch::optim::Optimizer* opt) {
-  auto archive = OpenCheckpoint(path);
+/// Loads checkpoint bytes read from `path` into the module, the optimiser and the trainer state.
+State LoadCheckpointBytes(const std::string& path, const std::string& bytes,
+                          torch::nn::Module* module, torch::optim::Optimizer* opt) {
+  auto archive = OpenCheckpointBytes(path, bytes);
   ReadModel(path, archive, module);
   State s;
   try {
@@ -249,6 +262,51 @@ State LoadCheckpoint(const std::string& path, torch::nn::Module* module,
     Fail(path, ": checkpoint is missing trainer state (", Brief(e), ")");
   }
   return s;
+}
+
+State LoadCheckpoint(const std::string& path, torch::nn::Module* module,
+                     torch::optim::Optimizer* opt) {
+  return LoadCheckpointBytes(path, ReadCheckpointBytes(path), module, opt);
+}
+
+/// Data parallel: rank 0 reads the checkpoint and sends its bytes to every rank (the other ranks
+/// need no access to rank 0's disk); a failure on rank 0 is the same Error on every rank.
+State LoadCheckpointEverywhere(dist::Group* group, const std::string& path,
+                               torch::nn::Module* module, torch::optim::Optimizer* opt) {
+  std::string message;
+  if (group->rank() == 0) {
+    try {
+      message = "+" + ReadCheckpointBytes(path);
+    } catch (const Error& e) {
+      message = std::string("-") + e.what();
+    }
+  }
+  message = group->BroadcastBytes(message, 0);
+  FS_THROW_UNLESS(!message.empty() && message[0] == '+', "rank 0: ", message.substr(1));
+  return LoadCheckpointBytes(path, message.substr(1), module, opt);
+}
+
+/// Data parallel: every rank must train the same thing; a difference is an Error naming the rank.
+void CheckRanksAgree(dist::Group* group, TrainingTask* task, const TrainConfig& c,
+                     std::uint64_t seed, bool resume) {
+  std::int64_t numel = 0;
+  for (const auto& p : task->module().parameters()) numel += p.numel();
+  std::ostringstream mine;
+  mine << "num_train=" << task->num_train() << " parameters=" << numel
+       << " batch_size=" << c.batch_size << " epochs=" << c.epochs << " seed=" << seed
+       << " resume=" << resume;
+  const auto all = group->AllGatherBytes(mine.str());
+  for (std::size_t r = 1; r < all.size(); ++r)
+    FS_THROW_UNLESS(all[r] == all[0], "data-parallel ranks disagree: rank 0 has ", all[0],
+                    ", rank ", r, " has ", all[r]);
+}
+
+/// Rank 0's `value` on every rank.
+double FromRankZero(dist::Group* group, double value) {
+  if (!group->distributed()) return value;
+  std::vector<torch::Tensor> t{torch::tensor({value}, torch::kFloat64)};
+  group->Broadcast(t, 0);
+  return t[0].item<double>();
 }
 
 /// Keeps the metrics rows of epochs 1..epoch (a resumed run rewrites later ones). A missing file
@@ -296,26 +354,46 @@ void LoadCheckpointModel(const std::string& path, torch::nn::Module* module) {
 }
 
 TrainingSummary Train(TrainingTask* task, const TrainConfig& c, const RunPaths& run,
-                      std::uint64_t seed, bool resume, const TrainHooks& hooks) {
+                      std::uint64_t seed, bool resume, const TrainHooks& hooks,
+                      dist::Group* group) {
+  std::shared_ptr<dist::Group> default_group;
+  if (group == nullptr) {
+    default_group = dist::DefaultGroup();
+    group = default_group.get();
+  }
+  // Data parallel (docs/distributed.md): every rank runs this loop in lockstep on the same
+  // shuffled global batches; rank 0 alone writes files and computes the validation loss.
+  const bool distributed = group->distributed();
+  const bool writer = group->rank() == 0;
   torch::set_num_threads(c.threads);
-  fs::create_directories(run.dir + "/checkpoints");
+  if (writer) fs::create_directories(run.dir + "/checkpoints");
   torch::nn::Module& module = task->module();
   torch::optim::Adam opt(module.parameters(),
                          torch::optim::AdamOptions(c.learning_rate).weight_decay(c.weight_decay));
+  if (distributed) CheckRanksAgree(group, task, c, seed, resume);
   State state;
   if (resume) {
-    state = LoadCheckpoint(run.Checkpoint(), &module, &opt);
-    TruncateMetrics(run.Metrics(), state.epoch);
-    log::Info("resuming ", run.Checkpoint(), " after epoch ", state.epoch);
-  } else {
+    state = distributed ? LoadCheckpointEverywhere(group, run.Checkpoint(), &module, &opt)
+                        : LoadCheckpoint(run.Checkpoint(), &module, &opt);
+    if (writer) {
+      TruncateMetrics(run.Metrics(), state.epoch);
+      log::Info("resuming ", run.Checkpoint(), " after epoch ", state.epoch);
+    }
+  } else if (writer) {
     fs::remove(run.Metrics());  // started with the first row: an epoch-less run leaves none
   }
+  if (distributed) group->BroadcastParameters(module, 0);
+  // After a stop that restores the last checkpoint (rank 0's disk), every rank holds its model.
+  const auto restore_checkpoint = [&] {
+    if (writer && fs::exists(run.Checkpoint())) LoadCheckpointModel(run.Checkpoint(), &module);
+    if (distributed) group->BroadcastParameters(module, 0);
+  };
 
   TrainingSummary summary;
   const auto t0 = std::chrono::steady_clock::now();
   const std::int64_t n = task->num_train();
   FS_THROW_UNLESS(n > 0, "training set is empty");
-  Progress progress(c.progress, c.epochs, "samples");
+  Progress progress(writer ? c.progress : ProgressStyle::kNone, c.epochs, "samples");
   double items = 0;
   bool stop = false;
   if (state.epoch >= c.epochs || (c.patience > 0 && state.bad_epochs >= c.patience)) {
@@ -338,20 +416,51 @@ TrainingSummary Train(TrainingTask* task, const TrainConfig& c, const RunPaths& 
     bool finite = true;
     bool interrupted = false;
     for (std::int64_t b = 0; b < n; b += c.batch_size) {
-      if (hooks.interrupt && hooks.interrupt->load()) {
-        interrupted = true;
-        break;
-      }
       const std::int64_t len = std::min<std::int64_t>(c.batch_size, n - b);
-      const auto idx = torch::from_blob(order.data() + b, {len}, torch::kInt64).clone();
-      opt.zero_grad();
-      torch::Tensor loss = task->BatchLoss(idx);
-      const double value = loss.item<double>();
-      if (!std::isfinite(value)) {
-        finite = false;
-        break;
+      double value = 0;
+      if (!distributed) {
+        if (hooks.interrupt && hooks.interrupt->load()) {
+          interrupted = true;
+          break;
+        }
+        const auto idx = torch::from_blob(order.data() + b, {len}, torch::kInt64).clone();
+        opt.zero_grad();
+        torch::Tensor loss = task->BatchLoss(idx);
+        value = loss.item<double>();
+        if (!std::isfinite(value)) {
+          finite = false;
+          break;
+        }
+        loss.backward();
+      } else {
+        // This rank's contiguous slice of the global batch; its gradient enters the sum with
+        // weight slice/len, so the sum is the gradient of the global-batch mean loss. The batch
+        // loss and the interrupt flags ride along in the same all-reduce.
+        const std::int64_t lo = len * group->rank() / group->size();
+        const std::int64_t hi = len * (group->rank() + 1) / group->size();
+        const double weight = static_cast<double>(hi - lo) / static_cast<double>(len);
+        const bool interrupt_here = hooks.interrupt && hooks.interrupt->load();
+        opt.zero_grad();
+        double local = 0;
+        if (!interrupt_here && hi > lo) {
+          const auto idx =
+              torch::from_blob(order.data() + b + lo, {hi - lo}, torch::kInt64).clone();
+          torch::Tensor loss = task->BatchLoss(idx);
+          local = loss.item<double>();
+          if (std::isfinite(local)) loss.backward();
+        }
+        std::vector<double> extra{local * weight, interrupt_here ? 1.0 : 0.0};
+        group->AllReduceGradients(module, weight, &extra);
+        if (extra[1] > 0) {
+          interrupted = true;
+          break;
+        }
+        value = extra[0];
+        if (!std::isfinite(value)) {
+          finite = false;
+          break;
+        }
       }
-      loss.backward();
       if (c.grad_clip_norm > 0)
         torch::nn::utils::clip_grad_norm_(module.parameters(), c.grad_clip_norm);
       opt.step();
@@ -363,29 +472,30 @@ TrainingSummary Train(TrainingTask* task, const TrainConfig& c, const RunPaths& 
     }
     if (interrupted) {
       summary.reason = TerminationReason::kInterrupted;
-      if (state.epoch == 0)
+      if (writer && state.epoch == 0)
         log::Warn("interrupted in epoch 1 before the first checkpoint; nothing was saved");
-      else
+      else if (writer)
         log::Warn("interrupted in epoch ", epoch + 1, "; the checkpoint of epoch ", state.epoch,
                   " is kept (continue with --resume)");
-      if (fs::exists(run.Checkpoint())) LoadCheckpointModel(run.Checkpoint(), &module);
+      restore_checkpoint();
       break;
     }
     double val = NAN;
     if (finite) {
       module.eval();
       torch::NoGradGuard no_grad;
-      val = task->ValidationLoss();
+      if (writer) val = task->ValidationLoss();
+      val = FromRankZero(group, val);
       finite = std::isfinite(val);
     }
     if (!finite) {
       summary.reason = TerminationReason::kNonFiniteLoss;
-      if (state.epoch == 0)
+      if (writer && state.epoch == 0)
         log::Warn("non-finite loss in epoch 1; stopping before the first checkpoint");
-      else
+      else if (writer)
         log::Warn("non-finite loss in epoch ", epoch + 1,
                   "; stopping and keeping the checkpoint of epoch ", state.epoch);
-      if (fs::exists(run.Checkpoint())) LoadCheckpointModel(run.Checkpoint(), &module);
+      restore_checkpoint();
       break;
     }
     const double train_loss = loss_sum / static_cast<double>(seen);
@@ -397,16 +507,16 @@ TrainingSummary Train(TrainingTask* task, const TrainConfig& c, const RunPaths& 
     std::ostringstream row;
     row << state.epoch << "," << train_loss << "," << val << "," << lr << "," << secs << ","
         << static_cast<double>(seen) / std::max(secs, 1e-9);
-    AppendMetrics(run.Metrics(), row.str());
+    if (writer) AppendMetrics(run.Metrics(), row.str());
     if (val < state.best_val - c.min_delta) {
       state.best_val = val;
       state.best_epoch = state.epoch;
       state.bad_epochs = 0;
-      SaveCheckpoint(run.BestCheckpoint(), module, opt, state);
+      if (writer) SaveCheckpoint(run.BestCheckpoint(), module, opt, state);
     } else {
       ++state.bad_epochs;
     }
-    SaveCheckpoint(run.Checkpoint(), module, opt, state);
+    if (writer) SaveCheckpoint(run.Checkpoint(), module, opt, state);
     std::ostringstream line;
     line << "train " << train_loss << " val " << val
          << (state.best_epoch == state.epoch ? " *" : "") << " lr " << lr;
@@ -418,6 +528,13 @@ TrainingSummary Train(TrainingTask* task, const TrainConfig& c, const RunPaths& 
     } else if (c.patience > 0 && state.bad_epochs >= c.patience) {
       summary.reason = TerminationReason::kEarlyStopped;
       stop = true;
+    } else if (distributed) {
+      // Every rank asks its hook; rank 0's answer holds for all.
+      const bool go_on = !hooks.continue_after_epoch || hooks.continue_after_epoch(state.epoch);
+      if (FromRankZero(group, go_on ? 1.0 : 0.0) == 0.0) {
+        summary.reason = TerminationReason::kInterrupted;
+        stop = true;
+      }
     } else if (hooks.continue_after_epoch && !hooks.continue_after_epoch(state.epoch)) {
       summary.reason = TerminationReason::kInterrupted;
       stop = true;
@@ -429,7 +546,7 @@ TrainingSummary Train(TrainingTask* task, const TrainConfig& c, const RunPaths& 
   summary.best_val_loss = state.best_val;
   summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   summary.samples_per_second = items / std::max(summary.seconds, 1e-9);
-  log::Info(summary.BriefReport());
+  if (writer) log::Info(summary.BriefReport());
   return summary;
 }
 

@@ -13,6 +13,10 @@
 
 namespace foresight {
 
+namespace dist {
+class Group;  // training/distributed.h
+}
+
 /// What the trainer trains: a module, a batch loss and a validation loss.
 class TrainingTask {
  public:
@@ -83,8 +87,17 @@ class ScopedInterruptFlag {
 /// missing or corrupt) and produces the same parameters as an uninterrupted run. Each epoch
 /// appends its metrics.csv row, then replaces the checkpoints (fsynced, atomic rename); a resume
 /// drops rows after the checkpoint's epoch.
+///
+/// Data parallel when `group` (default: dist::DefaultGroup(), i.e. the launch environment) has
+/// more than one rank (docs/distributed.md): every rank must call Train with the same task data,
+/// config and seed. Each global batch is split into contiguous slices, one per rank, and the
+/// gradients are all-reduced so that every step equals the single-process step on the global
+/// batch (to float rounding). Rank 0's parameters are broadcast at the start (and after a resume,
+/// whose checkpoint only rank 0 reads); rank 0 alone computes the validation loss, writes metrics
+/// and checkpoints, and decides every stop. A failed peer is an Error on the other ranks.
 TrainingSummary Train(TrainingTask* task, const TrainConfig& config, const RunPaths& run,
-                      std::uint64_t seed, bool resume, const TrainHooks& hooks = {});
+                      std::uint64_t seed, bool resume, const TrainHooks& hooks = {},
+                      dist::Group* group = nullptr);
 
 /// Loads the model parameters of a checkpoint into `module`; corrupt files are an Error.
 void LoadCheckpointModel(const std::string& path, torch::nn::Module* module);

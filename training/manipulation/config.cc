@@ -31,6 +31,10 @@ void ManipulationExperimentConfig::Validate(const std::string& path) const {
   if (problems.source == ProblemSource::kSynthetic)
     problems.scene.Validate(path + ": problems.scene");
   FS_THROW_UNLESS(!robot.empty(), path, ": robot: empty (a folder or 'builtin')");
+  for (const PlanMethodConfig& m : methods)
+    FS_THROW_UNLESS(m.sampler != GfcsSamplerKind::kLearned || !energy_model.empty(), path,
+                    ": methods: '", m.name,
+                    "' uses the learned sampler, but energy_model (the artifact) is empty");
   FS_THROW_UNLESS(fabric.t_max >= fabric.dt, path, ": fabric.t_max (", fabric.t_max,
                   ") is below fabric.dt (", fabric.dt, ")");
 }

@@ -1,13 +1,14 @@
 #pragma once
 /// The config of a manipulation experiment (thesis ch 9): which problems, which methods, the
-/// fabric, GFCS and planner parameters. Run by `foresight plan CONFIG` (experiments/manipulation).
-/// Torch-free.
+/// fabric, GFCS and planner parameters. Run by `foresight plan CONFIG`
+/// (training/manipulation/plan.h). Torch-free.
 
 #include <cstdint>
 #include <string>
 #include <vector>
 
 #include "core/config.h"
+#include "inference/manipulation/energy_model.h"
 #include "inference/manipulation/fabric.h"
 #include "inference/manipulation/gfcs.h"
 #include "inference/manipulation/synthetic_problems.h"
@@ -50,12 +51,16 @@ struct ManipulationProblemsConfig {
 /// What kind of method a row of the comparison is.
 enum class PlanMethodKind { kGfcs, kFabric, kBiEst, kBitStar, kRrtConnect };
 
+/// Where GFCS's first batch comes from.
+enum class GfcsSamplerKind { kUniform, kLearned };
+
 /// One row of the comparison table.
 struct PlanMethodConfig {
   std::string name = "GFCS (1 batch)";  ///< label in summary.json and the table
   PlanMethodKind kind = PlanMethodKind::kGfcs;
-  int batches = 1;           ///< gfcs: batches evaluated
-  double time_budget = 1.2;  ///< planners: seconds
+  int batches = 1;                                      ///< gfcs: batches evaluated
+  double time_budget = 1.2;                             ///< planners: seconds
+  GfcsSamplerKind sampler = GfcsSamplerKind::kUniform;  ///< gfcs: first batch
 
   template <class A>
   void Serialize(A* a) {
@@ -70,6 +75,10 @@ struct PlanMethodConfig {
     a->Visit("batches", &batches, config::Range::Closed(1, 1000), "gfcs: batches evaluated");
     a->Visit("time_budget", &time_budget, config::Range::OpenClosed(0, 3600),
              "planners: time budget (s)");
+    a->VisitEnum("sampler", &sampler,
+                 config::EnumNames<GfcsSamplerKind>{{GfcsSamplerKind::kUniform, "uniform"},
+                                                    {GfcsSamplerKind::kLearned, "learned"}},
+                 "gfcs: first batch uniform in the joint limits, or SGLD on energy_model");
   }
 };
 
@@ -108,7 +117,9 @@ struct ManipulationExperimentConfig {
   double resolution = 0.05;      ///< rad, C-space step of the path validity checks (every method)
   double max_joint_speed = 1.0;  ///< rad/s, timing of planner paths (metrics)
   ReactivityConfig reactivity;
-  int plot_problems = 3;  ///< problems drawn in ee_paths.png
+  int plot_problems = 3;          ///< problems drawn in ee_paths.png
+  std::string energy_model;       ///< artifact of the learned sampler (a gfcs run's model.h5)
+  manipulation::SgldParams sgld;  ///< the learned sampler's SGLD
 
   template <class A>
   void Serialize(A* a) {
@@ -128,6 +139,10 @@ struct ManipulationExperimentConfig {
     a->Visit("reactivity", &reactivity, config::Range::Any(), "obstacles added on solved paths");
     a->Visit("plot_problems", &plot_problems, config::Range::Closed(0, 100),
              "problems drawn in ee_paths.png");
+    a->Visit("energy_model", &energy_model, config::Range::Any(),
+             "artifact of the learned sampler (a gfcs run's model.h5; methods with sampler: "
+             "learned)");
+    a->Visit("sgld", &sgld, config::Range::Any(), "SGLD of the learned sampler");
   }
   /// Cross-field checks; errors name `path` and the key.
   void Validate(const std::string& path) const;

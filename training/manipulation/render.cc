@@ -1,4 +1,4 @@
-#include "experiments/manipulation/render.h"
+#include "training/manipulation/render.h"
 
 #include <cmath>
 #include <opencv2/imgcodecs.hpp>

@@ -4,6 +4,7 @@
 /// problems, judged by one validity checker at one resolution and one metrics module. Writes
 /// DIR/summary.json, DIR/problems.csv and DIR/ee_paths.png. Torch-free.
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -33,7 +34,8 @@ struct PlanAttempt {
   int problem = 0;
   std::string status;  ///< solved, or why not (timeout, collision, invalid_path, planner status)
   manipulation::PathMetrics metrics;
-  Eigen::Matrix3Xd ee_path;  ///< end-effector positions of the trajectory (empty on failure)
+  Eigen::Matrix3Xd ee_path;         ///< end-effector positions of the trajectory (empty on failure)
+  std::optional<double> gfcs_cost;  ///< GFCS: the best candidate's GFCOP cost (s), solved or not
 };
 
 struct PlanMethodResult {

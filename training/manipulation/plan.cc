@@ -1,9 +1,9 @@
-#include "experiments/manipulation/plan.h"
+#include "training/manipulation/plan.h"
 
 #include <chrono>
 #include <filesystem>
-#include <fstream>
 #include <iomanip>
+#include <optional>
 #include <random>
 #include <sstream>
 
@@ -11,13 +11,14 @@
 #include "core/file_io.h"
 #include "core/log.h"
 #include "datasets/data_root.h"
-#include "experiments/manipulation/render.h"
 #include "inference/manipulation/builtin_panda.h"
+#include "inference/manipulation/energy_model.h"
 #include "inference/manipulation/fabric.h"
 #include "inference/manipulation/gfcs.h"
 #include "inference/manipulation/planners.h"
 #include "inference/manipulation/synthetic_problems.h"
 #include "inference/manipulation/validity.h"
+#include "training/manipulation/render.h"
 
 namespace foresight {
 namespace fs = std::filesystem;
@@ -46,25 +47,25 @@ TimedPath ToTimedPath(const std::vector<JointVector>& states, double dt) {
   return path;
 }
 
+/// `sampler`'s world is set by the caller. `best` receives the best candidate (also unsolved).
 Trajectory RunGfcs(const Fabric& fabric, const ManipulationProblem& problem,
                    const ManipulationExperimentConfig& c, const PlanMethodConfig& method,
-                   std::uint64_t seed, GfcsCandidate* best) {
+                   CommandSampler* sampler, std::uint64_t seed, GfcsCandidate* best) {
   GfcsParams params = c.gfcs;
   params.batches = method.batches;
   params.seed = static_cast<std::int64_t>(seed);
-  const JointLimits& limits = fabric.robot().limits();
-  UniformSampler sampler(limits.lower, limits.upper);
   GfcsQuery query;
   query.start = problem.start;
   query.goal = problem.goal;
   const auto started = std::chrono::steady_clock::now();
-  const GfcsSolution solution = SolveGfcop(fabric, query, &sampler, params);
+  const GfcsSolution solution = SolveGfcop(fabric, query, sampler, params);
   Trajectory t;
   t.generation_time_s = Seconds(started);
   if (solution.status == GfcsStatus::kError) {
     t.status = "error: " + solution.message;
     return t;
   }
+  if (!solution.top.empty()) *best = solution.top.front();
   if (!solution.solved()) {
     t.status = solution.top.empty() ? "not_solved" : ToString(solution.top.front().last_status);
     return t;
@@ -167,13 +168,13 @@ std::string CsvNumber(const std::optional<double>& v) {
 void WriteProblemsCsv(const std::string& path, const PlanReport& report) {
   std::ostringstream os;
   os << "problem,method,status,success,time_s,ee_length,cspace_length,duration_s,ee_ldj,"
-        "cspace_ldj\n";
+        "cspace_ldj,gfcs_cost\n";
   for (const PlanAttempt& a : report.attempts) {
     const PathMetrics& m = a.metrics;
     os << a.problem << ",\"" << a.method << "\"," << a.status << "," << (m.success ? 1 : 0) << ","
        << m.time_s << "," << CsvNumber(m.ee_length) << "," << CsvNumber(m.cspace_length) << ","
        << CsvNumber(m.duration_s) << "," << CsvNumber(m.ee_ldj.value) << ","
-       << CsvNumber(m.cspace_ldj.value) << "\n";
+       << CsvNumber(m.cspace_ldj.value) << "," << CsvNumber(a.gfcs_cost) << "\n";
   }
   WriteFileAtomically(path, os.str());
 }
@@ -245,6 +246,17 @@ PlanReport RunPlanExperiment(const ManipulationExperimentConfig& c, const std::s
     return Eigen::Vector3d(ee_data.p_WE);
   };
 
+  const JointLimits& limits = robot.limits();
+  UniformSampler uniform(limits.lower, limits.upper);
+  std::optional<EnergyModel> energy;
+  std::optional<LearnedSampler> learned;
+  for (const PlanMethodConfig& m : c.methods)
+    if (m.kind == PlanMethodKind::kGfcs && m.sampler == GfcsSamplerKind::kLearned && !energy) {
+      energy.emplace(EnergyModel::Load(c.energy_model));
+      learned.emplace(*energy, c.sgld);
+      log::Info("learned sampler: ", c.energy_model);
+    }
+
   // Reactivity is measured on the first GFCS method's solutions.
   int reactive_method = -1;
   for (std::size_t m = 0; m < c.methods.size() && reactive_method < 0; ++m)
@@ -262,6 +274,7 @@ PlanReport RunPlanExperiment(const ManipulationExperimentConfig& c, const std::s
       continue;
     }
     const Fabric fabric(robot, problem.world, c.fabric);
+    if (learned) learned->SetWorld(problem.world);
     const std::uint64_t seed = static_cast<std::uint64_t>(c.seed + problem.index);
     PlanProblemPicture picture;
     picture.problem = problem.index;
@@ -272,11 +285,16 @@ PlanReport RunPlanExperiment(const ManipulationExperimentConfig& c, const std::s
       const PlanMethodConfig& method = c.methods[m];
       Trajectory t;
       GfcsCandidate best;
+      std::optional<double> attempt_cost;
       try {
         switch (method.kind) {
-          case PlanMethodKind::kGfcs:
-            t = RunGfcs(fabric, problem, c, method, seed, &best);
+          case PlanMethodKind::kGfcs: {
+            CommandSampler* sampler = &uniform;
+            if (method.sampler == GfcsSamplerKind::kLearned) sampler = &*learned;
+            t = RunGfcs(fabric, problem, c, method, sampler, seed, &best);
+            attempt_cost = best.commands.size() ? best.cost : std::optional<double>();
             break;
+          }
           case PlanMethodKind::kFabric:
             t = RunFabric(fabric, problem);
             break;
@@ -298,6 +316,7 @@ PlanReport RunPlanExperiment(const ManipulationExperimentConfig& c, const std::s
       attempt.method = method.name;
       attempt.problem = problem.index;
       attempt.status = t.status;
+      attempt.gfcs_cost = attempt_cost;
       if (t.reached) {
         const std::string verdict = JudgePath(t.joints, problem.goal, checker, c.resolution,
                                               c.fabric.goal_tolerance + 1e-9);

@@ -1,0 +1,102 @@
+// Google Benchmark of the learned GFCS sampler's energy engine at production size: encoding 64
+// (any k; it only enters the per-call context GEMV), energy MLP [21 + k + 7n] -> 800 -> 800 -> 800
+// -> 1, n = 1 (7 command inputs). Random weights: latency does not depend on their values.
+//   build/bin/bench_energy_model [--benchmark_repetitions=3]
+// Counters: GFLOP/s of the multiply-adds (2 flops each) of the forward and backward GEMMs.
+
+#include <benchmark/benchmark.h>
+
+#include <random>
+
+#include "inference/manipulation/energy_model.h"
+
+namespace foresight::manipulation {
+namespace {
+
+constexpr int kEncoding = 64, kCommands = 1, kWidth = 800;
+
+Mlp RandomMlp(const std::vector<int>& sizes, std::mt19937_64* rng) {
+  std::vector<DenseLayer> layers;
+  std::normal_distribution<float> n01;
+  for (std::size_t i = 0; i + 1 < sizes.size(); ++i) {
+    const float scale = 1.0f / std::sqrt(static_cast<float>(sizes[i]));
+    DenseLayer l;
+    l.weight =
+        Eigen::MatrixXf::NullaryExpr(sizes[i + 1], sizes[i], [&] { return scale * n01(*rng); });
+    l.bias = Eigen::VectorXf::NullaryExpr(sizes[i + 1], [&] { return 0.1f * n01(*rng); });
+    layers.push_back(std::move(l));
+  }
+  return Mlp(std::move(layers));
+}
+
+const EnergyModel& Model() {
+  static const EnergyModel model = [] {
+    std::mt19937_64 rng(1);
+    EnergyModelParts p;
+    p.lattice.lower = Eigen::Vector3d::Zero();
+    p.lattice.upper = Eigen::Vector3d::Constant(0.3);
+    p.lattice.spacing = 0.3;
+    p.bps_mean = Eigen::VectorXf::Zero(8);
+    p.bps_std = Eigen::VectorXf::Ones(8);
+    p.encoder = RandomMlp({8, kEncoding}, &rng);
+    const int in = EnergyModel::kStateContext + kEncoding + 7 * kCommands;
+    p.energy = RandomMlp({in, kWidth, kWidth, kWidth, 1}, &rng);
+    p.intermediate_commands = kCommands;
+    return EnergyModel(std::move(p));
+  }();
+  return model;
+}
+
+/// Multiply-adds x 2 of one EnergyAndGradient call over P particles (the context GEMV once).
+double Flops(int P, bool with_gradient) {
+  const double du = 7 * kCommands, w = kWidth;
+  const double forward = P * (w * du + 2 * w * w + w);
+  const double backward = with_gradient ? P * (2 * w * w + du * w) : 0;
+  return 2 * (forward + backward) + 2 * w * (EnergyModel::kStateContext + kEncoding);
+}
+
+Eigen::VectorXf Context() { return Eigen::VectorXf::Constant(Model().context_size(), 0.1f); }
+
+void BM_EnergyAndGradient(benchmark::State& state) {
+  const EnergyModel& m = Model();
+  const int P = static_cast<int>(state.range(0));
+  auto ws = m.MakeWorkspace(P);
+  std::mt19937_64 rng(2);
+  std::uniform_real_distribution<float> u11(-1, 1);
+  const Eigen::MatrixXf u =
+      Eigen::MatrixXf::NullaryExpr(m.command_size(), P, [&] { return u11(rng); });
+  const Eigen::VectorXf ctx = Context();
+  Eigen::VectorXf E(P);
+  Eigen::MatrixXf G(m.command_size(), P);
+  for (auto _ : state) {
+    m.EnergyAndGradient(ctx, u, &E, &G, &ws);
+    benchmark::DoNotOptimize(E.data());
+  }
+  state.counters["GFLOP/s"] =
+      benchmark::Counter(Flops(P, true) * 1e-9, benchmark::Counter::kIsIterationInvariantRate);
+}
+BENCHMARK(BM_EnergyAndGradient)->Arg(20)->Arg(200)->Unit(benchmark::kMillisecond);
+
+void BM_RunSgld(benchmark::State& state) {
+  const EnergyModel& m = Model();
+  SgldParams p;
+  p.particles = static_cast<int>(state.range(0));
+  p.steps = 50;
+  auto ws = m.MakeWorkspace(p.particles);
+  const Eigen::VectorXf ctx = Context();
+  std::mt19937_64 rng(3);
+  for (auto _ : state) {
+    const SgldResult r = RunSgld(m, ctx, p, &rng, &ws);
+    benchmark::DoNotOptimize(r.energy.data());
+  }
+  // 50 steps with the gradient plus one final energy-only evaluation
+  state.counters["GFLOP/s"] =
+      benchmark::Counter((50 * Flops(p.particles, true) + Flops(p.particles, false)) * 1e-9,
+                         benchmark::Counter::kIsIterationInvariantRate);
+}
+BENCHMARK(BM_RunSgld)->Arg(20)->Arg(200)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+}  // namespace foresight::manipulation
+
+BENCHMARK_MAIN();

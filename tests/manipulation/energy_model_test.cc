@@ -1,0 +1,548 @@
+// The learned sampler's energy engine (torch-free): energies and gradients against an independent
+// double-precision reference with central differences, artifacts, shape errors, no allocation on
+// the hot path, SGLD (schedule, clamping, descent, determinism, non-finite particles) and the
+// LearnedSampler.
+
+#include "inference/manipulation/energy_model.h"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <random>
+
+#include "core/h5.h"
+#include "inference/engine/artifact.h"
+#include "tests/alloc_counter.h"
+#include "tests/test_util.h"
+
+// Eigen's GEMM takes its packing buffers from malloc (not operator new) when no buffer is given:
+// count malloc too (glibc: the test's malloc wraps __libc_malloc).
+extern "C" void* __libc_malloc(std::size_t size);
+namespace {
+std::atomic<bool> g_counting_malloc{false};
+std::atomic<long> g_mallocs{0};
+}  // namespace
+extern "C" void* malloc(std::size_t size) noexcept {
+  if (g_counting_malloc) ++g_mallocs;
+  return __libc_malloc(size);
+}
+
+namespace foresight::manipulation {
+namespace {
+
+using testing::ExpectErrorContains;
+using testing::TempDir;
+
+Mlp RandomMlp(const std::vector<int>& sizes, std::mt19937_64* rng) {
+  std::vector<DenseLayer> layers;
+  std::normal_distribution<float> n01;
+  for (std::size_t i = 0; i + 1 < sizes.size(); ++i) {
+    DenseLayer l;
+    const float scale = 1.5f / std::sqrt(static_cast<float>(sizes[i]));
+    l.weight =
+        Eigen::MatrixXf::NullaryExpr(sizes[i + 1], sizes[i], [&] { return scale * n01(*rng); });
+    l.bias = Eigen::VectorXf::NullaryExpr(sizes[i + 1], [&] { return 0.3f * n01(*rng); });
+    layers.push_back(std::move(l));
+  }
+  return Mlp(std::move(layers));
+}
+
+/// A small model: lattice of 8 points, encoding 5, n intermediate commands, energy hidden sizes.
+EnergyModelParts RandomParts(int n, const std::vector<int>& hidden, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  EnergyModelParts p;
+  p.lattice.lower = Eigen::Vector3d(0, 0, 0);
+  p.lattice.upper = Eigen::Vector3d(0.3, 0.3, 0.3);
+  p.lattice.spacing = 0.3;
+  p.lattice.max_distance = 1.0;
+  p.bps_mean = Eigen::VectorXf::Constant(8, 0.4f);
+  p.bps_std = Eigen::VectorXf::Constant(8, 0.2f);
+  p.encoder = RandomMlp({8, 6, 5}, &rng);
+  std::vector<int> sizes = {21 + 5 + 7 * n};
+  sizes.insert(sizes.end(), hidden.begin(), hidden.end());
+  sizes.push_back(1);
+  p.energy = RandomMlp(sizes, &rng);
+  p.lower << -2.9, -1.76, -2.9, -3.07, -2.9, -0.02, -2.9;
+  p.upper << 2.9, 1.76, 2.9, -0.07, 2.9, 3.75, 2.9;
+  p.velocity_scale = 2.0;
+  p.intermediate_commands = n;
+  return p;
+}
+
+/// Independent reference: E([x_c; u]) in double by plain loops.
+double ReferenceEnergy(const EnergyModelParts& p, const Eigen::VectorXd& context,
+                       const Eigen::VectorXd& u) {
+  Eigen::VectorXd x(context.size() + u.size());
+  x << context, u;
+  const auto& layers = p.energy.layers();
+  for (std::size_t i = 0; i < layers.size(); ++i) {
+    const Eigen::MatrixXd W = layers[i].weight.cast<double>();
+    Eigen::VectorXd y(W.rows());
+    for (int r = 0; r < W.rows(); ++r) {
+      double s = layers[i].bias[r];
+      for (int c = 0; c < W.cols(); ++c) s += W(r, c) * x[c];
+      y[r] = (i + 1 < layers.size()) ? std::max(0.0, s) : s;
+    }
+    x = y;
+  }
+  return x[0];
+}
+
+Eigen::MatrixXf RandomU(int rows, int cols, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<float> u(-1, 1);
+  return Eigen::MatrixXf::NullaryExpr(rows, cols, [&] { return u(rng); });
+}
+
+GfcsQuery SomeQuery() {
+  GfcsQuery q;
+  q.start << 0.1, -0.5, 0.2, -2.0, 0.3, 1.5, 0.7;
+  q.start_velocity << 0.2, -0.4, 0.0, 1.0, 0.0, 0.0, -2.0;
+  q.goal << -1.0, 0.5, 0.4, -1.2, -0.3, 2.0, -0.5;
+  return q;
+}
+
+World SomeWorld() {
+  World w;
+  Box b;
+  b.X_WB.translation() = Eigen::Vector3d(0.2, 0.1, 0.15);
+  b.half_size = Eigen::Vector3d(0.05, 0.1, 0.2);
+  w.AddBox("b", b);
+  return w;
+}
+
+TEST(EnergyModel, SizesContextAndNormalisation) {
+  const EnergyModel m(RandomParts(2, {16, 16, 16}, 1));
+  EXPECT_EQ(m.encoding_size(), 5);
+  EXPECT_EQ(m.context_size(), 26);
+  EXPECT_EQ(m.command_size(), 14);
+  const GfcsQuery q = SomeQuery();
+  const Eigen::VectorXf enc = m.EncodeWorld(SomeWorld());
+  ASSERT_EQ(enc.size(), 5);
+  // the encoding is encoder((bps - mean) / std)
+  {
+    const Eigen::VectorXf x = (EncodeBps(SomeWorld(), m.parts().lattice).array() - 0.4f) / 0.2f;
+    Mlp::Workspace ws = m.parts().encoder.MakeWorkspace();
+    EXPECT_TRUE(m.parts().encoder.Forward(x, &ws).isApprox(enc));
+  }
+  Eigen::VectorXf ctx;
+  m.Context(q, enc, &ctx);
+  ASSERT_EQ(ctx.size(), 26);
+  const JointVector lo = m.parts().lower, hi = m.parts().upper;
+  for (int j = 0; j < kDof; ++j) {
+    EXPECT_NEAR(ctx[j], 2 * (q.start[j] - lo[j]) / (hi[j] - lo[j]) - 1, 1e-6);
+    EXPECT_NEAR(ctx[7 + j], q.start_velocity[j] / 2.0, 1e-6);
+    EXPECT_NEAR(ctx[14 + j], 2 * (q.goal[j] - lo[j]) / (hi[j] - lo[j]) - 1, 1e-6);
+  }
+  EXPECT_EQ(ctx.tail(5), enc);
+  EXPECT_TRUE(m.Normalise(lo).isApprox(-JointVector::Ones()));
+  EXPECT_TRUE(m.Normalise(hi).isApprox(JointVector::Ones()));
+  Eigen::VectorXd y(14);
+  y << q.start, q.goal;
+  EXPECT_TRUE(m.CommandsToRadians(m.RadiansToCommands(y)).isApprox(y, 1e-6));
+  EXPECT_TRUE(m.Denormalise(m.Normalise(q.goal)).isApprox(q.goal));
+}
+
+TEST(EnergyModel, EnergyAndGradientMatchDoubleReferenceAndCentralDifferences) {
+  for (const auto& hidden : std::vector<std::vector<int>>{{}, {7}, {16, 16, 16}, {64, 48, 32}}) {
+    for (int n : {1, 3}) {
+      const EnergyModelParts parts = RandomParts(n, hidden, 10 + n);
+      const EnergyModel m(parts);
+      Eigen::VectorXf ctx;
+      m.Context(SomeQuery(), m.EncodeWorld(SomeWorld()), &ctx);
+      const int P = 9;
+      // u as a block of a wider matrix (outer stride != rows)
+      const Eigen::MatrixXf wide = RandomU(m.command_size() + 3, P + 2, 7);
+      const auto u = wide.block(1, 1, m.command_size(), P);
+      auto ws = m.MakeWorkspace(P + 5);
+      Eigen::VectorXf E;
+      Eigen::MatrixXf G;
+      m.EnergyAndGradient(ctx, u, &E, &G, &ws);
+      ASSERT_EQ(E.size(), P);
+      ASSERT_EQ(G.rows(), m.command_size());
+      ASSERT_EQ(G.cols(), P);
+      const Eigen::VectorXd c = ctx.cast<double>();
+      for (int p = 0; p < P; ++p) {
+        const Eigen::VectorXd up = u.col(p).cast<double>();
+        const auto f = [&](const Eigen::VectorXd& x) { return ReferenceEnergy(parts, c, x); };
+        const double e = f(up);
+        EXPECT_NEAR(E[p], e, 1e-5 * (1 + std::abs(e))) << "hidden " << hidden.size() << " n " << n;
+        const Eigen::VectorXd fd = testing::CentralGradient(f, up, 1e-6);
+        const double scale = 1 + fd.cwiseAbs().maxCoeff();
+        EXPECT_TRUE(testing::MatricesNear(G.col(p).cast<double>(), fd, 1e-4 * scale))
+            << "hidden " << hidden.size() << " n " << n << " particle " << p;
+      }
+      // energies without the gradient are the same numbers
+      Eigen::VectorXf E2;
+      m.EnergyAndGradient(ctx, u, &E2, nullptr, &ws);
+      EXPECT_EQ(E2, E);
+      // fewer particles: the same columns
+      m.EnergyAndGradient(ctx, u.leftCols(3), &E2, &G, &ws);
+      EXPECT_TRUE(E2.isApprox(E.head(3), 1e-6f));  // GEMM panels may round differently
+    }
+  }
+}
+
+TEST(EnergyModel, NoAllocationOnTheHotPath) {
+  const EnergyModel m(RandomParts(2, {800, 800, 800}, 3));
+  Eigen::VectorXf ctx;
+  m.Context(SomeQuery(), m.EncodeWorld(SomeWorld()), &ctx);
+  auto ws = m.MakeWorkspace(200);
+  const Eigen::MatrixXf u = RandomU(m.command_size(), 200, 4);
+  {  // the malloc counter is live: Eigen's own product mallocs its packing buffers
+    const Eigen::MatrixXf a = Eigen::MatrixXf::Ones(800, 800), b = Eigen::MatrixXf::Ones(800, 200);
+    Eigen::MatrixXf c(800, 200);
+    g_mallocs = 0;
+    g_counting_malloc = true;
+    c.noalias() = a * b;
+    g_counting_malloc = false;
+    EXPECT_GT(g_mallocs.load(), 0);
+  }
+  for (int P : {200, 20, 1}) {
+    Eigen::VectorXf E(P);
+    Eigen::MatrixXf G(m.command_size(), P);
+    g_allocations = 0;
+    g_mallocs = 0;
+    g_counting = true;
+    g_counting_malloc = true;
+    m.EnergyAndGradient(ctx, u.leftCols(P), &E, &G, &ws);
+    m.EnergyAndGradient(ctx, u.leftCols(P), &E, nullptr, &ws);
+    g_counting_malloc = false;
+    g_counting = false;
+    EXPECT_EQ(g_allocations.load(), 0) << P << " particles";
+    EXPECT_EQ(g_mallocs.load(), 0) << P << " particles";
+    EXPECT_TRUE(E.allFinite() && G.allFinite());
+  }
+}
+
+TEST(EnergyModel, SaveLoadRoundTrip) {
+  TempDir tmp;
+  const EnergyModelParts parts = RandomParts(2, {16, 12}, 5);
+  const EnergyModel m(parts);
+  const std::string path = tmp.File("energy.h5");
+  m.Save(path, "model: gfcs_energy\n", 42);
+  const EnergyModel back = EnergyModel::Load(path);
+  const EnergyModelParts& q = back.parts();
+  EXPECT_EQ(q.lattice.lower, parts.lattice.lower);
+  EXPECT_EQ(q.lattice.upper, parts.lattice.upper);
+  EXPECT_EQ(q.lattice.spacing, parts.lattice.spacing);
+  EXPECT_EQ(q.lattice.max_distance, parts.lattice.max_distance);
+  EXPECT_EQ(q.bps_mean, parts.bps_mean);
+  EXPECT_EQ(q.bps_std, parts.bps_std);
+  EXPECT_EQ(q.lower, parts.lower);
+  EXPECT_EQ(q.upper, parts.upper);
+  EXPECT_EQ(q.velocity_scale, parts.velocity_scale);
+  EXPECT_EQ(q.intermediate_commands, 2);
+  ASSERT_EQ(q.energy.layers().size(), 3u);
+  ASSERT_EQ(q.encoder.layers().size(), 2u);
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(q.energy.layers()[i].weight, parts.energy.layers()[i].weight);
+    EXPECT_EQ(q.energy.layers()[i].bias, parts.energy.layers()[i].bias);
+  }
+  EXPECT_EQ(back.EncodeWorld(SomeWorld()), m.EncodeWorld(SomeWorld()));
+  const Artifact art = Artifact::Open(path, kEnergyModelType);
+  EXPECT_EQ(art.seed(), 42);
+  EXPECT_EQ(art.config_yaml(), "model: gfcs_energy\n");
+  EXPECT_TRUE(art.file().Exists("/weights/energy/linear0/weight"));
+  EXPECT_TRUE(art.file().Exists("/weights/encoder/linear1/bias"));
+}
+
+TEST(EnergyModel, CorruptOrMissingArtifactsAreErrorsNamingFileAndObject) {
+  TempDir tmp;
+  const EnergyModel m(RandomParts(1, {8}, 6));
+  const std::string good = tmp.File("good.h5");
+  m.Save(good, "", 1);
+  ExpectErrorContains([&] { EnergyModel::Load(tmp.File("none.h5")); }, {"none.h5"});
+  {
+    const std::string path = tmp.File("other.h5");
+    h5::WriteAtomically(path,
+                        [](h5::File* f) { Artifact::WriteHeader(f, "span_predictor", "", 0); });
+    ExpectErrorContains([&] { EnergyModel::Load(path); }, {"other.h5", "span_predictor"});
+  }
+  {
+    const std::string path = tmp.File("short.h5");
+    std::filesystem::copy_file(good, path);
+    testing::Truncate(path, 1000);
+    ExpectErrorContains([&] { EnergyModel::Load(path); }, {"short.h5"});
+  }
+  {
+    const std::string path = tmp.File("layers.h5");
+    std::filesystem::copy_file(good, path);
+    testing::OverwriteAttr(path, "/model", "energy_layers", std::int64_t{3});
+    ExpectErrorContains([&] { EnergyModel::Load(path); }, {"layers.h5", "/weights/energy/linear2"});
+  }
+  {
+    const std::string path = tmp.File("n.h5");
+    std::filesystem::copy_file(good, path);
+    testing::OverwriteAttr(path, "/model", "intermediate_commands", std::int64_t{2});
+    ExpectErrorContains([&] { EnergyModel::Load(path); }, {"n.h5", "energy network takes", "33"});
+  }
+  {
+    const std::string path = tmp.File("scale.h5");
+    std::filesystem::copy_file(good, path);
+    testing::OverwriteAttr(path, "/model", "velocity_scale", -1.0);
+    ExpectErrorContains([&] { EnergyModel::Load(path); }, {"scale.h5", "velocity_scale"});
+  }
+  {
+    const std::string path = tmp.File("missing.h5");
+    h5::WriteAtomically(path, [](h5::File* f) {
+      Artifact::WriteHeader(f, kEnergyModelType, "", 0);
+      f->SetAttr("/model", "intermediate_commands", std::int64_t{1});
+      f->SetAttr("/model", "velocity_scale", 1.0);
+      f->SetAttr("/model", "bps_spacing", 0.3);
+      f->SetAttr("/model", "bps_max_distance", 1.0);
+    });
+    ExpectErrorContains([&] { EnergyModel::Load(path); }, {"missing.h5", "/model/bps_lower"});
+  }
+}
+
+TEST(EnergyModel, ShapeErrorsNameTheMismatch) {
+  {
+    auto p = RandomParts(1, {8}, 7);
+    p.bps_mean.resize(7);
+    ExpectErrorContains([&] { EnergyModel m(p); }, {"bps_mean", "7", "N_R = 8"});
+  }
+  {
+    auto p = RandomParts(1, {8}, 7);
+    p.bps_std[2] = 0;
+    ExpectErrorContains([&] { EnergyModel m(p); }, {"bps_std"});
+  }
+  {
+    auto p = RandomParts(1, {8}, 7);
+    p.lattice.upper.x() = 0.6;  // 12 points
+    p.bps_mean = Eigen::VectorXf::Zero(12);
+    p.bps_std = Eigen::VectorXf::Ones(12);
+    ExpectErrorContains([&] { EnergyModel m(p); }, {"encoder takes 8", "N_R = 12"});
+  }
+  {
+    auto p = RandomParts(1, {8}, 7);
+    p.intermediate_commands = 2;
+    ExpectErrorContains([&] { EnergyModel m(p); }, {"takes 33 inputs", "= 40"});
+  }
+  {
+    auto p = RandomParts(1, {8}, 7);
+    std::mt19937_64 rng(1);
+    p.energy = RandomMlp({33, 8, 2}, &rng);
+    ExpectErrorContains([&] { EnergyModel m(p); }, {"gives 2 outputs"});
+  }
+  {
+    auto p = RandomParts(1, {8}, 7);
+    p.energy = Mlp();
+    ExpectErrorContains([&] { EnergyModel m(p); }, {"no layers"});
+  }
+  {
+    auto p = RandomParts(1, {8}, 7);
+    std::swap(p.lower[3], p.upper[3]);
+    ExpectErrorContains([&] { EnergyModel m(p); }, {"joint limits"});
+  }
+  const EnergyModel m(RandomParts(1, {8}, 7));
+  auto ws = m.MakeWorkspace(4);
+  Eigen::VectorXf E;
+  Eigen::MatrixXf G;
+  const Eigen::VectorXf ctx = Eigen::VectorXf::Zero(26);
+  ExpectErrorContains(
+      [&] { m.EnergyAndGradient(Eigen::VectorXf::Zero(25), RandomU(7, 2, 1), &E, &G, &ws); },
+      {"context has 25", "26"});
+  ExpectErrorContains([&] { m.EnergyAndGradient(ctx, RandomU(14, 2, 1), &E, &G, &ws); },
+                      {"u has 14 rows", "7"});
+  ExpectErrorContains([&] { m.EnergyAndGradient(ctx, RandomU(7, 5, 1), &E, &G, &ws); },
+                      {"5 particles", "4"});
+  ExpectErrorContains([&] { m.Context(SomeQuery(), Eigen::VectorXf::Zero(4), &E); },
+                      {"encoding has 4", "5"});
+}
+
+// ---------------------------------------------------------------------------------------------
+/// E(u) = weight * sum_i |u_i - target| (+ 0 context): 2-layer ReLU net, minimum at u = target.
+EnergyModelParts AbsEnergy(int n, float target, float weight) {
+  EnergyModelParts p = RandomParts(n, {}, 1);
+  const int D = 7 * n, ctx = 26;
+  DenseLayer h, o;
+  h.weight = Eigen::MatrixXf::Zero(2 * D, ctx + D);
+  h.bias.resize(2 * D);
+  for (int i = 0; i < D; ++i) {
+    h.weight(i, ctx + i) = 1;
+    h.bias[i] = -target;
+    h.weight(D + i, ctx + i) = -1;
+    h.bias[D + i] = target;
+  }
+  o.weight = Eigen::MatrixXf::Constant(1, 2 * D, weight);
+  o.bias = Eigen::VectorXf::Zero(1);
+  p.energy = Mlp({h, o});
+  return p;
+}
+
+/// E(u) = w . u + b: one linear layer, constant gradient w.
+EnergyModelParts LinearEnergy(int n, const Eigen::VectorXf& w) {
+  EnergyModelParts p = RandomParts(n, {}, 1);
+  DenseLayer l;
+  l.weight = Eigen::MatrixXf::Zero(1, 26 + 7 * n);
+  l.weight.rightCols(7 * n) = w.transpose();
+  l.bias = Eigen::VectorXf::Constant(1, 0.5f);
+  p.energy = Mlp({l});
+  return p;
+}
+
+TEST(Sgld, StepVarianceSchedule) {
+  SgldParams p;
+  p.step_scale = 0.02;
+  EXPECT_DOUBLE_EQ(SgldStepVariance(p, 0), 0.02);
+  EXPECT_DOUBLE_EQ(SgldStepVariance(p, 3), 0.01);
+  EXPECT_DOUBLE_EQ(SgldStepVariance(p, 8), 0.02 / 3);
+}
+
+TEST(Sgld, UpdatesFollowTheScheduleWithClampingAndAreDeterministic) {
+  // Constant gradient w: replay the documented update with the same random stream.
+  const int n = 1, D = 7;
+  Eigen::VectorXf w(D);
+  w << 30, -30, 0.5, -0.5, 0, 100, -100;
+  const EnergyModel m(LinearEnergy(n, w));
+  SgldParams p;
+  p.particles = 13;
+  p.steps = 7;
+  p.step_scale = 0.05;
+  Eigen::VectorXf ctx = Eigen::VectorXf::Zero(26);
+  auto ws = m.MakeWorkspace(p.particles);
+  std::mt19937_64 rng(99);
+  const SgldResult r = RunSgld(m, ctx, p, &rng, &ws);
+  // replay
+  std::mt19937_64 replay(99);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  Eigen::MatrixXf u(D, p.particles);
+  for (int i = 0; i < u.size(); ++i) u.data()[i] = static_cast<float>(uniform(replay));
+  for (int k = 0; k < p.steps; ++k) {
+    const double s2 = p.step_scale / std::sqrt(1.0 + k);
+    for (int j = 0; j < p.particles; ++j)
+      for (int d = 0; d < D; ++d)
+        u(d, j) = static_cast<float>(
+            std::clamp(u(d, j) - s2 / 2 * w[d] + std::sqrt(s2) * normal(replay), -1.0, 1.0));
+  }
+  Eigen::VectorXf e = (w.transpose() * u).transpose().array() + 0.5f;
+  ASSERT_EQ(r.u.cols(), p.particles);
+  EXPECT_EQ(r.dropped, 0);
+  // sorted by energy ascending; the same set of particles as the replay
+  for (int j = 0; j + 1 < p.particles; ++j) EXPECT_LE(r.energy[j], r.energy[j + 1]);
+  for (int j = 0; j < p.particles; ++j) {
+    Eigen::Index best;
+    (u.colwise() - r.u.col(j)).colwise().norm().minCoeff(&best);
+    EXPECT_LT((u.col(best) - r.u.col(j)).norm(), 1e-5f);
+    EXPECT_NEAR(r.energy[j], e[best], 1e-4);
+  }
+  // strong gradients pin the coordinates at the bounds (clamped)
+  EXPECT_TRUE((r.u.row(5).array() == -1.0f).all());
+  EXPECT_TRUE((r.u.row(6).array() == 1.0f).all());
+  EXPECT_TRUE((r.u.array().abs() <= 1.0f).all());
+  // deterministic for a given rng state; another state differs
+  std::mt19937_64 again(99);
+  const SgldResult r2 = RunSgld(m, ctx, p, &again, &ws);
+  EXPECT_EQ(r2.u, r.u);
+  EXPECT_EQ(r2.energy, r.energy);
+  std::mt19937_64 other(100);
+  EXPECT_NE(RunSgld(m, ctx, p, &other, &ws).u, r.u);
+}
+
+TEST(Sgld, DescendsTheEnergyToItsMinimum) {
+  const float target = 0.3f;
+  const EnergyModel m(AbsEnergy(2, target, 100.0f));
+  SgldParams p;  // defaults: 200 particles, 50 steps, step_scale 0.01
+  Eigen::VectorXf ctx = Eigen::VectorXf::Zero(26);
+  auto ws = m.MakeWorkspace(p.particles);
+  std::mt19937_64 rng(3);
+  // initial energies of uniform particles: mean |u - 0.3| = 0.545 per coordinate
+  const SgldResult r = RunSgld(m, ctx, p, &rng, &ws);
+  ASSERT_EQ(r.u.cols(), 200);
+  const double mean_abs = (r.u.array() - target).abs().mean();
+  EXPECT_LT(mean_abs, 0.1) << "particles did not move to the minimum";
+  EXPECT_LT(r.energy.mean(), 100.0 * 14 * 0.1);
+  for (int j = 0; j + 1 < r.u.cols(); ++j) EXPECT_LE(r.energy[j], r.energy[j + 1]);
+  // without steps, the particles stay uniform
+  SgldParams none = p;
+  none.steps = 0;
+  const SgldResult r0 = RunSgld(m, ctx, none, &rng, &ws);
+  EXPECT_GT((r0.u.array() - target).abs().mean(), 0.4);
+  EXPECT_GT(r0.energy.mean(), 5 * r.energy.mean());
+}
+
+TEST(Sgld, NonFiniteParticlesAreDroppedAndCountedOrAnError) {
+  // E = 1e30 relu(1e30 u_0): +inf energy and gradient for u_0 > 0, finite (0) otherwise.
+  EnergyModelParts parts = RandomParts(1, {}, 1);
+  DenseLayer h, o;
+  h.weight = Eigen::MatrixXf::Zero(1, 33);
+  h.weight(0, 26) = 1e30f;
+  h.bias = Eigen::VectorXf::Zero(1);
+  o.weight = Eigen::MatrixXf::Constant(1, 1, 1e30f);
+  o.bias = Eigen::VectorXf::Zero(1);
+  parts.energy = Mlp({h, o});
+  const EnergyModel m(parts);
+  Eigen::VectorXf ctx = Eigen::VectorXf::Zero(26);
+  SgldParams p;
+  p.particles = 100;
+  p.steps = 5;
+  p.max_dropped_share = 1.0;
+  auto ws = m.MakeWorkspace(p.particles);
+  std::mt19937_64 rng(8);
+  const SgldResult r = RunSgld(m, ctx, p, &rng, &ws);
+  EXPECT_GT(r.dropped, 20);
+  EXPECT_EQ(r.dropped + r.u.cols(), p.particles);
+  EXPECT_TRUE(r.energy.allFinite());
+  EXPECT_TRUE((r.u.row(0).array() <= 0.0f).all());
+  p.max_dropped_share = 0.1;
+  std::mt19937_64 rng2(8);
+  ExpectErrorContains([&] { RunSgld(m, ctx, p, &rng2, &ws); },
+                      {"of 100 particles became non-finite", "max_dropped_share 0.1"});
+  p.particles = 101;
+  ExpectErrorContains([&] { RunSgld(m, ctx, p, &rng2, &ws); }, {"101 particles", "100"});
+}
+
+TEST(Sgld, ParamsSerialize) {
+  SgldParams p;
+  p.particles = 20;
+  const SgldParams back =
+      config::FromYaml<SgldParams>(config::ParseYaml(config::ToYaml(p), "t"), "t");
+  EXPECT_EQ(back.particles, 20);
+  EXPECT_EQ(back.steps, 50);
+  ExpectErrorContains(
+      [] {
+        config::FromYaml<SgldParams>(config::ParseYaml("max_dropped_share: 2", "s.yaml"), "s.yaml");
+      },
+      {"s.yaml", "max_dropped_share"});
+}
+
+TEST(LearnedSampler, ReturnsTheLowestEnergyParticlesInRadians) {
+  const float target = -0.5f;
+  const EnergyModel m(AbsEnergy(2, target, 100.0f));
+  SgldParams p;
+  p.particles = 50;
+  p.steps = 30;
+  LearnedSampler s(m, p);
+  EXPECT_EQ(s.name(), "learned");
+  CommandSampler* base = &s;
+  std::mt19937_64 rng(4);
+  Eigen::MatrixXd out;
+  ExpectErrorContains([&] { base->Sample(SomeQuery(), 2, 5, &rng, &out); }, {"SetWorld"});
+  s.SetWorld(SomeWorld());
+  ExpectErrorContains([&] { base->Sample(SomeQuery(), 1, 5, &rng, &out); },
+                      {"1 intermediate commands", "trained for 2"});
+  base->Sample(SomeQuery(), 2, 5, &rng, &out);
+  ASSERT_EQ(out.rows(), 14);
+  ASSERT_EQ(out.cols(), 5);
+  EXPECT_EQ(s.last_result().u.cols(), 50);
+  EXPECT_EQ(s.last_dropped(), 0);
+  EXPECT_EQ(s.last_filled(), 0);
+  EXPECT_GT(s.last_seconds(), 0);
+  for (int c = 0; c < 5; ++c) {
+    EXPECT_TRUE(out.col(c).isApprox(m.CommandsToRadians(s.last_result().u.col(c))));
+    // near Denormalise(target) per joint
+    const JointVector expect = m.Denormalise(JointVector::Constant(target));
+    for (int k = 0; k < 2; ++k)
+      for (int j = 0; j < kDof; ++j)
+        EXPECT_NEAR(out(7 * k + j, c), expect[j], 0.1 * (m.parts().upper - m.parts().lower)[j]);
+  }
+  // more candidates than particles: SGLD runs with `count` particles
+  base->Sample(SomeQuery(), 2, 80, &rng, &out);
+  EXPECT_EQ(out.cols(), 80);
+  EXPECT_EQ(s.last_result().u.cols(), 80);
+}
+
+}  // namespace
+}  // namespace foresight::manipulation

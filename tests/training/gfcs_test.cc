@@ -1,0 +1,184 @@
+// Self-supervised GFCS (thesis ch 9): the InfoNCE loss against its definition, the LibTorch
+// energy network against the engine that runs it, and the loop's resume (a run stopped at an
+// arbitrary solve and continued ends with the same model as an uninterrupted one).
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <thread>
+
+#include "core/config.h"
+#include "inference/manipulation/energy_model.h"
+#include "models/gfcs/gfcs_nets.h"
+#include "tests/test_util.h"
+#include "training/gfcs/config.h"
+#include "training/gfcs/loop.h"
+#include "training/gfcs/pipeline.h"
+
+namespace foresight {
+namespace {
+namespace fs = std::filesystem;
+
+TEST(InfoNce, MatchesTheDefinitionPerPositive) {
+  torch::manual_seed(3);
+  const torch::Tensor pos = torch::randn({5}, torch::kFloat64);
+  const torch::Tensor neg = torch::randn({5, 7}, torch::kFloat64) * 2;
+  double expected = 0;
+  for (int j = 0; j < 5; ++j) {
+    // -log(e^{-E+} / (e^{-E+} + sum_k e^{-E-_k})), thesis eq. "lossimpli" with the errata's sign.
+    double denominator = std::exp(-pos[j].item<double>());
+    for (int k = 0; k < 7; ++k) denominator += std::exp(-neg[j][k].item<double>());
+    expected += -std::log(std::exp(-pos[j].item<double>()) / denominator) / 5;
+  }
+  EXPECT_NEAR(InfoNceLoss(pos, neg).item<double>(), expected, 1e-12);
+  // Lower positive energy is better: the loss falls when E+ falls.
+  EXPECT_LT(InfoNceLoss(pos - 1, neg).item<double>(), InfoNceLoss(pos, neg).item<double>());
+}
+
+TEST(EnergyNet, TheEngineComputesWhatLibTorchTrained) {
+  torch::manual_seed(5);
+  const int encoding = 6, commands = 14, context = 21 + encoding;
+  EnergyNet net(context, commands, 32, 3);
+  manipulation::EnergyModelParts parts;
+  parts.lattice.spacing = 1.0;
+  const int n_r = parts.lattice.size();
+  parts.bps_mean = Eigen::VectorXf::Zero(n_r);
+  parts.bps_std = Eigen::VectorXf::Ones(n_r);
+  DenseLayer enc;
+  enc.weight = Eigen::MatrixXf::Random(encoding, n_r);
+  enc.bias = Eigen::VectorXf::Zero(encoding);
+  parts.encoder = Mlp({enc});
+  parts.energy = net->net()->ToMlp();
+  parts.intermediate_commands = 2;
+  const manipulation::EnergyModel model(parts);
+
+  const torch::Tensor ctx = torch::randn({1, context});
+  const torch::Tensor u = torch::rand({1, 9, commands}) * 2 - 1;
+  const torch::Tensor e = net->forward(ctx, u);  // [1, 9]
+  Eigen::VectorXf c(context), energy;
+  for (int i = 0; i < context; ++i) c[i] = ctx[0][i].item<float>();
+  Eigen::MatrixXf uu(commands, 9), grad;
+  for (int k = 0; k < 9; ++k)
+    for (int d = 0; d < commands; ++d) uu(d, k) = u[0][k][d].item<float>();
+  auto ws = model.MakeWorkspace(9);
+  model.EnergyAndGradient(c, uu, &energy, &grad, &ws);
+  for (int k = 0; k < 9; ++k) EXPECT_NEAR(energy[k], e[0][k].item<float>(), 1e-5) << k;
+
+  // The round trip through engine weights keeps the network.
+  EnergyNet copy(context, commands, 32, 3);
+  copy->net()->LoadMlp(parts.energy);
+  EXPECT_TRUE(torch::allclose(copy->forward(ctx, u), e));
+}
+
+/// The tiny self-supervised run of these tests (built-in Panda, generated scenes).
+GfcsTrainConfig TinyConfig() {
+  return config::ExperimentConfigFromYaml<GfcsTrainConfig>(
+      "model: gfcs\nrobot: builtin\ntrain_problems: [{source: synthetic, synthetic_count: 3}]\n"
+      "lattice: {spacing: 0.6}\nautoencoder: {encoding: 4, hidden: 8, train: {epochs: 3, "
+      "batch_size: 2, progress: none}}\nenergy: {hidden: 16, layers: 2}\nloop: {passes: 2, "
+      "train_every: 2, adam_steps: 4, learning_rate: 0.01, negatives: 3, negative_sgld: {steps: "
+      "3}, batches: 2, batch_size: 6}\nsampler: {particles: 6, steps: 3}\n",
+      "<tiny gfcs>");
+}
+
+std::vector<Eigen::MatrixXf> EnergyWeights(const std::string& artifact) {
+  const manipulation::EnergyModel model = manipulation::EnergyModel::Load(artifact);
+  std::vector<Eigen::MatrixXf> out;
+  for (const DenseLayer& l : model.parts().energy.layers()) out.push_back(l.weight);
+  return out;
+}
+
+TEST(GfcsLoop, AResumedRunEndsWithTheModelOfAnUninterruptedOne) {
+  const GfcsTrainConfig c = TinyConfig();
+  testing::TempDir dir;
+  const std::string whole = dir.File("whole"), broken = dir.File("broken");
+  ASSERT_TRUE(TrainGfcsRun(c, whole, false, nullptr));
+
+  // Stop the second run as soon as its loop has written a checkpoint (some solve, not chosen).
+  std::atomic<bool> stop{false};
+  std::thread watcher([&] {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+    while (!fs::exists(LoopCheckpointPath(broken, 0)) &&
+           std::chrono::steady_clock::now() < deadline)
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    stop = true;
+  });
+  const bool finished = TrainGfcsRun(c, broken, false, &stop);
+  watcher.join();
+  EXPECT_FALSE(finished) << "the run was stopped before its end";
+  ASSERT_TRUE(TrainGfcsRun(c, broken, true, nullptr));
+
+  const auto a = EnergyWeights(whole + "/model.h5"), b = EnergyWeights(broken + "/model.h5");
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) EXPECT_TRUE(a[i].isApprox(b[i], 1e-6f)) << i;
+  EXPECT_NE(testing::ReadText(whole + "/loop_summary.json").find("\"solves\": 6"),
+            std::string::npos);
+
+  // A checkpoint from another config is refused with the key that differs.
+  GfcsTrainConfig other = c;
+  other.loop.adam_steps = 5;
+  GfcsEncoding enc;
+  Mlp energy;
+  testing::ExpectErrorContains(
+      [&] { LoadLoopResult(other, config::ToYaml(other), whole, &enc, &energy); },
+      {"another config", "adam_steps: 5"});
+}
+
+/// `command` in bash; its exit status.
+int Shell(const std::string& command) {
+  const int s = std::system(("bash -c '" + command + "'").c_str());
+  return WIFEXITED(s) ? WEXITSTATUS(s) : 128;
+}
+
+TEST(GfcsLoop, TwoRanksShareTheSolvesAndEndWithTheModelOfOne) {
+  GfcsTrainConfig c = TinyConfig();
+  c.loop.threads = 1;
+  c.autoencoder.train.threads = 1;
+  testing::TempDir dir;
+  const std::string config = dir.File("tiny.yaml");
+  testing::WriteText(config, config::ToYaml(c));
+  const std::string cli = FORESIGHT_CLI, d = dir.path();
+  ASSERT_EQ(Shell("cd " + d + " && timeout 120 " + cli +
+                  " train tiny.yaml --run-dir one --no-eval > one.out 2>&1"),
+            0)
+      << testing::ReadText(d + "/one.out");
+  const std::string rank = "FORESIGHT_STORE_FILE=" + d +
+                           "/store FORESIGHT_DIST_TIMEOUT_S=60 WORLD_SIZE=2 timeout 120 " + cli +
+                           " train tiny.yaml --run-dir two --no-eval";
+  ASSERT_EQ(Shell("cd " + d + " && (RANK=0 " + rank + " > r0.out 2>&1 & p0=$!; RANK=1 " + rank +
+                  " > r1.out 2>&1 & p1=$!; wait $p0; a=$?; wait $p1; b=$?; exit $((a | b)))"),
+            0)
+      << testing::ReadText(d + "/r0.out") << testing::ReadText(d + "/r1.out");
+  // Rank 1 solved its share (every other solve of a block) and kept its own checkpoint.
+  EXPECT_NE(testing::ReadText(d + "/two/log.rank1.txt").find("solve 2/6"), std::string::npos);
+  EXPECT_TRUE(fs::exists(LoopCheckpointPath(d + "/two", 1)));
+  const auto a = EnergyWeights(d + "/one/model.h5"), b = EnergyWeights(d + "/two/model.h5");
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i)
+    EXPECT_EQ((a[i] - b[i]).cwiseAbs().maxCoeff(), 0.0f) << "layer " << i;
+}
+
+TEST(GfcsConfig, HeldOutProblemsMayNotOverlapTheTrainingOnes) {
+  testing::ExpectErrorContains(
+      [] {
+        (void)config::ExperimentConfigFromYaml<GfcsTrainConfig>(
+            "model: gfcs\ntrain_problems: [{family: box_panda, first: 1, last: 50}]\n"
+            "eval: {problems: [{family: box_panda, first: 40, last: 60}]}\n",
+            "overlap.yaml");
+      },
+      {"overlap.yaml", "eval.problems", "overlaps"});
+  testing::ExpectErrorContains(
+      [] {
+        (void)config::ExperimentConfigFromYaml<GfcsTrainConfig>(
+            "model: gfcs\ngfcs: {commands: 1}\n", "one.yaml");
+      },
+      {"one.yaml", "gfcs.commands"});
+}
+
+}  // namespace
+}  // namespace foresight

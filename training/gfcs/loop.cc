@@ -1,0 +1,641 @@
+#include "training/gfcs/loop.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <memory>
+#include <random>
+#include <sstream>
+#include <thread>
+
+#include "core/error.h"
+#include "core/file_io.h"
+#include "core/log.h"
+#include "inference/manipulation/fabric.h"
+#include "inference/manipulation/gfcs.h"
+#include "training/distributed.h"
+
+namespace foresight {
+namespace fs = std::filesystem;
+using manipulation::EnergyModel;
+using manipulation::JointVector;
+
+namespace {
+
+double Seconds(std::chrono::steady_clock::time_point since) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
+/// A seed for stream `what` of counter `k` (and `j`): splitmix64 of the combination, so streams
+/// of neighbouring counters are unrelated.
+std::uint64_t StreamSeed(std::int64_t seed, std::uint64_t what, std::uint64_t k,
+                         std::uint64_t j = 0) {
+  std::uint64_t z = static_cast<std::uint64_t>(seed) ^ (what * 0x9E3779B97F4A7C15ull) ^
+                    (k * 0xBF58476D1CE4E5B9ull) ^ (j * 0x94D049BB133111EBull);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+constexpr std::uint64_t kNegativeStream = 1, kBatchStream = 2;
+
+// --- Byte packing of positives (the rank gather and nothing else) ---------------------------
+
+void PutInt(std::string* s, std::int64_t v) { s->append(reinterpret_cast<const char*>(&v), 8); }
+std::int64_t GetInt(const std::string& s, std::size_t* at) {
+  FS_THROW_UNLESS(*at + 8 <= s.size(), "gfcs loop: truncated gather message");
+  std::int64_t v;
+  std::memcpy(&v, s.data() + *at, 8);
+  *at += 8;
+  return v;
+}
+
+/// What one rank contributes to a block: its solves and their positives.
+struct BlockResult {
+  int solves = 0, solved = 0, dropped = 0;
+  std::vector<GfcsPositive> positives;
+};
+
+std::string Pack(const BlockResult& r) {
+  std::string s;
+  PutInt(&s, r.solves);
+  PutInt(&s, r.solved);
+  PutInt(&s, r.dropped);
+  PutInt(&s, static_cast<std::int64_t>(r.positives.size()));
+  for (const GfcsPositive& p : r.positives) {
+    PutInt(&s, p.problem);
+    PutInt(&s, p.solve);
+    float cost = p.cost;
+    s.append(reinterpret_cast<const char*>(&cost), sizeof cost);
+    PutInt(&s, p.u.size());
+    s.append(reinterpret_cast<const char*>(p.u.data()), sizeof(float) * p.u.size());
+  }
+  return s;
+}
+
+BlockResult Unpack(const std::string& s) {
+  BlockResult r;
+  std::size_t at = 0;
+  r.solves = static_cast<int>(GetInt(s, &at));
+  r.solved = static_cast<int>(GetInt(s, &at));
+  r.dropped = static_cast<int>(GetInt(s, &at));
+  const std::int64_t n = GetInt(s, &at);
+  for (std::int64_t i = 0; i < n; ++i) {
+    GfcsPositive p;
+    p.problem = static_cast<int>(GetInt(s, &at));
+    p.solve = static_cast<int>(GetInt(s, &at));
+    FS_THROW_UNLESS(at + sizeof(float) <= s.size(), "gfcs loop: truncated gather message");
+    std::memcpy(&p.cost, s.data() + at, sizeof(float));
+    at += sizeof(float);
+    const std::int64_t d = GetInt(s, &at);
+    FS_THROW_UNLESS(d >= 0 && at + sizeof(float) * d <= s.size(),
+                    "gfcs loop: truncated gather message");
+    p.u.resize(d);
+    std::memcpy(p.u.data(), s.data() + at, sizeof(float) * d);
+    at += sizeof(float) * d;
+    r.positives.push_back(std::move(p));
+  }
+  return r;
+}
+
+// --- Tensors <-> Eigen ------------------------------------------------------------------------
+
+torch::Tensor ToTensor(const Eigen::VectorXf& v) {
+  return torch::from_blob(const_cast<float*>(v.data()), {v.size()}, torch::kFloat32).clone();
+}
+Eigen::VectorXf ToVector(const torch::Tensor& t) {
+  const torch::Tensor c = t.contiguous().to(torch::kFloat32);
+  return Eigen::Map<const Eigen::VectorXf>(c.data_ptr<float>(), c.numel());
+}
+torch::Tensor Int64Tensor(const std::vector<std::int64_t>& v) {
+  return torch::tensor(v, torch::kInt64);
+}
+
+/// A fresh tensor per key: InputArchive::read into a defined tensor re-points it in place.
+torch::Tensor Read(torch::serialize::InputArchive* a, const std::string& key) {
+  torch::Tensor t;
+  a->read(key, t);
+  return t;
+}
+
+// --- Positives <-> the buffer tensors of a checkpoint --------------------------------------------
+
+void WritePositives(torch::serialize::OutputArchive* a, const std::string& key,
+                    const std::vector<GfcsPositive>& list, int dim) {
+  std::vector<std::int64_t> problem, solve;
+  torch::Tensor cost = torch::zeros({static_cast<std::int64_t>(list.size())}, torch::kFloat32);
+  torch::Tensor u = torch::zeros({static_cast<std::int64_t>(list.size()), dim}, torch::kFloat32);
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    problem.push_back(list[i].problem);
+    solve.push_back(list[i].solve);
+    cost[static_cast<std::int64_t>(i)] = list[i].cost;
+    u[static_cast<std::int64_t>(i)] = ToTensor(list[i].u);
+  }
+  a->write(key + ".problem", Int64Tensor(problem));
+  a->write(key + ".solve", Int64Tensor(solve));
+  a->write(key + ".cost", cost);
+  a->write(key + ".u", u);
+}
+
+std::vector<GfcsPositive> ReadPositives(torch::serialize::InputArchive* a, const std::string& key) {
+  const torch::Tensor problem = Read(a, key + ".problem"), solve = Read(a, key + ".solve"),
+                      cost = Read(a, key + ".cost"), u = Read(a, key + ".u");
+  std::vector<GfcsPositive> out(static_cast<std::size_t>(problem.size(0)));
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    const auto k = static_cast<std::int64_t>(i);
+    out[i].problem = static_cast<int>(problem[k].item<std::int64_t>());
+    out[i].solve = static_cast<int>(solve[k].item<std::int64_t>());
+    out[i].cost = cost[k].item<float>();
+    out[i].u = ToVector(u[k]);
+  }
+  return out;
+}
+
+torch::Tensor TextTensor(const std::string& s) {
+  return torch::from_blob(const_cast<char*>(s.data()), {static_cast<std::int64_t>(s.size())},
+                          torch::kUInt8)
+      .clone();
+}
+std::string TensorText(const torch::Tensor& t) {
+  const torch::Tensor c = t.contiguous();
+  return std::string(reinterpret_cast<const char*>(c.data_ptr<std::uint8_t>()),
+                     static_cast<std::size_t>(c.numel()));
+}
+
+/// The first line where two YAML texts differ (the key a foreign checkpoint disagrees on).
+std::string FirstDifference(const std::string& a, const std::string& b) {
+  std::istringstream sa(a), sb(b);
+  std::string la, lb;
+  while (true) {
+    const bool ga = static_cast<bool>(std::getline(sa, la));
+    const bool gb = static_cast<bool>(std::getline(sb, lb));
+    if (!ga && !gb) return "";
+    if (!ga || !gb || la != lb)
+      return "'" + (gb ? lb : std::string("<end>")) + "' here, '" +
+             (ga ? la : std::string("<end>")) + "' in the checkpoint";
+  }
+}
+
+void WriteMlp(torch::serialize::OutputArchive* a, const std::string& key, const Mlp& mlp) {
+  a->write(key + ".layers", Int64Tensor({static_cast<std::int64_t>(mlp.layers().size())}));
+  for (std::size_t i = 0; i < mlp.layers().size(); ++i) {
+    const DenseLayer& l = mlp.layers()[i];
+    const Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> w = l.weight;
+    a->write(key + ".w" + std::to_string(i),
+             torch::from_blob(const_cast<float*>(w.data()), {w.rows(), w.cols()}, torch::kFloat32)
+                 .clone());
+    a->write(key + ".b" + std::to_string(i), ToTensor(l.bias));
+  }
+}
+
+Mlp ReadMlp(torch::serialize::InputArchive* a, const std::string& key) {
+  const torch::Tensor n = Read(a, key + ".layers");
+  std::vector<DenseLayer> layers;
+  for (std::int64_t i = 0; i < n[0].item<std::int64_t>(); ++i) {
+    const torch::Tensor w = Read(a, key + ".w" + std::to_string(i));
+    const torch::Tensor b = Read(a, key + ".b" + std::to_string(i));
+    DenseLayer l;
+    const torch::Tensor wc = w.contiguous();
+    l.weight =
+        Eigen::Map<const Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
+            wc.data_ptr<float>(), wc.size(0), wc.size(1));
+    l.bias = ToVector(b);
+    layers.push_back(std::move(l));
+  }
+  return Mlp(std::move(layers));
+}
+
+/// Everything a checkpoint holds besides the network and the optimiser.
+struct LoopState {
+  int block_start = 0;  ///< first solve of the current block
+  int rank_next = 0;    ///< this rank's next solve (>= block_start)
+  int solves = 0, solved = 0, rounds = 0, dropped = 0;
+  double last_loss = 0;
+  std::vector<GfcsPositive> buffer;
+  BlockResult pending;  ///< this rank's results in the current block
+};
+
+int CommandSize(const GfcsTrainConfig& c) { return manipulation::kDof * (c.gfcs.commands - 1); }
+
+EnergyNet MakeNet(const GfcsTrainConfig& c, int context_size) {
+  return EnergyNet(context_size, CommandSize(c), c.energy.hidden, c.energy.layers);
+}
+
+/// Commands in radians [7n] -> normalised [-1, 1] and back, joint by joint.
+Eigen::VectorXf Normalise(const Eigen::VectorXd& q, const manipulation::JointLimits& l) {
+  Eigen::VectorXf u(q.size());
+  for (Eigen::Index i = 0; i < q.size(); ++i) {
+    const int j = static_cast<int>(i % manipulation::kDof);
+    u[i] = static_cast<float>(2 * (q[i] - l.lower[j]) / (l.upper[j] - l.lower[j]) - 1);
+  }
+  return u;
+}
+
+class Loop {
+ public:
+  Loop(const GfcsTrainConfig& c, const std::string& config_yaml,
+       const manipulation::RobotModel& robot, const GfcsEncoding& encoding,
+       const std::vector<GfcsTrainingProblem>& problems, const std::string& run_dir)
+      : c_(c),
+        yaml_(config_yaml),
+        robot_(robot),
+        encoding_(encoding),
+        problems_(problems),
+        run_dir_(run_dir),
+        group_(dist::DefaultGroup()),
+        net_(MakeNet(c, static_cast<int>(problems.front().context.size()))),
+        adam_(net_->parameters(), torch::optim::AdamOptions(c.loop.learning_rate)) {}
+
+  GfcsLoopStats Run(bool resume, const std::atomic<bool>* interrupt);
+  Mlp Energy() const { return net_->net()->ToMlp(); }
+
+ private:
+  void Save();
+  void Load();
+  void RebuildSampler();
+  void Solve(int s);
+  void FinishBlock(int block_end);
+  void TrainRound();
+  std::string Where(int s) const;
+
+  const GfcsTrainConfig& c_;
+  const std::string& yaml_;
+  const manipulation::RobotModel& robot_;
+  const GfcsEncoding& encoding_;
+  const std::vector<GfcsTrainingProblem>& problems_;
+  std::string run_dir_;
+  std::shared_ptr<dist::Group> group_;
+  EnergyNet net_;
+  torch::optim::Adam adam_;
+  LoopState st_;
+  GfcsLoopStats stats_;
+  std::unique_ptr<EnergyModel> engine_;
+  std::unique_ptr<manipulation::LearnedSampler> sampler_;
+  std::chrono::steady_clock::time_point started_ = std::chrono::steady_clock::now();
+};
+
+std::string Loop::Where(int s) const {
+  const GfcsTrainingProblem& p = problems_[static_cast<std::size_t>(s) % problems_.size()];
+  return p.family + " #" + std::to_string(p.problem.index);
+}
+
+void Loop::Save() {
+  torch::serialize::OutputArchive a;
+  a.write("config_yaml", TextTensor(yaml_));
+  a.write("world_size", Int64Tensor({group_->size()}));
+  a.write("counters", Int64Tensor({st_.block_start, st_.rank_next, st_.solves, st_.solved,
+                                   st_.rounds, st_.dropped}));
+  a.write("last_loss", torch::tensor({st_.last_loss}, torch::kFloat64));
+  a.write("pending.counts",
+          Int64Tensor({st_.pending.solves, st_.pending.solved, st_.pending.dropped}));
+  WritePositives(&a, "buffer", st_.buffer, CommandSize(c_));
+  WritePositives(&a, "pending", st_.pending.positives, CommandSize(c_));
+  a.write("encoding.bps_mean", ToTensor(encoding_.bps_mean));
+  a.write("encoding.bps_std", ToTensor(encoding_.bps_std));
+  WriteMlp(&a, "encoding.encoder", encoding_.encoder);
+  torch::serialize::OutputArchive net, adam;
+  net_->save(net);
+  adam_.save(adam);
+  a.write("net", net);
+  a.write("adam", adam);
+  std::ostringstream os;
+  a.save_to(os);
+  WriteFileAtomically(LoopCheckpointPath(run_dir_, group_->rank()), os.str());
+}
+
+void Loop::Load() {
+  const std::string path = LoopCheckpointPath(run_dir_, group_->rank());
+  torch::serialize::InputArchive a;
+  try {
+    a.load_from(path);
+  } catch (const std::exception& e) {
+    Fail(path, ": cannot read the loop checkpoint (", std::string(e.what()).substr(0, 120), ")");
+  }
+  const std::string diff = FirstDifference(yaml_, TensorText(Read(&a, "config_yaml")));
+  FS_THROW_UNLESS(diff.empty(), path, ": the checkpoint is from another config (", diff, ")");
+  torch::Tensor t = Read(&a, "world_size");
+  FS_THROW_UNLESS(t[0].item<std::int64_t>() == group_->size(), path, ": written by a run of ",
+                  t[0].item<std::int64_t>(), " ranks, this one has ", group_->size(),
+                  " (resume with the same WORLD_SIZE)");
+  t = Read(&a, "counters");
+  st_.block_start = static_cast<int>(t[0].item<std::int64_t>());
+  st_.rank_next = static_cast<int>(t[1].item<std::int64_t>());
+  st_.solves = static_cast<int>(t[2].item<std::int64_t>());
+  st_.solved = static_cast<int>(t[3].item<std::int64_t>());
+  st_.rounds = static_cast<int>(t[4].item<std::int64_t>());
+  st_.dropped = static_cast<int>(t[5].item<std::int64_t>());
+  st_.last_loss = Read(&a, "last_loss")[0].item<double>();
+  t = Read(&a, "pending.counts");
+  st_.pending.solves = static_cast<int>(t[0].item<std::int64_t>());
+  st_.pending.solved = static_cast<int>(t[1].item<std::int64_t>());
+  st_.pending.dropped = static_cast<int>(t[2].item<std::int64_t>());
+  st_.buffer = ReadPositives(&a, "buffer");
+  st_.pending.positives = ReadPositives(&a, "pending");
+  torch::serialize::InputArchive net, adam;
+  a.read("net", net);
+  a.read("adam", adam);
+  net_->load(net);
+  adam_.load(adam);
+}
+
+void Loop::RebuildSampler() {
+  sampler_.reset();
+  engine_.reset();
+  if (st_.rounds == 0) return;
+  engine_ = std::make_unique<EnergyModel>(MakeEnergyParts(c_, robot_, encoding_, Energy()));
+  sampler_ = std::make_unique<manipulation::LearnedSampler>(*engine_, c_.sampler);
+}
+
+void Loop::Solve(int s) {
+  const GfcsTrainingProblem& p = problems_[static_cast<std::size_t>(s) % problems_.size()];
+  const auto started = std::chrono::steady_clock::now();
+  const manipulation::Fabric fabric(robot_, p.problem.world, c_.fabric);
+  manipulation::GfcsParams params = c_.gfcs;
+  params.batches = c_.loop.batches;
+  params.batch_size = c_.loop.batch_size;
+  params.seed = c_.seed + s;
+  manipulation::GfcsQuery query;
+  query.start = p.problem.start;
+  query.goal = p.problem.goal;
+  manipulation::UniformSampler uniform(robot_.limits().lower, robot_.limits().upper);
+  manipulation::CommandSampler* sampler = &uniform;
+  if (sampler_) {
+    sampler_->SetWorld(p.problem.world);
+    sampler = sampler_.get();
+  }
+  const manipulation::GfcsSolution sol = SolveGfcop(fabric, query, sampler, params);
+  FS_THROW_UNLESS(sol.status != manipulation::GfcsStatus::kError, "gfcs loop: solve ", s, " (",
+                  Where(s), "): ", sol.message);
+  if (sampler_) st_.pending.dropped += sampler_->last_dropped();  // one Sample per solve
+  ++st_.pending.solves;
+  st_.pending.solved += sol.solved();
+  const std::size_t before = st_.pending.positives.size();
+  for (const manipulation::GfcsCandidate& cand : sol.top) {
+    if (c_.loop.reached_only && !cand.reached) continue;
+    GfcsPositive pos;
+    pos.problem = static_cast<int>(static_cast<std::size_t>(s) % problems_.size());
+    pos.solve = s;
+    pos.cost = static_cast<float>(cand.cost);
+    pos.u = Normalise(cand.commands, robot_.limits());
+    st_.pending.positives.push_back(std::move(pos));
+  }
+  const double secs = Seconds(started);
+  stats_.solve_seconds += secs;
+  const int total = c_.loop.passes * static_cast<int>(problems_.size());
+  const int done = st_.solves + st_.pending.solves;  // this rank's view
+  const int ok = st_.solved + st_.pending.solved;
+  log::Info("solve ", s + 1, "/", total, " (pass ", s / problems_.size() + 1, ", ", Where(s), ", ",
+            sampler->name(), "): ", sol.solved() ? "solved" : "not solved", ", +",
+            st_.pending.positives.size() - before, " positives; success so far ", ok, "/", done,
+            ", buffer ", st_.buffer.size(), ", last loss ", st_.last_loss, ", ", secs, " s");
+}
+
+void Loop::FinishBlock(int block_end) {
+  // Every rank's results, merged in solve order: the buffer does not depend on the rank count.
+  const std::vector<std::string> parts = group_->AllGatherBytes(Pack(st_.pending));
+  std::vector<GfcsPositive> fresh;
+  for (const std::string& part : parts) {
+    BlockResult r = Unpack(part);
+    st_.solves += r.solves;
+    st_.solved += r.solved;
+    st_.dropped += r.dropped;
+    for (GfcsPositive& p : r.positives) fresh.push_back(std::move(p));
+  }
+  std::stable_sort(fresh.begin(), fresh.end(),
+                   [](const GfcsPositive& a, const GfcsPositive& b) { return a.solve < b.solve; });
+  for (GfcsPositive& p : fresh) st_.buffer.push_back(std::move(p));
+  if (st_.buffer.size() > static_cast<std::size_t>(c_.loop.buffer))
+    st_.buffer.erase(st_.buffer.begin(),
+                     st_.buffer.end() - static_cast<std::ptrdiff_t>(c_.loop.buffer));
+  st_.pending = BlockResult{};
+  if (block_end % c_.loop.train_every == 0 && !st_.buffer.empty()) {
+    TrainRound();
+    ++st_.rounds;
+    RebuildSampler();
+  }
+  st_.block_start = block_end;
+  st_.rank_next = block_end;
+}
+
+void Loop::TrainRound() {
+  const int b_total = static_cast<int>(st_.buffer.size());
+  const int n_neg = c_.loop.negatives;
+  const int dim = CommandSize(c_);
+  const int round = st_.rounds;
+
+  // Negatives: SGLD on the current model from uniform particles (thesis Algorithm, inner loop),
+  // buffer entries dealt over the ranks and, within a rank, over threads.
+  auto neg_started = std::chrono::steady_clock::now();
+  const EnergyModel engine(MakeEnergyParts(c_, robot_, encoding_, Energy()));
+  manipulation::SgldParams sgld = c_.loop.negative_sgld;
+  sgld.particles = n_neg;
+  std::vector<Eigen::MatrixXf> negatives(static_cast<std::size_t>(b_total));
+  std::vector<int> mine;
+  for (int j = group_->rank(); j < b_total; j += group_->size()) mine.push_back(j);
+  const int threads = std::max(1, std::min<int>(c_.loop.threads, static_cast<int>(mine.size())));
+  std::vector<int> dropped(static_cast<std::size_t>(threads), 0);
+  std::vector<std::string> errors(static_cast<std::size_t>(threads));
+  std::vector<std::thread> pool;
+  for (int t = 0; t < threads; ++t)
+    pool.emplace_back([&, t] {
+      try {
+        EnergyModel::Workspace ws = engine.MakeWorkspace(n_neg);
+        for (std::size_t i = static_cast<std::size_t>(t); i < mine.size();
+             i += static_cast<std::size_t>(threads)) {
+          const int j = mine[i];
+          const GfcsPositive& pos = st_.buffer[static_cast<std::size_t>(j)];
+          std::mt19937_64 rng(StreamSeed(c_.seed, kNegativeStream, round, pos.solve * 64 + j));
+          manipulation::SgldResult r = manipulation::RunSgld(
+              engine, problems_[static_cast<std::size_t>(pos.problem)].context, sgld, &rng, &ws);
+          dropped[static_cast<std::size_t>(t)] += r.dropped;
+          Eigen::MatrixXf u(dim, n_neg);
+          for (int k = 0; k < n_neg; ++k) u.col(k) = r.u.col(k % r.u.cols());  // refill dropped
+          negatives[static_cast<std::size_t>(j)] = std::move(u);
+        }
+      } catch (const std::exception& e) {
+        errors[static_cast<std::size_t>(t)] = e.what();
+      }
+    });
+  for (std::thread& th : pool) th.join();
+  for (const std::string& e : errors)
+    FS_THROW_UNLESS(e.empty(), "gfcs loop: training round ", round + 1, ": negatives: ", e);
+  for (int d : dropped) st_.dropped += d;
+  if (group_->size() > 1) {
+    std::string msg;
+    for (int j : mine)
+      msg.append(reinterpret_cast<const char*>(negatives[static_cast<std::size_t>(j)].data()),
+                 sizeof(float) * static_cast<std::size_t>(dim * n_neg));
+    const std::vector<std::string> all = group_->AllGatherBytes(msg);
+    for (int r = 0; r < group_->size(); ++r) {
+      std::size_t at = 0;
+      for (int j = r; j < b_total; j += group_->size()) {
+        Eigen::MatrixXf u(dim, n_neg);
+        FS_THROW_UNLESS(at + sizeof(float) * u.size() <= all[static_cast<std::size_t>(r)].size(),
+                        "gfcs loop: truncated negatives from rank ", r);
+        std::memcpy(u.data(), all[static_cast<std::size_t>(r)].data() + at,
+                    sizeof(float) * static_cast<std::size_t>(u.size()));
+        at += sizeof(float) * static_cast<std::size_t>(u.size());
+        negatives[static_cast<std::size_t>(j)] = std::move(u);
+      }
+    }
+  }
+  stats_.negative_seconds += Seconds(neg_started);
+
+  // InfoNCE over the buffer, each positive against its own negatives.
+  const auto train_started = std::chrono::steady_clock::now();
+  const int context_size = static_cast<int>(problems_.front().context.size());
+  torch::Tensor ctx = torch::empty({b_total, context_size}, torch::kFloat32);
+  torch::Tensor u_all = torch::empty({b_total, 1 + n_neg, dim}, torch::kFloat32);
+  for (int j = 0; j < b_total; ++j) {
+    const GfcsPositive& pos = st_.buffer[static_cast<std::size_t>(j)];
+    ctx[j] = ToTensor(problems_[static_cast<std::size_t>(pos.problem)].context);
+    u_all[j][0] = ToTensor(pos.u);
+    const Eigen::MatrixXf& neg = negatives[static_cast<std::size_t>(j)];
+    u_all[j].slice(0, 1, 1 + n_neg) =
+        torch::from_blob(const_cast<float*>(neg.data()), {n_neg, dim}, torch::kFloat32).clone();
+  }
+  std::mt19937_64 rng(StreamSeed(c_.seed, kBatchStream, round));
+  const int batch = std::min(c_.loop.batch_positives, b_total);
+  std::vector<std::int64_t> order(static_cast<std::size_t>(b_total));
+  net_->train();
+  double loss_sum = 0;
+  for (int step = 0; step < c_.loop.adam_steps; ++step) {
+    // A batch without replacement (a fresh permutation's head), identical on every rank.
+    std::iota(order.begin(), order.end(), 0);
+    for (int i = 0; i < batch; ++i) {
+      std::uniform_int_distribution<int> pick(i, b_total - 1);
+      std::swap(order[static_cast<std::size_t>(i)], order[static_cast<std::size_t>(pick(rng))]);
+    }
+    adam_.zero_grad();
+    const torch::Tensor idx = torch::tensor(
+        std::vector<std::int64_t>(order.begin(), order.begin() + batch), torch::kInt64);
+    const torch::Tensor e = net_->forward(ctx.index_select(0, idx), u_all.index_select(0, idx));
+    const torch::Tensor local = InfoNceLoss(e.select(1, 0), e.slice(1, 1));
+    local.backward();
+    const double value = local.item<double>();
+    FS_THROW_UNLESS(std::isfinite(value), "gfcs loop: training round ", round + 1, ", step ",
+                    step + 1, ": the InfoNCE loss is not finite");
+    loss_sum += value;
+    adam_.step();
+  }
+  net_->eval();
+  st_.last_loss = c_.loop.adam_steps > 0 ? loss_sum / c_.loop.adam_steps : st_.last_loss;
+  stats_.train_seconds += Seconds(train_started);
+  log::Info("training round ", round + 1, ": ", b_total, " positives x ", n_neg, " negatives, ",
+            c_.loop.adam_steps, " Adam steps, mean InfoNCE ", st_.last_loss);
+}
+
+GfcsLoopStats Loop::Run(bool resume, const std::atomic<bool>* interrupt) {
+  torch::set_num_threads(c_.loop.threads);
+  const bool have = fs::exists(LoopCheckpointPath(run_dir_, group_->rank()));
+  if (resume && have) {
+    Load();
+    log::Info("resuming the loop at solve ", st_.rank_next + 1, " (", st_.rounds,
+              " training rounds done, buffer ", st_.buffer.size(), ")");
+  } else {
+    group_->BroadcastParameters(*net_, 0);
+  }
+  RebuildSampler();
+  const int total = c_.loop.passes * static_cast<int>(problems_.size());
+  int since_save = 0;
+  while (st_.block_start < total) {
+    const int block_end =
+        std::min(total, (st_.block_start / c_.loop.train_every + 1) * c_.loop.train_every);
+    for (int s = st_.rank_next; s < block_end; ++s) {
+      if ((s - st_.block_start) % group_->size() != group_->rank()) continue;
+      if (interrupt && interrupt->load()) {
+        Save();
+        stats_.interrupted = true;
+        log::Info("interrupted before solve ", s + 1, "; continue with train --resume");
+        break;
+      }
+      Solve(s);
+      st_.rank_next = s + 1;
+      if (++since_save >= c_.loop.checkpoint_every) {
+        Save();
+        since_save = 0;
+      }
+    }
+    if (stats_.interrupted) break;
+    FinishBlock(block_end);
+    Save();
+    since_save = 0;
+  }
+  stats_.solves = st_.solves;
+  stats_.solved = st_.solved;
+  stats_.rounds = st_.rounds;
+  stats_.last_loss = st_.last_loss;
+  stats_.dropped_particles = st_.dropped;
+  return stats_;
+}
+
+}  // namespace
+
+std::string GfcsLoopStats::ToJson() const {
+  std::ostringstream os;
+  os << "{\"solves\": " << solves << ", \"solved\": " << solved
+     << ", \"success_rate\": " << (solves ? static_cast<double>(solved) / solves : 0.0)
+     << ", \"training_rounds\": " << rounds << ", \"last_loss\": " << last_loss
+     << ", \"dropped_particles\": " << dropped_particles << ", \"solve_seconds\": " << solve_seconds
+     << ", \"negative_seconds\": " << negative_seconds << ", \"train_seconds\": " << train_seconds
+     << ", \"interrupted\": " << (interrupted ? "true" : "false") << "}";
+  return os.str();
+}
+
+std::string LoopCheckpointPath(const std::string& run_dir, int rank) {
+  return run_dir + "/checkpoints/loop" + (rank ? ".rank" + std::to_string(rank) : "") + ".pt";
+}
+
+manipulation::EnergyModelParts MakeEnergyParts(const GfcsTrainConfig& c,
+                                               const manipulation::RobotModel& robot,
+                                               const GfcsEncoding& encoding, const Mlp& energy) {
+  manipulation::EnergyModelParts p;
+  p.lattice = c.lattice;
+  p.bps_mean = encoding.bps_mean;
+  p.bps_std = encoding.bps_std;
+  p.encoder = encoding.encoder;
+  p.energy = energy;
+  p.lower = robot.limits().lower;
+  p.upper = robot.limits().upper;
+  p.velocity_scale = 1.0;
+  p.intermediate_commands = c.gfcs.commands - 1;
+  return p;
+}
+
+GfcsLoopStats RunSelfSupervisedLoop(const GfcsTrainConfig& c, const std::string& config_yaml,
+                                    const manipulation::RobotModel& robot,
+                                    const GfcsEncoding& encoding,
+                                    const std::vector<GfcsTrainingProblem>& problems,
+                                    const std::string& run_dir, bool resume,
+                                    const std::atomic<bool>* interrupt, Mlp* energy) {
+  FS_THROW_UNLESS(!problems.empty(), run_dir, ": no valid training problems");
+  fs::create_directories(run_dir + "/checkpoints");
+  torch::manual_seed(static_cast<std::uint64_t>(c.seed));
+  Loop loop(c, config_yaml, robot, encoding, problems, run_dir);
+  const GfcsLoopStats stats = loop.Run(resume, interrupt);
+  *energy = loop.Energy();
+  return stats;
+}
+
+void LoadLoopResult(const GfcsTrainConfig& c, const std::string& config_yaml,
+                    const std::string& run_dir, GfcsEncoding* encoding, Mlp* energy) {
+  const std::string path = LoopCheckpointPath(run_dir, 0);
+  FS_THROW_UNLESS(fs::exists(path), run_dir,
+                  ": no loop checkpoint (the run has not started its loop; continue it with train "
+                  "--resume)");
+  torch::serialize::InputArchive a;
+  a.load_from(path);
+  const std::string diff = FirstDifference(config_yaml, TensorText(Read(&a, "config_yaml")));
+  FS_THROW_UNLESS(diff.empty(), path, ": the checkpoint is from another config (", diff, ")");
+  encoding->bps_mean = ToVector(Read(&a, "encoding.bps_mean"));
+  encoding->bps_std = ToVector(Read(&a, "encoding.bps_std"));
+  encoding->encoder = ReadMlp(&a, "encoding.encoder");
+  EnergyNet net = MakeNet(c, manipulation::kDof * 3 + encoding->encoder.output_size());
+  torch::serialize::InputArchive n;
+  a.read("net", n);
+  net->load(n);
+  *energy = net->net()->ToMlp();
+}
+
+}  // namespace foresight

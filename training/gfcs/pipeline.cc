@@ -1,0 +1,367 @@
+#include "training/gfcs/pipeline.h"
+
+#include <torch/torch.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <iomanip>
+#include <map>
+#include <random>
+#include <sstream>
+
+#include "core/error.h"
+#include "core/file_io.h"
+#include "core/log.h"
+#include "inference/manipulation/bps.h"
+#include "inference/manipulation/energy_model.h"
+#include "inference/manipulation/validity.h"
+#include "models/gfcs/gfcs_nets.h"
+#include "training/distributed.h"
+#include "training/gfcs/loop.h"
+#include "training/manipulation/plan.h"
+#include "training/run_dir.h"
+#include "training/trainer.h"
+
+namespace foresight {
+namespace fs = std::filesystem;
+using namespace manipulation;  // NOLINT: this file is the gfcs pipeline
+
+namespace {
+
+/// A gfcs run directory holds these; a fresh start refuses a directory holding one.
+const RunDirectoryRules kGfcsRunRules{{"checkpoints", "autoencoder", "model.h5"}, true};
+
+/// The harness config that loads the robot and one problem set.
+ManipulationExperimentConfig HarnessConfig(const GfcsTrainConfig& c,
+                                           const ManipulationProblemsConfig& set) {
+  ManipulationExperimentConfig mc;
+  mc.seed = c.seed;
+  mc.robot = c.robot;
+  mc.problems = set;
+  if (mc.problems.root.empty()) mc.problems.root = c.data.root;
+  mc.fabric = c.fabric;
+  mc.gfcs = c.gfcs;
+  return mc;
+}
+
+std::string SetName(const ManipulationProblemsConfig& set) {
+  return set.source == ProblemSource::kSynthetic ? "synthetic" : set.family;
+}
+
+/// The training problems whose start and goal are valid for the robot model (others skipped).
+std::vector<GfcsTrainingProblem> LoadTrainingProblems(const GfcsTrainConfig& c,
+                                                      const RobotModel& robot) {
+  std::vector<GfcsTrainingProblem> out;
+  for (const ManipulationProblemsConfig& set : c.train_problems) {
+    int skipped = 0;
+    for (ManipulationProblem& p : LoadExperimentProblems(HarnessConfig(c, set), robot)) {
+      const ValidityChecker checker(robot, p.world);
+      KinematicsData data = robot.MakeData();
+      if (checker.Check(p.start, &data) != Validity::kValid ||
+          checker.Check(p.goal, &data) != Validity::kValid) {
+        ++skipped;
+        continue;
+      }
+      out.push_back({SetName(set), std::move(p), {}});
+    }
+    if (skipped)
+      log::Info(SetName(set), ": ", skipped, " problems with an invalid start or goal skipped");
+  }
+  return out;
+}
+
+/// The autoencoder's training task: reconstruction error of normalised BPS distances.
+class AutoencoderTask : public TrainingTask {
+ public:
+  AutoencoderTask(BpsAutoencoder ae, torch::Tensor train, torch::Tensor val)
+      : ae_(std::move(ae)), train_(std::move(train)), val_(std::move(val)) {}
+  torch::nn::Module& module() override { return *ae_; }
+  std::int64_t num_train() const override { return train_.size(0); }
+  torch::Tensor BatchLoss(const torch::Tensor& indices) override {
+    const torch::Tensor x = train_.index_select(0, indices);
+    return torch::mse_loss(ae_->forward(x), x);
+  }
+  double ValidationLoss() override {
+    torch::NoGradGuard no_grad;
+    const torch::Tensor& x = val_.size(0) > 0 ? val_ : train_;
+    return torch::mse_loss(ae_->forward(x), x).item<double>();
+  }
+
+ private:
+  BpsAutoencoder ae_;
+  torch::Tensor train_, val_;
+};
+
+torch::Tensor RowsToTensor(const std::vector<Eigen::VectorXf>& rows) {
+  torch::Tensor t =
+      torch::empty({static_cast<std::int64_t>(rows.size()), rows.front().size()}, torch::kFloat32);
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    std::copy(rows[i].data(), rows[i].data() + rows[i].size(),
+              t[static_cast<std::int64_t>(i)].data_ptr<float>());
+  return t;
+}
+
+/// BPS distances of the training worlds, their normalisation, and the autoencoder (trained by the
+/// trainer in run_dir/autoencoder, resumable). `*interrupted` when the trainer was stopped.
+GfcsEncoding TrainEncoding(const GfcsTrainConfig& c, const RobotModel& robot,
+                           const std::vector<GfcsTrainingProblem>& problems,
+                           const std::string& run_dir, bool resume,
+                           const std::atomic<bool>* interrupt, bool* interrupted) {
+  CheckLatticeCovers(c.lattice, ReachBox(robot), "lattice");
+  std::vector<Eigen::VectorXf> bps;
+  for (const GfcsTrainingProblem& p : problems)
+    bps.push_back(EncodeBps(p.problem.world, c.lattice));
+  const Eigen::Index n_r = bps.front().size();
+  GfcsEncoding enc;
+  enc.bps_mean = Eigen::VectorXf::Zero(n_r);
+  for (const auto& b : bps) enc.bps_mean += b;
+  enc.bps_mean /= static_cast<float>(bps.size());
+  Eigen::VectorXf var = Eigen::VectorXf::Zero(n_r);
+  for (const auto& b : bps) var += (b - enc.bps_mean).cwiseAbs2();
+  // Reference points no scene comes near are constant: a floor keeps them at ~0, not inf.
+  enc.bps_std = (var / static_cast<float>(bps.size())).cwiseSqrt().cwiseMax(0.01f);
+  for (auto& b : bps) b = (b - enc.bps_mean).cwiseQuotient(enc.bps_std);
+  log::Info("basis point set: ", n_r, " reference points (", c.lattice.spacing, " m lattice), ",
+            bps.size(), " training scenes");
+
+  // Held-out scenes for early stopping, a seeded choice.
+  std::vector<std::size_t> order(bps.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::mt19937_64 rng(static_cast<std::uint64_t>(c.seed) + 7);
+  std::shuffle(order.begin(), order.end(), rng);
+  const std::size_t n_val =
+      bps.size() > 1 ? static_cast<std::size_t>(std::floor(c.autoencoder.val_fraction * bps.size()))
+                     : 0;
+  std::vector<Eigen::VectorXf> train, val;
+  for (std::size_t i = 0; i < order.size(); ++i) (i < n_val ? val : train).push_back(bps[order[i]]);
+
+  torch::manual_seed(static_cast<std::uint64_t>(c.seed));
+  BpsAutoencoder ae(static_cast<int>(n_r), c.autoencoder.hidden, c.autoencoder.encoding);
+  AutoencoderTask task(ae, RowsToTensor(train),
+                       val.empty() ? torch::empty({0, n_r}) : RowsToTensor(val));
+  // Every rank trains the (small) autoencoder itself, in its own folder, not data-parallel: the
+  // encoder, hence every context, is then bit-identical for any number of ranks.
+  const int rank = dist::DefaultGroup()->rank();
+  const RunPaths run{run_dir + "/autoencoder" + (rank ? ".rank" + std::to_string(rank) : "")};
+  fs::create_directories(run.dir);
+  TrainHooks hooks;
+  hooks.interrupt = interrupt;
+  const auto local = dist::Group::Local();
+  const TrainingSummary s =
+      Train(&task, c.autoencoder.train, run, static_cast<std::uint64_t>(c.seed),
+            resume && fs::exists(run.Checkpoint()), hooks, local.get());
+  *interrupted = s.reason == TerminationReason::kInterrupted;
+  if (*interrupted) return enc;
+  const std::string ckpt =
+      fs::exists(run.BestCheckpoint()) ? run.BestCheckpoint() : run.Checkpoint();
+  FS_THROW_UNLESS(fs::exists(ckpt), run.dir, ": the autoencoder left no checkpoint (",
+                  ToString(s.reason), ")");
+  LoadCheckpointModel(ckpt, ae.ptr().get());
+  log::Info("autoencoder: ", s.BriefReport());
+  enc.encoder = ae->encoder()->ToMlp();
+  return enc;
+}
+
+/// Fills the problems' contexts [q0, qd0, qg, encoding] with the engine's own encoder.
+void EncodeProblems(const GfcsTrainConfig& c, const RobotModel& robot, const GfcsEncoding& enc,
+                    std::vector<GfcsTrainingProblem>* problems) {
+  const int context = 3 * kDof + enc.encoder.output_size();
+  const int command = kDof * (c.gfcs.commands - 1);
+  // Energy weights do not enter the context: a placeholder layer of the right width.
+  DenseLayer placeholder;
+  placeholder.weight = Eigen::MatrixXf::Zero(1, context + command);
+  placeholder.bias = Eigen::VectorXf::Zero(1);
+  const EnergyModel model(MakeEnergyParts(c, robot, enc, Mlp({placeholder})));
+  for (GfcsTrainingProblem& p : *problems) {
+    GfcsQuery q;
+    q.start = p.problem.start;
+    q.goal = p.problem.goal;
+    model.Context(q, model.EncodeWorld(p.problem.world), &p.context);
+  }
+}
+
+void WriteArtifact(const GfcsTrainConfig& c, const RobotModel& robot, const GfcsEncoding& enc,
+                   const Mlp& energy, const std::string& yaml, const std::string& path) {
+  EnergyModel(MakeEnergyParts(c, robot, enc, energy)).Save(path, yaml, c.seed);
+  (void)EnergyModel::Load(path);  // the engine loads what was written
+}
+
+RobotModel LoadRobot(const GfcsTrainConfig& c) {
+  FS_THROW_UNLESS(!c.train_problems.empty(), "gfcs: train_problems is empty");
+  return LoadExperimentRobot(HarnessConfig(c, c.train_problems.front()));
+}
+
+// --- Evaluation -------------------------------------------------------------------------------
+
+struct PairedDifference {
+  int n = 0;
+  double mean = 0, lo = 0, hi = 0;
+};
+
+/// Mean of `d` with a 95 % percentile-bootstrap interval (2000 resamples, fixed seed).
+PairedDifference Bootstrap(const std::vector<double>& d, std::uint64_t seed) {
+  PairedDifference out;
+  out.n = static_cast<int>(d.size());
+  if (d.empty()) return out;
+  for (double v : d) out.mean += v / static_cast<double>(d.size());
+  std::mt19937_64 rng(seed);
+  std::uniform_int_distribution<std::size_t> pick(0, d.size() - 1);
+  std::vector<double> means(2000);
+  for (double& m : means) {
+    double s = 0;
+    for (std::size_t i = 0; i < d.size(); ++i) s += d[pick(rng)];
+    m = s / static_cast<double>(d.size());
+  }
+  std::sort(means.begin(), means.end());
+  out.lo = means[50];
+  out.hi = means[1949];
+  return out;
+}
+
+std::string Num(double v) {
+  if (!std::isfinite(v)) return "null";
+  std::ostringstream os;
+  os << std::setprecision(6) << v;
+  return os.str();
+}
+
+std::string BudgetLabel(int batches) {
+  return std::to_string(batches) + (batches == 1 ? " batch" : " batches");
+}
+
+}  // namespace
+
+ManipulationExperimentConfig GfcsEvalPlanConfig(const GfcsTrainConfig& c,
+                                                const ManipulationProblemsConfig& problems,
+                                                const std::string& energy_model) {
+  ManipulationExperimentConfig mc = HarnessConfig(c, problems);
+  mc.gfcs.batch_size = c.eval.batch_size;
+  mc.methods.clear();
+  for (int b : c.eval.batches) {
+    mc.methods.push_back({"GFCS uniform (" + BudgetLabel(b) + ")", PlanMethodKind::kGfcs, b, 1.2,
+                          GfcsSamplerKind::kUniform});
+    mc.methods.push_back({"GFCS learned (" + BudgetLabel(b) + ")", PlanMethodKind::kGfcs, b, 1.2,
+                          GfcsSamplerKind::kLearned});
+  }
+  for (const PlanMethodConfig& m : c.eval.baselines) mc.methods.push_back(m);
+  mc.resolution = c.eval.resolution;
+  mc.max_joint_speed = c.eval.max_joint_speed;
+  mc.plot_problems = c.eval.plot_problems;
+  mc.energy_model = energy_model;
+  mc.sgld = c.sampler;
+  return mc;
+}
+
+bool TrainGfcsRun(const GfcsTrainConfig& c, const std::string& run_dir, bool resume,
+                  const std::atomic<bool>* interrupt) {
+  const std::string yaml = config::ToYaml(c);
+  const auto group = dist::DefaultGroup();
+  if (group->rank() == 0) {
+    StartRunDirectory(run_dir, yaml, resume, kGfcsRunRules);
+  } else {  // rank 0 owns config.yaml and log.txt (the directory may be shared)
+    fs::create_directories(run_dir);
+    log::SetFile(run_dir + "/log.rank" + std::to_string(group->rank()) + ".txt");
+  }
+  group->Barrier();  // rank 0's checks passed (or it failed, and the barrier fails for all)
+  log::Info(resume ? "resuming" : "starting", " self-supervised GFCS in ", run_dir, " (seed ",
+            c.seed, ", rank ", group->rank(), " of ", group->size(), ")");
+  const RobotModel robot = LoadRobot(c);
+  std::vector<GfcsTrainingProblem> problems = LoadTrainingProblems(c, robot);
+  FS_THROW_UNLESS(!problems.empty(), run_dir, ": no training problem has a valid start and goal");
+  if (c.loop.shuffle) {
+    std::mt19937_64 rng(static_cast<std::uint64_t>(c.seed) + 11);
+    std::shuffle(problems.begin(), problems.end(), rng);
+  }
+  bool interrupted = false;
+  const GfcsEncoding enc =
+      TrainEncoding(c, robot, problems, run_dir, resume, interrupt, &interrupted);
+  if (interrupted) return false;
+  EncodeProblems(c, robot, enc, &problems);
+  Mlp energy;
+  const GfcsLoopStats stats =
+      RunSelfSupervisedLoop(c, yaml, robot, enc, problems, run_dir, resume, interrupt, &energy);
+  if (group->rank() == 0)
+    WriteFileAtomically(run_dir + "/loop_summary.json", stats.ToJson() + "\n");
+  if (stats.interrupted) return false;
+  log::Info("loop: ", stats.solved, "/", stats.solves, " solved, ", stats.rounds,
+            " training rounds; solving ", stats.solve_seconds, " s, negatives ",
+            stats.negative_seconds, " s, training ", stats.train_seconds, " s (this invocation)");
+  if (group->rank() == 0) WriteArtifact(c, robot, enc, energy, yaml, run_dir + "/" + kGfcsArtifact);
+  return true;
+}
+
+std::string ExportGfcsRun(const std::string& run_dir) {
+  const auto c = config::LoadExperimentConfig<GfcsTrainConfig>(run_dir + "/config.yaml");
+  const std::string yaml = config::ToYaml(c);
+  GfcsEncoding enc;
+  Mlp energy;
+  LoadLoopResult(c, yaml, run_dir, &enc, &energy);
+  const std::string path = run_dir + "/" + kGfcsArtifact;
+  WriteArtifact(c, LoadRobot(c), enc, energy, yaml, path);
+  return path;
+}
+
+std::string EvaluateGfcsRun(const GfcsTrainConfig& c, const std::string& run_dir) {
+  const std::string artifact = run_dir + "/" + kGfcsArtifact;
+  FS_THROW_UNLESS(fs::exists(artifact), run_dir, ": no ", kGfcsArtifact,
+                  " (the run is not finished; continue it with train --resume)");
+  log::SetFile(run_dir + "/log.txt");
+  std::ostringstream os;
+  os << "{\n  \"artifact\": \"" << artifact << "\",\n  \"sets\": [\n";
+  for (std::size_t i = 0; i < c.eval.problems.size(); ++i) {
+    const ManipulationProblemsConfig& set = c.eval.problems[i];
+    const std::string dir = run_dir + "/eval/" + std::to_string(i) + "_" + SetName(set);
+    fs::create_directories(dir);
+    log::Info("evaluating on ", SetName(set), " problems ", set.first, "-", set.last, " -> ", dir);
+    const PlanReport report = RunPlanExperiment(GfcsEvalPlanConfig(c, set, artifact), dir);
+    os << "    {\"set\": \"" << SetName(set) << "\", \"first\": " << set.first
+       << ", \"last\": " << set.last << ", \"problems\": " << report.problems
+       << ", \"invalid_problems\": " << report.invalid_problems.size()
+       << ",\n     \"methods\": [\n";
+    for (std::size_t m = 0; m < report.methods.size(); ++m)
+      os << "       {\"name\": \"" << report.methods[m].method
+         << "\", \"metrics\": " << report.methods[m].summary.ToJson() << "}"
+         << (m + 1 < report.methods.size() ? "," : "") << "\n";
+    os << "     ],\n     \"learned_minus_uniform\": [\n";
+    for (std::size_t b = 0; b < c.eval.batches.size(); ++b) {
+      const std::string uni = "GFCS uniform (" + BudgetLabel(c.eval.batches[b]) + ")";
+      const std::string lea = "GFCS learned (" + BudgetLabel(c.eval.batches[b]) + ")";
+      std::map<int, std::pair<const PlanAttempt*, const PlanAttempt*>> by_problem;
+      for (const PlanAttempt& a : report.attempts) {
+        if (a.method == uni) by_problem[a.problem].first = &a;
+        if (a.method == lea) by_problem[a.problem].second = &a;
+      }
+      std::vector<double> cost, time, success;
+      int only_learned = 0, only_uniform = 0;
+      for (const auto& [problem, pair] : by_problem) {
+        if (!pair.first || !pair.second) continue;
+        const bool su = pair.first->metrics.success, sl = pair.second->metrics.success;
+        only_learned += sl && !su;
+        only_uniform += su && !sl;
+        success.push_back(static_cast<double>(sl) - static_cast<double>(su));
+        time.push_back(pair.second->metrics.time_s - pair.first->metrics.time_s);
+        if (pair.first->gfcs_cost && pair.second->gfcs_cost)
+          cost.push_back(*pair.second->gfcs_cost - *pair.first->gfcs_cost);
+      }
+      const std::uint64_t seed = static_cast<std::uint64_t>(c.seed) + 1000 * i + b;
+      const PairedDifference dc = Bootstrap(cost, seed), dt = Bootstrap(time, seed + 1),
+                             ds = Bootstrap(success, seed + 2);
+      os << "       {\"batches\": " << c.eval.batches[b] << ", \"pairs\": " << dc.n
+         << ", \"cost_s\": {\"mean\": " << Num(dc.mean) << ", \"ci95\": [" << Num(dc.lo) << ", "
+         << Num(dc.hi) << "]}, \"solve_time_s\": {\"mean\": " << Num(dt.mean) << ", \"ci95\": ["
+         << Num(dt.lo) << ", " << Num(dt.hi) << "]}, \"success\": {\"mean\": " << Num(ds.mean)
+         << ", \"ci95\": [" << Num(ds.lo) << ", " << Num(ds.hi)
+         << "], \"only_learned\": " << only_learned << ", \"only_uniform\": " << only_uniform
+         << "}}" << (b + 1 < c.eval.batches.size() ? "," : "") << "\n";
+    }
+    os << "     ]}" << (i + 1 < c.eval.problems.size() ? "," : "") << "\n";
+  }
+  const std::string loop = ReadText(run_dir + "/loop_summary.json");
+  os << "  ],\n  \"loop\": "
+     << (loop.empty() ? "null" : loop.substr(0, loop.find_last_not_of("\n") + 1)) << "\n}\n";
+  WriteFileAtomically(run_dir + "/eval.json", os.str());
+  return os.str();
+}
+
+}  // namespace foresight

@@ -1,0 +1,31 @@
+#pragma once
+/// The gfcs kind's steps (thesis ch 9): encode the training problems (basis point set, then an
+/// autoencoder trained by the trainer), run the self-supervised loop, export the energy model
+/// with its encoder to one artifact, and evaluate the learned sampler against the uniform one
+/// (and the baselines) on held-out problems through the plan harness.
+
+#include <atomic>
+#include <string>
+#include <vector>
+
+#include "training/gfcs/config.h"
+
+namespace foresight {
+
+/// Files of a gfcs run directory (a resumable kind).
+inline constexpr const char* kGfcsArtifact = "model.h5";
+
+/// Trains into `run_dir` (resuming when `resume`) and exports run_dir/model.h5. @return false
+/// when interrupted (the checkpoints stay valid).
+bool TrainGfcsRun(const GfcsTrainConfig& c, const std::string& run_dir, bool resume,
+                  const std::atomic<bool>* interrupt);
+
+/// Writes run_dir/model.h5 from the loop's last checkpoint. @return its path.
+std::string ExportGfcsRun(const std::string& run_dir);
+
+/// Held-out evaluation of run_dir/model.h5: run_dir/eval/<set>/ (the plan harness's files) and
+/// run_dir/eval.json (per family and method: success, lengths, LDJ, times; the learned-minus-
+/// uniform paired cost difference with its 95 % bootstrap interval). @return eval.json's text.
+std::string EvaluateGfcsRun(const GfcsTrainConfig& c, const std::string& run_dir);
+
+}  // namespace foresight
