@@ -61,16 +61,16 @@ def main():
     print("\nPaired differences, learned minus uniform, per held-out problem (same seeds); "
           "mean and 95 % bootstrap interval. Cost = GFCOP cost of the best candidate (s, sum of "
           "rollout times, + penalty when unsolved): negative favours the learned sampler.\n")
-    print("| family | batches | pairs | cost (s) | solve time (s) | success | solved only by "
-          "learned / only by uniform |")
+    print("| family | batches | cost (s) | cost, both solved (s) | solve time (s) | success | "
+          "solved only by learned / only by uniform |")
     print("|---|---|---|---|---|---|---|")
     for s in j["sets"]:
         for d in s["learned_minus_uniform"]:
             def ci(x):
                 if x["mean"] is None:
-                    return "-"
-                return f"{x['mean']:+.3f} [{x['ci95'][0]:+.3f}, {x['ci95'][1]:+.3f}]"
-            print(f"| {s['set']} | {d['batches']} | {d['pairs']} | {ci(d['cost_s'])} | "
+                    return f"- (n {x['n']})"
+                return f"{x['mean']:+.3f} [{x['ci95'][0]:+.3f}, {x['ci95'][1]:+.3f}] (n {x['n']})"
+            print(f"| {s['set']} | {d['batches']} | {ci(d['cost_s'])} | {ci(d['cost_both_solved_s'])} | "
                   f"{ci(d['solve_time_s'])} | {ci(d['success'])} | "
                   f"{d['success']['only_learned']} / {d['success']['only_uniform']} |")
 

@@ -6,7 +6,7 @@ ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 PACKAGES=(build-essential cmake ninja-build pkg-config libtorch-dev libeigen3-dev libopencv-dev
           libnlopt-cxx-dev libompl-dev libhdf5-dev libyaml-cpp-dev libcli11-dev libgtest-dev
           libgmock-dev libbenchmark-dev liboctomap-dev clang-format
-          liburdfdom-dev liborocos-kdl-dev libfcl-dev libgloo-dev)
+          liburdfdom-dev liborocos-kdl-dev libfcl-dev libgloo-dev libopenblas0-serial)
 
 install_missing() {
   local missing=()

@@ -46,6 +46,9 @@ void GfcsTrainConfig::Validate(const std::string& path) const {
                     "' is GFCS (GFCS rows come from eval.batches)");
     FS_THROW_UNLESS(names.insert(m.name).second, path, ": eval.baselines: '", m.name,
                     "' listed twice");
+    FS_THROW_UNLESS(
+        m.name.rfind("GFCS uniform (", 0) != 0 && m.name.rfind("GFCS learned (", 0) != 0, path,
+        ": eval.baselines: '", m.name, "' is the name of a generated GFCS row");
   }
   FS_THROW_UNLESS(fabric.t_max >= fabric.dt, path, ": fabric.t_max (", fabric.t_max,
                   ") is below fabric.dt (", fabric.dt, ")");

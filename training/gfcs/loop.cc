@@ -16,6 +16,7 @@
 #include "inference/manipulation/fabric.h"
 #include "inference/manipulation/gfcs.h"
 #include "training/distributed.h"
+#include "training/run_dir.h"
 
 namespace foresight {
 namespace fs = std::filesystem;
@@ -53,7 +54,7 @@ std::int64_t GetInt(const std::string& s, std::size_t* at) {
 
 /// What one rank contributes to a block: its solves and their positives.
 struct BlockResult {
-  int solves = 0, solved = 0, dropped = 0;
+  int solves = 0, solved = 0, dropped = 0, sampler_failures = 0;
   std::vector<GfcsPositive> positives;
 };
 
@@ -62,6 +63,7 @@ std::string Pack(const BlockResult& r) {
   PutInt(&s, r.solves);
   PutInt(&s, r.solved);
   PutInt(&s, r.dropped);
+  PutInt(&s, r.sampler_failures);
   PutInt(&s, static_cast<std::int64_t>(r.positives.size()));
   for (const GfcsPositive& p : r.positives) {
     PutInt(&s, p.problem);
@@ -80,6 +82,7 @@ BlockResult Unpack(const std::string& s) {
   r.solves = static_cast<int>(GetInt(s, &at));
   r.solved = static_cast<int>(GetInt(s, &at));
   r.dropped = static_cast<int>(GetInt(s, &at));
+  r.sampler_failures = static_cast<int>(GetInt(s, &at));
   const std::int64_t n = GetInt(s, &at);
   for (std::int64_t i = 0; i < n; ++i) {
     GfcsPositive p;
@@ -172,8 +175,8 @@ std::string FirstDifference(const std::string& a, const std::string& b) {
     const bool gb = static_cast<bool>(std::getline(sb, lb));
     if (!ga && !gb) return "";
     if (!ga || !gb || la != lb)
-      return "'" + (gb ? lb : std::string("<end>")) + "' here, '" +
-             (ga ? la : std::string("<end>")) + "' in the checkpoint";
+      return "'" + (ga ? la : std::string("<end>")) + "' here, '" +
+             (gb ? lb : std::string("<end>")) + "' in the checkpoint";
   }
 }
 
@@ -210,7 +213,7 @@ Mlp ReadMlp(torch::serialize::InputArchive* a, const std::string& key) {
 struct LoopState {
   int block_start = 0;  ///< first solve of the current block
   int rank_next = 0;    ///< this rank's next solve (>= block_start)
-  int solves = 0, solved = 0, rounds = 0, dropped = 0;
+  int solves = 0, solved = 0, rounds = 0, dropped = 0, sampler_failures = 0;
   double last_loss = 0;
   std::vector<GfcsPositive> buffer;
   BlockResult pending;  ///< this rank's results in the current block
@@ -251,8 +254,11 @@ class Loop {
   Mlp Energy() const { return net_->net()->ToMlp(); }
 
  private:
+  int Total() const { return c_.loop.passes * static_cast<int>(problems_.size()); }
+  std::string Serialize(bool with_pending) const;
+  void Deserialize(const std::string& bytes, const std::string& source);
   void Save();
-  void Load();
+  void Resume(bool resume);
   void RebuildSampler();
   void Solve(int s);
   void FinishBlock(int block_end);
@@ -272,6 +278,7 @@ class Loop {
   GfcsLoopStats stats_;
   std::unique_ptr<EnergyModel> engine_;
   std::unique_ptr<manipulation::LearnedSampler> sampler_;
+  int walk_from_ = 0;  ///< where this invocation's walk over the current block starts
   std::chrono::steady_clock::time_point started_ = std::chrono::steady_clock::now();
 };
 
@@ -280,17 +287,20 @@ std::string Loop::Where(int s) const {
   return p.family + " #" + std::to_string(p.problem.index);
 }
 
-void Loop::Save() {
+std::string Loop::Serialize(bool with_pending) const {
   torch::serialize::OutputArchive a;
   a.write("config_yaml", TextTensor(yaml_));
   a.write("world_size", Int64Tensor({group_->size()}));
-  a.write("counters", Int64Tensor({st_.block_start, st_.rank_next, st_.solves, st_.solved,
-                                   st_.rounds, st_.dropped}));
+  a.write("counters",
+          Int64Tensor({st_.block_start, with_pending ? st_.rank_next : st_.block_start, st_.solves,
+                       st_.solved, st_.rounds, st_.dropped, Total(), st_.sampler_failures}));
   a.write("last_loss", torch::tensor({st_.last_loss}, torch::kFloat64));
+  const BlockResult none;
+  const BlockResult& pending = with_pending ? st_.pending : none;
   a.write("pending.counts",
-          Int64Tensor({st_.pending.solves, st_.pending.solved, st_.pending.dropped}));
+          Int64Tensor({pending.solves, pending.solved, pending.dropped, pending.sampler_failures}));
   WritePositives(&a, "buffer", st_.buffer, CommandSize(c_));
-  WritePositives(&a, "pending", st_.pending.positives, CommandSize(c_));
+  WritePositives(&a, "pending", pending.positives, CommandSize(c_));
   a.write("encoding.bps_mean", ToTensor(encoding_.bps_mean));
   a.write("encoding.bps_std", ToTensor(encoding_.bps_std));
   WriteMlp(&a, "encoding.encoder", encoding_.encoder);
@@ -301,21 +311,25 @@ void Loop::Save() {
   a.write("adam", adam);
   std::ostringstream os;
   a.save_to(os);
-  WriteFileAtomically(LoopCheckpointPath(run_dir_, group_->rank()), os.str());
+  return os.str();
 }
 
-void Loop::Load() {
-  const std::string path = LoopCheckpointPath(run_dir_, group_->rank());
+void Loop::Save() {
+  WriteFileAtomically(LoopCheckpointPath(run_dir_, group_->rank()), Serialize(true));
+}
+
+void Loop::Deserialize(const std::string& bytes, const std::string& source) {
   torch::serialize::InputArchive a;
   try {
-    a.load_from(path);
+    std::istringstream in(bytes);
+    a.load_from(in);
   } catch (const std::exception& e) {
-    Fail(path, ": cannot read the loop checkpoint (", std::string(e.what()).substr(0, 120), ")");
+    Fail(source, ": cannot read the loop checkpoint (", std::string(e.what()).substr(0, 120), ")");
   }
   const std::string diff = FirstDifference(yaml_, TensorText(Read(&a, "config_yaml")));
-  FS_THROW_UNLESS(diff.empty(), path, ": the checkpoint is from another config (", diff, ")");
+  FS_THROW_UNLESS(diff.empty(), source, ": the checkpoint is from another config (", diff, ")");
   torch::Tensor t = Read(&a, "world_size");
-  FS_THROW_UNLESS(t[0].item<std::int64_t>() == group_->size(), path, ": written by a run of ",
+  FS_THROW_UNLESS(t[0].item<std::int64_t>() == group_->size(), source, ": written by a run of ",
                   t[0].item<std::int64_t>(), " ranks, this one has ", group_->size(),
                   " (resume with the same WORLD_SIZE)");
   t = Read(&a, "counters");
@@ -325,18 +339,82 @@ void Loop::Load() {
   st_.solved = static_cast<int>(t[3].item<std::int64_t>());
   st_.rounds = static_cast<int>(t[4].item<std::int64_t>());
   st_.dropped = static_cast<int>(t[5].item<std::int64_t>());
+  FS_THROW_UNLESS(t.size(0) == 8 && t[6].item<std::int64_t>() == Total(), source,
+                  ": the checkpoint's loop has another number of solves (the training problems "
+                  "changed under the same config?)");
+  st_.sampler_failures = static_cast<int>(t[7].item<std::int64_t>());
   st_.last_loss = Read(&a, "last_loss")[0].item<double>();
   t = Read(&a, "pending.counts");
   st_.pending.solves = static_cast<int>(t[0].item<std::int64_t>());
   st_.pending.solved = static_cast<int>(t[1].item<std::int64_t>());
   st_.pending.dropped = static_cast<int>(t[2].item<std::int64_t>());
+  st_.pending.sampler_failures = static_cast<int>(t[3].item<std::int64_t>());
   st_.buffer = ReadPositives(&a, "buffer");
   st_.pending.positives = ReadPositives(&a, "pending");
+  for (const auto* list : {&st_.buffer, &st_.pending.positives})
+    for (const GfcsPositive& p : *list)
+      FS_THROW_UNLESS(p.problem >= 0 && p.problem < static_cast<int>(problems_.size()) &&
+                          p.u.size() == CommandSize(c_),
+                      source, ": a positive of problem ", p.problem, " (", p.u.size(),
+                      " values) does not fit the ", problems_.size(), " training problems");
+  FS_THROW_UNLESS(
+      ToVector(Read(&a, "encoding.bps_mean")).isApprox(encoding_.bps_mean) &&
+          ReadMlp(&a, "encoding.encoder").layers().size() == encoding_.encoder.layers().size(),
+      source, ": the checkpoint's problem encoding differs from this run's");
   torch::serialize::InputArchive net, adam;
   a.read("net", net);
   a.read("adam", adam);
   net_->load(net);
   adam_.load(adam);
+}
+
+/// Brings every rank to one consistent state before the loop continues. A rank can be one block
+/// behind another (killed between a block's gather and its checkpoint) or have no checkpoint at
+/// all; such a rank takes the shared state (buffer, network, optimiser, counters) of the most
+/// advanced rank and redoes its solves of that block. Then every rank walks the block from the
+/// least advanced rank's position (solves it already did are not repeated).
+void Loop::Resume(bool resume) {
+  const std::string path = LoopCheckpointPath(run_dir_, group_->rank());
+  const bool have = resume && fs::exists(path);
+  if (have) Deserialize(ReadText(path), path);
+  std::string mine;
+  PutInt(&mine, have ? st_.block_start : -1);
+  PutInt(&mine, have ? st_.rank_next : -1);
+  const std::vector<std::string> all = group_->AllGatherBytes(mine);
+  int leader = -1, lead_block = -1;
+  std::vector<std::int64_t> block(all.size()), next(all.size());
+  for (std::size_t r = 0; r < all.size(); ++r) {
+    std::size_t at = 0;
+    block[r] = GetInt(all[r], &at);
+    next[r] = GetInt(all[r], &at);
+    if (block[r] > lead_block) {
+      lead_block = static_cast<int>(block[r]);
+      leader = static_cast<int>(r);
+    }
+  }
+  if (lead_block < 0) {  // nobody has a checkpoint: a fresh start (same seed, same network)
+    walk_from_ = 0;
+    return;
+  }
+  bool behind = false;
+  for (std::int64_t b : block) behind = behind || b != lead_block;
+  if (behind) {
+    const std::string shared =
+        group_->BroadcastBytes(group_->rank() == leader ? Serialize(false) : std::string(), leader);
+    if (block[static_cast<std::size_t>(group_->rank())] != lead_block) {
+      log::Info("rank ", group_->rank(), " was behind (block at solve ",
+                block[static_cast<std::size_t>(group_->rank())] + 1, "); taking rank ", leader,
+                "'s state at solve ", lead_block + 1);
+      Deserialize(shared, "rank " + std::to_string(leader) + "'s loop state");
+      st_.pending = BlockResult{};
+      st_.rank_next = st_.block_start;
+      next[static_cast<std::size_t>(group_->rank())] = st_.block_start;
+    }
+  }
+  // Ranks that were behind redo their block from its start; the others continue where they were.
+  walk_from_ = lead_block;
+  for (std::size_t r = 0; r < all.size(); ++r)
+    if (block[r] == lead_block) walk_from_ = std::min(walk_from_, static_cast<int>(next[r]));
 }
 
 void Loop::RebuildSampler() {
@@ -364,10 +442,21 @@ void Loop::Solve(int s) {
     sampler_->SetWorld(p.problem.world);
     sampler = sampler_.get();
   }
-  const manipulation::GfcsSolution sol = SolveGfcop(fabric, query, sampler, params);
+  manipulation::GfcsSolution sol;
+  try {
+    sol = SolveGfcop(fabric, query, sampler, params);
+  } catch (const std::exception& e) {
+    // The learned sampler failed (e.g. too many non-finite SGLD particles): this solve falls back
+    // to the uniform sampler, deterministically, so a resumed run does not fail here again.
+    if (sampler == &uniform) throw;
+    log::Info("solve ", s + 1, ": the learned sampler failed (", e.what(), "); uniform instead");
+    ++st_.pending.sampler_failures;
+    sampler = &uniform;
+    sol = SolveGfcop(fabric, query, sampler, params);
+  }
   FS_THROW_UNLESS(sol.status != manipulation::GfcsStatus::kError, "gfcs loop: solve ", s, " (",
                   Where(s), "): ", sol.message);
-  if (sampler_) st_.pending.dropped += sampler_->last_dropped();  // one Sample per solve
+  if (sampler == sampler_.get()) st_.pending.dropped += sampler_->last_dropped();
   ++st_.pending.solves;
   st_.pending.solved += sol.solved();
   const std::size_t before = st_.pending.positives.size();
@@ -400,6 +489,7 @@ void Loop::FinishBlock(int block_end) {
     st_.solves += r.solves;
     st_.solved += r.solved;
     st_.dropped += r.dropped;
+    st_.sampler_failures += r.sampler_failures;
     for (GfcsPositive& p : r.positives) fresh.push_back(std::move(p));
   }
   std::stable_sort(fresh.begin(), fresh.end(),
@@ -409,7 +499,7 @@ void Loop::FinishBlock(int block_end) {
     st_.buffer.erase(st_.buffer.begin(),
                      st_.buffer.end() - static_cast<std::ptrdiff_t>(c_.loop.buffer));
   st_.pending = BlockResult{};
-  if (block_end % c_.loop.train_every == 0 && !st_.buffer.empty()) {
+  if ((block_end % c_.loop.train_every == 0 || block_end == Total()) && !st_.buffer.empty()) {
     TrainRound();
     ++st_.rounds;
     RebuildSampler();
@@ -446,11 +536,25 @@ void Loop::TrainRound() {
           const int j = mine[i];
           const GfcsPositive& pos = st_.buffer[static_cast<std::size_t>(j)];
           std::mt19937_64 rng(StreamSeed(c_.seed, kNegativeStream, round, pos.solve * 64 + j));
-          manipulation::SgldResult r = manipulation::RunSgld(
-              engine, problems_[static_cast<std::size_t>(pos.problem)].context, sgld, &rng, &ws);
+          manipulation::SgldResult r;
+          try {
+            r = manipulation::RunSgld(
+                engine, problems_[static_cast<std::size_t>(pos.problem)].context, sgld, &rng, &ws);
+          } catch (const std::exception&) {  // too many non-finite particles: all count as dropped
+            r = manipulation::SgldResult{};
+            r.dropped = n_neg;
+          }
           dropped[static_cast<std::size_t>(t)] += r.dropped;
+          // Dropped particles are replaced by survivors, or by uniform ones when none survived.
           Eigen::MatrixXf u(dim, n_neg);
-          for (int k = 0; k < n_neg; ++k) u.col(k) = r.u.col(k % r.u.cols());  // refill dropped
+          std::uniform_real_distribution<float> uniform(-1.f, 1.f);
+          for (int k = 0; k < n_neg; ++k) {
+            if (r.u.cols() > 0) {
+              u.col(k) = r.u.col(k % r.u.cols());
+            } else {
+              for (int d = 0; d < dim; ++d) u(d, k) = uniform(rng);
+            }
+          }
           negatives[static_cast<std::size_t>(j)] = std::move(u);
         }
       } catch (const std::exception& e) {
@@ -460,15 +564,19 @@ void Loop::TrainRound() {
   for (std::thread& th : pool) th.join();
   for (const std::string& e : errors)
     FS_THROW_UNLESS(e.empty(), "gfcs loop: training round ", round + 1, ": negatives: ", e);
-  for (int d : dropped) st_.dropped += d;
+  int round_dropped = 0;
+  for (int d : dropped) round_dropped += d;
   if (group_->size() > 1) {
     std::string msg;
+    PutInt(&msg, round_dropped);
     for (int j : mine)
       msg.append(reinterpret_cast<const char*>(negatives[static_cast<std::size_t>(j)].data()),
                  sizeof(float) * static_cast<std::size_t>(dim * n_neg));
     const std::vector<std::string> all = group_->AllGatherBytes(msg);
+    round_dropped = 0;
     for (int r = 0; r < group_->size(); ++r) {
       std::size_t at = 0;
+      round_dropped += static_cast<int>(GetInt(all[static_cast<std::size_t>(r)], &at));
       for (int j = r; j < b_total; j += group_->size()) {
         Eigen::MatrixXf u(dim, n_neg);
         FS_THROW_UNLESS(at + sizeof(float) * u.size() <= all[static_cast<std::size_t>(r)].size(),
@@ -480,6 +588,7 @@ void Loop::TrainRound() {
       }
     }
   }
+  st_.dropped += round_dropped;
   stats_.negative_seconds += Seconds(neg_started);
 
   // InfoNCE over the buffer, each positive against its own negatives.
@@ -528,30 +637,35 @@ void Loop::TrainRound() {
 
 GfcsLoopStats Loop::Run(bool resume, const std::atomic<bool>* interrupt) {
   torch::set_num_threads(c_.loop.threads);
-  const bool have = fs::exists(LoopCheckpointPath(run_dir_, group_->rank()));
-  if (resume && have) {
-    Load();
-    log::Info("resuming the loop at solve ", st_.rank_next + 1, " (", st_.rounds,
+  Resume(resume);
+  if (resume && st_.block_start + st_.rounds > 0)
+    log::Info("resuming the loop at solve ", walk_from_ + 1, " (", st_.rounds,
               " training rounds done, buffer ", st_.buffer.size(), ")");
-  } else {
-    group_->BroadcastParameters(*net_, 0);
-  }
   RebuildSampler();
-  const int total = c_.loop.passes * static_cast<int>(problems_.size());
+  const int total = Total(), size = group_->size(), rank = group_->rank();
   int since_save = 0;
+  int s = walk_from_;        // start of the next chunk: `size` solves, one per rank
+  int done = st_.rank_next;  // this rank's solves before `done` are in its pending results
   while (st_.block_start < total) {
     const int block_end =
         std::min(total, (st_.block_start / c_.loop.train_every + 1) * c_.loop.train_every);
-    for (int s = st_.rank_next; s < block_end; ++s) {
-      if ((s - st_.block_start) % group_->size() != group_->rank()) continue;
-      if (interrupt && interrupt->load()) {
+    for (; s < block_end; s += size) {
+      // Every rank stops at the same chunk: the flag is agreed on (one small all-reduce).
+      std::vector<torch::Tensor> stop{
+          torch::full({1}, interrupt && interrupt->load() ? 1.0 : 0.0, torch::kFloat64)};
+      group_->AllReduceSum(stop);
+      if (stop[0].item<double>() > 0) {
         Save();
         stats_.interrupted = true;
         log::Info("interrupted before solve ", s + 1, "; continue with train --resume");
         break;
       }
-      Solve(s);
-      st_.rank_next = s + 1;
+      const int mine = s + rank;
+      if (mine < block_end && mine >= done) {
+        Solve(mine);
+        done = mine + 1;
+      }
+      st_.rank_next = std::min(block_end, s + size);
       if (++since_save >= c_.loop.checkpoint_every) {
         Save();
         since_save = 0;
@@ -561,12 +675,14 @@ GfcsLoopStats Loop::Run(bool resume, const std::atomic<bool>* interrupt) {
     FinishBlock(block_end);
     Save();
     since_save = 0;
+    s = done = st_.block_start;
   }
   stats_.solves = st_.solves;
   stats_.solved = st_.solved;
   stats_.rounds = st_.rounds;
   stats_.last_loss = st_.last_loss;
   stats_.dropped_particles = st_.dropped;
+  stats_.sampler_failures = st_.sampler_failures;
   return stats_;
 }
 
@@ -577,7 +693,8 @@ std::string GfcsLoopStats::ToJson() const {
   os << "{\"solves\": " << solves << ", \"solved\": " << solved
      << ", \"success_rate\": " << (solves ? static_cast<double>(solved) / solves : 0.0)
      << ", \"training_rounds\": " << rounds << ", \"last_loss\": " << last_loss
-     << ", \"dropped_particles\": " << dropped_particles << ", \"solve_seconds\": " << solve_seconds
+     << ", \"dropped_particles\": " << dropped_particles
+     << ", \"sampler_failures\": " << sampler_failures << ", \"solve_seconds\": " << solve_seconds
      << ", \"negative_seconds\": " << negative_seconds << ", \"train_seconds\": " << train_seconds
      << ", \"interrupted\": " << (interrupted ? "true" : "false") << "}";
   return os.str();
@@ -628,6 +745,12 @@ void LoadLoopResult(const GfcsTrainConfig& c, const std::string& config_yaml,
   a.load_from(path);
   const std::string diff = FirstDifference(config_yaml, TensorText(Read(&a, "config_yaml")));
   FS_THROW_UNLESS(diff.empty(), path, ": the checkpoint is from another config (", diff, ")");
+  const torch::Tensor counters = Read(&a, "counters");
+  FS_THROW_UNLESS(counters.size(0) == 8, path, ": not a loop checkpoint of this version");
+  const std::int64_t at = counters[0].item<std::int64_t>(),
+                     total = counters[6].item<std::int64_t>();
+  FS_THROW_UNLESS(at >= total, path, ": the loop is unfinished (", at, " of ", total,
+                  " solves trained on); continue it with train --resume");
   encoding->bps_mean = ToVector(Read(&a, "encoding.bps_mean"));
   encoding->bps_std = ToVector(Read(&a, "encoding.bps_std"));
   encoding->encoder = ReadMlp(&a, "encoding.encoder");

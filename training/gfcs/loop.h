@@ -57,6 +57,7 @@ struct GfcsLoopStats {
   double last_loss = 0;
   double solve_seconds = 0, negative_seconds = 0, train_seconds = 0;  ///< this invocation
   int dropped_particles = 0;  ///< non-finite SGLD particles (sampler and negatives)
+  int sampler_failures = 0;   ///< solves where the learned sampler failed (uniform instead)
   bool interrupted = false;
   std::string ToJson() const;
 };

@@ -196,7 +196,7 @@ RobotModel LoadRobot(const GfcsTrainConfig& c) {
 
 struct PairedDifference {
   int n = 0;
-  double mean = 0, lo = 0, hi = 0;
+  double mean = NAN, lo = NAN, hi = NAN;  ///< NaN (JSON null) without pairs
 };
 
 /// Mean of `d` with a 95 % percentile-bootstrap interval (2000 resamples, fixed seed).
@@ -204,6 +204,7 @@ PairedDifference Bootstrap(const std::vector<double>& d, std::uint64_t seed) {
   PairedDifference out;
   out.n = static_cast<int>(d.size());
   if (d.empty()) return out;
+  out.mean = 0;
   for (double v : d) out.mean += v / static_cast<double>(d.size());
   std::mt19937_64 rng(seed);
   std::uniform_int_distribution<std::size_t> pick(0, d.size() - 1);
@@ -217,6 +218,16 @@ PairedDifference Bootstrap(const std::vector<double>& d, std::uint64_t seed) {
   out.lo = means[50];
   out.hi = means[1949];
   return out;
+}
+
+std::string JsonString(const std::string& s) {
+  std::string out = "\"";
+  for (char ch : s) {
+    if (ch == '"' || ch == '\\') out += '\\';
+    if (static_cast<unsigned char>(ch) < 0x20) continue;
+    out += ch;
+  }
+  return out + "\"";
 }
 
 std::string Num(double v) {
@@ -308,20 +319,20 @@ std::string EvaluateGfcsRun(const GfcsTrainConfig& c, const std::string& run_dir
                   " (the run is not finished; continue it with train --resume)");
   log::SetFile(run_dir + "/log.txt");
   std::ostringstream os;
-  os << "{\n  \"artifact\": \"" << artifact << "\",\n  \"sets\": [\n";
+  os << "{\n  \"artifact\": " << JsonString(artifact) << ",\n  \"sets\": [\n";
   for (std::size_t i = 0; i < c.eval.problems.size(); ++i) {
     const ManipulationProblemsConfig& set = c.eval.problems[i];
     const std::string dir = run_dir + "/eval/" + std::to_string(i) + "_" + SetName(set);
     fs::create_directories(dir);
     log::Info("evaluating on ", SetName(set), " problems ", set.first, "-", set.last, " -> ", dir);
     const PlanReport report = RunPlanExperiment(GfcsEvalPlanConfig(c, set, artifact), dir);
-    os << "    {\"set\": \"" << SetName(set) << "\", \"first\": " << set.first
+    os << "    {\"set\": " << JsonString(SetName(set)) << ", \"first\": " << set.first
        << ", \"last\": " << set.last << ", \"problems\": " << report.problems
        << ", \"invalid_problems\": " << report.invalid_problems.size()
        << ",\n     \"methods\": [\n";
     for (std::size_t m = 0; m < report.methods.size(); ++m)
-      os << "       {\"name\": \"" << report.methods[m].method
-         << "\", \"metrics\": " << report.methods[m].summary.ToJson() << "}"
+      os << "       {\"name\": " << JsonString(report.methods[m].method)
+         << ", \"metrics\": " << report.methods[m].summary.ToJson() << "}"
          << (m + 1 < report.methods.size() ? "," : "") << "\n";
     os << "     ],\n     \"learned_minus_uniform\": [\n";
     for (std::size_t b = 0; b < c.eval.batches.size(); ++b) {
@@ -332,28 +343,35 @@ std::string EvaluateGfcsRun(const GfcsTrainConfig& c, const std::string& run_dir
         if (a.method == uni) by_problem[a.problem].first = &a;
         if (a.method == lea) by_problem[a.problem].second = &a;
       }
-      std::vector<double> cost, time, success;
+      // Pairs: every problem both ran; times only where neither errored (an error takes no time);
+      // cost_s over all pairs mixes the penalty of unsolved problems in, cost_both_solved_s not.
+      std::vector<double> cost, cost_solved, time, success;
       int only_learned = 0, only_uniform = 0;
+      const auto errored = [](const PlanAttempt& a) { return a.status.rfind("error", 0) == 0; };
       for (const auto& [problem, pair] : by_problem) {
         if (!pair.first || !pair.second) continue;
         const bool su = pair.first->metrics.success, sl = pair.second->metrics.success;
         only_learned += sl && !su;
         only_uniform += su && !sl;
         success.push_back(static_cast<double>(sl) - static_cast<double>(su));
-        time.push_back(pair.second->metrics.time_s - pair.first->metrics.time_s);
-        if (pair.first->gfcs_cost && pair.second->gfcs_cost)
+        if (!errored(*pair.first) && !errored(*pair.second))
+          time.push_back(pair.second->metrics.time_s - pair.first->metrics.time_s);
+        if (pair.first->gfcs_cost && pair.second->gfcs_cost) {
           cost.push_back(*pair.second->gfcs_cost - *pair.first->gfcs_cost);
+          if (su && sl) cost_solved.push_back(cost.back());
+        }
       }
-      const std::uint64_t seed = static_cast<std::uint64_t>(c.seed) + 1000 * i + b;
-      const PairedDifference dc = Bootstrap(cost, seed), dt = Bootstrap(time, seed + 1),
-                             ds = Bootstrap(success, seed + 2);
-      os << "       {\"batches\": " << c.eval.batches[b] << ", \"pairs\": " << dc.n
-         << ", \"cost_s\": {\"mean\": " << Num(dc.mean) << ", \"ci95\": [" << Num(dc.lo) << ", "
-         << Num(dc.hi) << "]}, \"solve_time_s\": {\"mean\": " << Num(dt.mean) << ", \"ci95\": ["
-         << Num(dt.lo) << ", " << Num(dt.hi) << "]}, \"success\": {\"mean\": " << Num(ds.mean)
-         << ", \"ci95\": [" << Num(ds.lo) << ", " << Num(ds.hi)
-         << "], \"only_learned\": " << only_learned << ", \"only_uniform\": " << only_uniform
-         << "}}" << (b + 1 < c.eval.batches.size() ? "," : "") << "\n";
+      const std::uint64_t seed = static_cast<std::uint64_t>(c.seed) + 1000 * i + 10 * b;
+      const auto stat = [&](const char* key, const std::vector<double>& d, int k) {
+        const PairedDifference p = Bootstrap(d, seed + k);
+        return std::string("\"") + key + "\": {\"n\": " + std::to_string(p.n) +
+               ", \"mean\": " + Num(p.mean) + ", \"ci95\": [" + Num(p.lo) + ", " + Num(p.hi) + "]";
+      };
+      os << "       {\"batches\": " << c.eval.batches[b] << ", " << stat("cost_s", cost, 0) << "}, "
+         << stat("cost_both_solved_s", cost_solved, 1) << "}, " << stat("solve_time_s", time, 2)
+         << "}, " << stat("success", success, 3) << ", \"only_learned\": " << only_learned
+         << ", \"only_uniform\": " << only_uniform << "}}"
+         << (b + 1 < c.eval.batches.size() ? "," : "") << "\n";
     }
     os << "     ]}" << (i + 1 < c.eval.problems.size() ? "," : "") << "\n";
   }

@@ -274,7 +274,6 @@ PlanReport RunPlanExperiment(const ManipulationExperimentConfig& c, const std::s
       continue;
     }
     const Fabric fabric(robot, problem.world, c.fabric);
-    if (learned) learned->SetWorld(problem.world);
     const std::uint64_t seed = static_cast<std::uint64_t>(c.seed + problem.index);
     PlanProblemPicture picture;
     picture.problem = problem.index;
@@ -290,8 +289,15 @@ PlanReport RunPlanExperiment(const ManipulationExperimentConfig& c, const std::s
         switch (method.kind) {
           case PlanMethodKind::kGfcs: {
             CommandSampler* sampler = &uniform;
-            if (method.sampler == GfcsSamplerKind::kLearned) sampler = &*learned;
+            double encode_s = 0;  // the world's encoding is part of the learned method's time
+            if (method.sampler == GfcsSamplerKind::kLearned) {
+              const auto started = std::chrono::steady_clock::now();
+              learned->SetWorld(problem.world);
+              encode_s = Seconds(started);
+              sampler = &*learned;
+            }
             t = RunGfcs(fabric, problem, c, method, sampler, seed, &best);
+            t.generation_time_s += encode_s;
             attempt_cost = best.commands.size() ? best.cost : std::optional<double>();
             break;
           }
