@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Self-supervised GFCS (thesis ch 9): the loop over problems 1-50 of six MotionBenchMaker families,
 # then the learned sampler against the uniform one (same budget, same seeds) and the fabric on the
-# held-out problems 51-100. Needs ../shared/data (or FORESIGHT_DATA). Writes runs/gfcs_all/ and
+# held-out problems 51-75 (the data holds 75 per family). Needs ../shared/data (or FORESIGHT_DATA). Writes runs/gfcs_all/ and
 # results/gfcs.md, results/gfcs_eval.json.
 #   experiments/gfcs.sh [key.path=value ...]          (overrides of configs/gfcs/all_families.yaml)
 #   RESUME=1 experiments/gfcs.sh                      (continue a killed run)

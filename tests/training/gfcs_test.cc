@@ -82,7 +82,9 @@ GfcsTrainConfig TinyConfig() {
       "lattice: {spacing: 0.6}\nautoencoder: {encoding: 4, hidden: 8, train: {epochs: 3, "
       "batch_size: 2, progress: none}}\nenergy: {hidden: 16, layers: 2}\nloop: {passes: 2, "
       "train_every: 2, adam_steps: 4, learning_rate: 0.01, negatives: 3, negative_sgld: {steps: "
-      "3}, batches: 2, batch_size: 6}\nsampler: {particles: 6, steps: 3}\n",
+      "3}, batches: 2, batch_size: 6}\nsampler: {particles: 6, steps: 3}\neval: {problems: "
+      "[{source: "
+      "synthetic, synthetic_seed: 100, synthetic_count: 2}]}\n",
       "<tiny gfcs>");
 }
 

@@ -105,7 +105,7 @@ struct GfcsEvalConfig {
   std::vector<ManipulationProblemsConfig> problems = [] {
     ManipulationProblemsConfig p;
     p.first = 51;
-    p.last = 100;
+    p.last = 75;
     return std::vector<ManipulationProblemsConfig>{p};
   }();
   int batch_size = 20;                ///< candidates per batch at test (thesis 20)

@@ -25,7 +25,7 @@ ExperimentKind GfcsKind() {
     bool done = false;
     {
       const ScopedInterruptFlag interrupt;
-      done = TrainGfcsRun(c, req.run_dir, req.resume, interrupt.flag());
+      done = TrainGfcsRun(c, req.run_dir, req.resume, interrupt.flag(), req.evaluate);
     }
     if (!done) Fail("interrupted; continue with --resume --run-dir ", req.run_dir);
     if (dist::DefaultGroup()->rank() != 0) return;  // rank 0 exports and evaluates

@@ -265,7 +265,7 @@ ManipulationExperimentConfig GfcsEvalPlanConfig(const GfcsTrainConfig& c,
 }
 
 bool TrainGfcsRun(const GfcsTrainConfig& c, const std::string& run_dir, bool resume,
-                  const std::atomic<bool>* interrupt) {
+                  const std::atomic<bool>* interrupt, bool check_eval_sets) {
   const std::string yaml = config::ToYaml(c);
   const auto group = dist::DefaultGroup();
   if (group->rank() == 0) {
@@ -278,6 +278,10 @@ bool TrainGfcsRun(const GfcsTrainConfig& c, const std::string& run_dir, bool res
   log::Info(resume ? "resuming" : "starting", " self-supervised GFCS in ", run_dir, " (seed ",
             c.seed, ", rank ", group->rank(), " of ", group->size(), ")");
   const RobotModel robot = LoadRobot(c);
+  // The held-out sets are read now, so a missing file fails before an hour of training, not after.
+  if (check_eval_sets)
+    for (const ManipulationProblemsConfig& set : c.eval.problems)
+      (void)LoadExperimentProblems(HarnessConfig(c, set), robot);
   std::vector<GfcsTrainingProblem> problems = LoadTrainingProblems(c, robot);
   FS_THROW_UNLESS(!problems.empty(), run_dir, ": no training problem has a valid start and goal");
   if (c.loop.shuffle) {

@@ -17,8 +17,10 @@ inline constexpr const char* kGfcsArtifact = "model.h5";
 
 /// Trains into `run_dir` (resuming when `resume`) and exports run_dir/model.h5. @return false
 /// when interrupted (the checkpoints stay valid).
+/// With `check_eval_sets` the held-out sets are loaded first, so a missing file fails before the
+/// loop rather than after it (off for runs that will not be evaluated).
 bool TrainGfcsRun(const GfcsTrainConfig& c, const std::string& run_dir, bool resume,
-                  const std::atomic<bool>* interrupt);
+                  const std::atomic<bool>* interrupt, bool check_eval_sets = true);
 
 /// Writes run_dir/model.h5 from the loop's last checkpoint. @return its path.
 std::string ExportGfcsRun(const std::string& run_dir);
