@@ -28,3 +28,7 @@ rm -rf runs/occupancy_synthetic_fusion
 rm -rf runs/plan_quickstart
 ./build/bin/foresight plan default --run-dir runs/plan_quickstart
 ./build/bin/foresight bench fabric
+# Self-supervised GFCS (thesis ch 9): the loop on 12 generated scenes, then the learned sampler
+# against the uniform one on 6 others (runs/gfcs_quickstart/eval.json).
+rm -rf runs/gfcs_quickstart
+./build/bin/foresight train configs/gfcs/synthetic.yaml --run-dir runs/gfcs_quickstart
