@@ -165,6 +165,41 @@ TEST(GfcsLoop, TwoRanksShareTheSolvesAndEndWithTheModelOfOne) {
     EXPECT_EQ((a[i] - b[i]).cwiseAbs().maxCoeff(), 0.0f) << "layer " << i;
 }
 
+TEST(GfcsLoop, TwoRanksKilledMidRunResumeToTheModelOfOne) {
+  GfcsTrainConfig c = TinyConfig();
+  c.loop.threads = 1;
+  c.autoencoder.train.threads = 1;
+  c.loop.passes = 4;  // 12 solves, 6 blocks
+  testing::TempDir dir;
+  testing::WriteText(dir.File("tiny.yaml"), config::ToYaml(c));
+  const std::string cli = FORESIGHT_CLI, d = dir.path();
+  ASSERT_EQ(Shell("cd " + d + " && timeout 120 " + cli +
+                  " train tiny.yaml --run-dir one --no-eval > one.out 2>&1"),
+            0);
+  // Rank 1 is killed as soon as its loop checkpoint shows a few solves; rank 0 then fails (a short
+  // collective timeout) wherever it was. Both are relaunched with --resume.
+  const std::string env = "FORESIGHT_DIST_TIMEOUT_S=5 WORLD_SIZE=2 ";
+  const std::string run = " timeout 120 " + cli + " train tiny.yaml --run-dir two --no-eval";
+  const std::string bare = " " + cli + " train tiny.yaml --run-dir two --no-eval";  // killable
+  Shell("cd " + d + " && (FORESIGHT_STORE_FILE=" + d + "/s1 RANK=0 " + env + run +
+        " > r0.out 2>&1 & FORESIGHT_STORE_FILE=" + d + "/s1 RANK=1 " + env + bare +
+        " > r1.out 2>&1 & p1=$!; for i in $(seq 2000); do grep -q \"solve 4/\" two/log.rank1.txt "
+        "2>/dev/null && break; sleep 0.005; done; kill -9 $p1; wait)");
+  if (testing::ReadText(d + "/r0.out").find("error: rank 0 of 2") == std::string::npos)
+    GTEST_SKIP()
+        << "rank 1 finished before the kill reached it (a loaded machine): nothing to resume";
+  const int resumed = Shell(
+      "cd " + d + " && (FORESIGHT_STORE_FILE=" + d + "/s2 RANK=0 " + env + run +
+      " --resume > q0.out 2>&1 & p0=$!; FORESIGHT_STORE_FILE=" + d + "/s2 RANK=1 " + env + run +
+      " --resume > q1.out 2>&1 & p1=$!; wait $p0; a=$?; wait $p1; b=$?; exit $((a | b)))");
+  ASSERT_EQ(resumed, 0) << testing::ReadText(d + "/r0.out") << testing::ReadText(d + "/q0.out")
+                        << testing::ReadText(d + "/q1.out");
+  const auto a = EnergyWeights(d + "/one/model.h5"), b = EnergyWeights(d + "/two/model.h5");
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i)
+    EXPECT_EQ((a[i] - b[i]).cwiseAbs().maxCoeff(), 0.0f) << "layer " << i;
+}
+
 TEST(GfcsConfig, HeldOutProblemsMayNotOverlapTheTrainingOnes) {
   testing::ExpectErrorContains(
       [] {
