@@ -18,6 +18,8 @@ void AddMapCommands(CLI::App* app);        // map fuse, map info
 void AddBenchMapCommand(CLI::App* bench);  // bench map (under `bench`)
 /// `bench directional` (under `bench`; needs LibTorch for the comparison).
 void AddBenchDirectionalCommand(CLI::App* bench);
+/// `bench diffeo --artifact FILE` (under `bench`; needs LibTorch for the comparison).
+void AddBenchDiffeoCommand(CLI::App* bench);
 /// `navigate CONFIG --run-dir DIR [--episodes N]` (SPAN and baselines in a crowd scenario).
 void AddNavigateCommand(CLI::App* app);
 /// `plan CONFIG [--problems A-B] --run-dir DIR` (GFCS, fabric and planners on manipulation

@@ -16,6 +16,7 @@ int main(int argc, char** argv) {
     foresight::app::AddBenchCommands(&app);
 #ifdef FORESIGHT_WITH_TORCH
     foresight::app::AddBenchDirectionalCommand(app.get_subcommand("bench"));
+    foresight::app::AddBenchDiffeoCommand(app.get_subcommand("bench"));
 #endif
     foresight::app::AddMapCommands(&app);
     foresight::app::AddNavigateCommand(&app);

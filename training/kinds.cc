@@ -19,6 +19,7 @@ ExperimentRegistry BuiltinKinds() {
   r.Add(ManipulationKind());
 #ifdef FORESIGHT_WITH_TORCH
   r.Add(GfcsKind());
+  r.Add(DiffeoKind());
   r.SetDefault("span_predictor");
 #endif
   return r;

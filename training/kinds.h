@@ -22,6 +22,7 @@ ExperimentKind ManipulationKind();
 ExperimentKind SpanKind(const std::string& embedded_default);
 ExperimentKind DirectionalKind();
 ExperimentKind GfcsKind();
+ExperimentKind DiffeoKind();
 #endif
 
 /// The config of a train request: the file, or `embedded_default` (named `default_name` in

@@ -133,6 +133,12 @@ const std::map<std::string, std::string>& TinyConfigs() {
        "sampler: {particles: 6, steps: 3}\neval: {problems: [{source: synthetic, synthetic_seed: "
        "100, "
        "synthetic_count: 2}], batch_size: 6, batches: [1], baselines: []}\n"},
+      {"diffeo",
+       "model: diffeo\ndata: {source: synthetic, synthetic_demos: 3, synthetic_points: 40, "
+       "downsample: 1, held_out: [2]}\nflow: {spacing: 0.1, gamma: 200, cutoff_radius: 0.3, steps: "
+       "4}\ntrain: {epochs: 2, batch_size: 32, progress: none}\neflow: {layers: 2, features: 8, "
+       "train: {epochs: 2, batch_size: 32, progress: none}}\nobstacle: {times: [0.002, 0.004], "
+       "repulsor_gains: [0.1, 1]}\neval: {max_steps: 300, grid: 2, plots: false}\n"},
   };
   return configs;
 }

@@ -1,0 +1,256 @@
+// `foresight bench diffeo --artifact FILE [--json]`: time of one velocity evaluation (one rollout
+// step) of diffeomorphic templates, measured side by side in one run on one thread, medians of
+// repeated runs: the imitation system alone (engine vs LibTorch on the same weights), composed
+// with an obstacle transform (2-D artifacts), and the JACO arm's C-space system with and without
+// the C-space obstacle transform (3-D artifacts; needs kinova_jaco_j2n6s300 in the data root).
+// A benchmark that prints figures, not a test.
+
+#include <torch/torch.h>
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <iostream>
+#include <random>
+#include <sstream>
+
+#include "apps/commands.h"
+#include "core/error.h"
+#include "datasets/data_root.h"
+#include "inference/imitation/cspace.h"
+#include "inference/imitation/template_artifact.h"
+#include "inference/imitation/transforms.h"
+#include "models/imitation/flow_net.h"
+#include "models/imitation/occupancy_fit.h"
+#include "training/diffeo/config.h"
+
+namespace foresight::app {
+namespace {
+
+using namespace imitation;  // NOLINT: a benchmark of the imitation engine
+using Clock = std::chrono::steady_clock;
+
+struct BenchDiffeoArgs {
+  std::string artifact;
+  std::string data_root;
+  int calls = 2000;
+  int repeats = 7;
+  bool json = false;
+};
+
+double Median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+/// Median over `repeats` of the mean time (us) of `calls` calls of f(i).
+template <class F>
+double MicrosPerCall(const BenchDiffeoArgs& a, F&& f) {
+  for (int i = 0; i < std::min(200, a.calls); ++i) f(i);  // warm up
+  std::vector<double> t;
+  for (int r = 0; r < a.repeats; ++r) {
+    const auto s = Clock::now();
+    for (int i = 0; i < a.calls; ++i) f(i);
+    t.push_back(std::chrono::duration<double, std::micro>(Clock::now() - s).count() / a.calls);
+  }
+  return Median(t);
+}
+
+/// Points spread over the grid's box (the region the template was trained on).
+template <int D>
+std::vector<Vec<D>> Points(const RbfGrid<D>& grid, int n) {
+  std::mt19937_64 rng(1);
+  const Vec<D> lo = grid.spec().lower;
+  Vec<D> hi = lo;
+  for (int a = 0; a < D; ++a) hi[a] += grid.spec().spacing * (grid.spec().counts[a] - 1);
+  std::vector<Vec<D>> out;
+  for (int i = 0; i < n; ++i) {
+    Vec<D> p;
+    for (int a = 0; a < D; ++a)
+      p[a] = std::uniform_real_distribution<double>(lo[a] + 0.1 * (hi[a] - lo[a]),
+                                                    hi[a] - 0.1 * (hi[a] - lo[a]))(rng);
+    out.push_back(p);
+  }
+  return out;
+}
+
+/// The LibTorch net with the artifact's weights (the trainer's module).
+template <int D>
+RbfFlowNet TorchNet(const ImitationSystem<D>& s) {
+  const RbfGrid<D>& grid = s.flow().grid();
+  torch::Tensor centres = torch::empty({grid.size(), D}, torch::kFloat64);
+  for (int i = 0; i < grid.size(); ++i)
+    for (int k = 0; k < D; ++k) centres[i][k] = grid.Centre(i)[k];
+  RbfFlowNet net(centres, grid.gamma(), grid.spec().cutoff_radius, s.flow().settings().time,
+                 s.flow().settings().steps, s.speed());
+  torch::NoGradGuard no_grad;
+  const Eigen::MatrixXd& w = s.flow().weights();
+  for (Eigen::Index i = 0; i < w.rows(); ++i)
+    for (Eigen::Index k = 0; k < w.cols(); ++k) net->weights[i][k] = w(i, k);
+  return net;
+}
+
+struct Row {
+  std::string name;
+  double micros = 0;
+  std::string note;
+};
+
+template <int D>
+std::vector<Row> Imitation(const BenchDiffeoArgs& a, const ImitationSystem<D>& s) {
+  const auto pts = Points<D>(s.flow().grid(), 256);
+  FlowWorkspace<D> ws = s.flow().MakeWorkspace();
+  Vec<D> sink = Vec<D>::Zero();
+  const double engine = MicrosPerCall(a, [&](int i) { sink += s.Velocity(pts[i % 256], &ws); });
+  RbfFlowNet net = TorchNet<D>(s);
+  torch::NoGradGuard no_grad;
+  std::vector<torch::Tensor> xs;
+  for (const Vec<D>& p : pts) {
+    torch::Tensor t = torch::empty({1, D}, torch::kFloat64);
+    for (int k = 0; k < D; ++k) t[0][k] = p[k];
+    xs.push_back(t);
+  }
+  const torch::Tensor goal = torch::zeros({D}, torch::kFloat64);
+  BenchDiffeoArgs fewer = a;
+  fewer.calls = std::max(50, a.calls / 10);
+  const double libtorch = MicrosPerCall(
+      fewer, [&](int i) { (void)net->Velocity(xs[static_cast<std::size_t>(i % 256)], goal); });
+  std::ostringstream note;
+  note << "K = " << s.flow().settings().steps << " Euler steps, " << s.flow().grid().size()
+       << " inducing states";
+  (void)sink;
+  return {{"imitation step, engine", engine, note.str()},
+          {"imitation step, LibTorch (batch 1)", libtorch, "same weights, no autograd"}};
+}
+
+Row Composed2d(const BenchDiffeoArgs& a, const ImitationSystem<2>& s) {
+  // A disc between the middle of the grid and the goal, mapped as the evaluation does.
+  const DiffeoObstacleConfig o;
+  const RbfGrid<2>& g = s.flow().grid();
+  Vec<2> mid = g.spec().lower;
+  for (int k = 0; k < 2; ++k) mid[k] += 0.5 * g.spec().spacing * (g.spec().counts[k] - 1);
+  const Vec<2> centre = 0.5 * (mid + s.goal());
+  const double r = o.radius;
+  Eigen::Matrix<double, 2, Eigen::Dynamic> pts;
+  std::vector<std::uint8_t> occ;
+  SampleObstacleOccupancy<2>([&](const Vec<2>& p) { return (p - centre).norm() - r; },
+                             centre.array() - r - o.sample_margin,
+                             centre.array() + r + o.sample_margin, o.sample_spacing, &pts, &occ);
+  const RbfGrid<2> mg(RbfGrid<2>::Covering(centre.array() - r - o.sample_margin,
+                                           centre.array() + r + o.sample_margin, 0, o.map_spacing,
+                                           o.map_gamma, o.map_cutoff),
+                      "bench map");
+  const OccupancyField<2> field = FitOccupancyField<2>(mg, pts, occ, o.map_l2, "bench map");
+  OuterTransform<2> t;
+  t.type = OuterTransform<2>::Type::kObstacle;
+  FlowSettings<2> fs;
+  fs.time = 0.008;
+  fs.steps = 16;
+  t.obstacle = ObstacleTransform<2>(field, fs);
+  const ComposedSystem<2> sys(s, {t});
+  auto ws = sys.MakeWorkspace();
+  std::vector<Vec<2>> near;
+  std::mt19937_64 rng(2);
+  std::uniform_real_distribution<double> u(-3 * r, 3 * r);
+  for (int i = 0; i < 256; ++i) near.push_back(centre + Vec<2>(u(rng), u(rng)));
+  Vec<2> sink = Vec<2>::Zero();
+  const double us = MicrosPerCall(a, [&](int i) { sink += sys.Velocity(near[i % 256], &ws); });
+  (void)sink;
+  return {"composed step (imitation + obstacle), engine", us,
+          "obstacle flow 16 Euler steps, queries within 3 radii of the disc"};
+}
+
+std::vector<Row> CSpace(const BenchDiffeoArgs& a, const TemplateArtifact<3>& art) {
+  const std::string dir = ResolveDataFile(a.data_root, "kinova_jaco_j2n6s300");
+  if (!std::filesystem::exists(dir)) return {{"C-space step", -1, "skipped: no " + dir}};
+  const SerialChain chain = SerialChain::LoadJaco(dir);
+  TaskNormalisation tn;
+  tn.offset = art.normalisation.offset;
+  tn.scale = art.normalisation.scale;
+  // A 15 cm cylinder's map (as a sphere of the same radius at the task's middle, for timing).
+  const DiffeoObstacleConfig o;
+  const Eigen::Vector3d centre = tn.ToWorld(Vec<3>::Zero()) + Eigen::Vector3d(0.1, 0, 0.1);
+  const double r = 0.075, margin = 0.1, spacing = 0.05;
+  Eigen::Matrix<double, 3, Eigen::Dynamic> pts;
+  std::vector<std::uint8_t> occ;
+  SampleObstacleOccupancy<3>([&](const Vec<3>& p) { return (p - centre).norm() - r; },
+                             centre.array() - r - margin, centre.array() + r + margin, 0.02, &pts,
+                             &occ);
+  const RbfGrid<3> mg(RbfGrid<3>::Covering(centre.array() - r - margin, centre.array() + r + margin,
+                                           0, spacing, 300, 0.12),
+                      "bench map");
+  const OccupancyField<3> field = FitOccupancyField<3>(mg, pts, occ, o.map_l2, "bench map");
+  FlowSettings<kArmDof> fs;
+  fs.time = 0.02;
+  fs.steps = 10;
+  const CSpaceSystem plain(chain, art.system, tn);
+  const CSpaceSystem avoid(chain, art.system, tn, CSpaceObstacleTransform(chain, field, fs));
+  std::mt19937_64 rng(3);
+  std::vector<ArmVector> qs;
+  ArmVector seed_q;
+  seed_q << 0, 3.6, 1.4, 0, 1.0, 0;
+  std::normal_distribution<double> n(0, 0.3);
+  for (int i = 0; i < 64; ++i) {
+    ArmVector q = seed_q;
+    for (int k = 0; k < kArmDof; ++k) q[k] += n(rng);
+    qs.push_back(q);
+  }
+  auto w1 = plain.MakeWorkspace();
+  auto w2 = avoid.MakeWorkspace();
+  ArmVector sink = ArmVector::Zero();
+  const double t_plain = MicrosPerCall(a, [&](int i) { sink += plain.Velocity(qs[i % 64], &w1); });
+  const double t_avoid = MicrosPerCall(a, [&](int i) { sink += avoid.Velocity(qs[i % 64], &w2); });
+  (void)sink;
+  std::ostringstream note;
+  note << chain.num_points() << " body points, obstacle flow 10 Euler steps";
+  return {{"C-space step (pull-back only), engine", t_plain, "J_ee pseudo-inverse"},
+          {"C-space step (with obstacle transform), engine", t_avoid, note.str()}};
+}
+
+void RunDiffeoBench(const BenchDiffeoArgs& a) {
+  torch::set_num_threads(1);
+  const int d = TemplateDimension(a.artifact);
+  std::vector<Row> rows;
+  if (d == 2) {
+    const TemplateArtifact<2> art = LoadTemplate<2>(a.artifact);
+    rows = Imitation<2>(a, art.system);
+    rows.push_back(Composed2d(a, art.system));
+  } else {
+    const TemplateArtifact<3> art = LoadTemplate<3>(a.artifact);
+    rows = Imitation<3>(a, art.system);
+    for (const Row& r : CSpace(a, art)) rows.push_back(r);
+  }
+  const double ratio = rows[1].micros / rows[0].micros;
+  if (a.json) {
+    std::cout << "{\"artifact\": \"" << a.artifact << "\", \"dimension\": " << d
+              << ", \"engine_vs_libtorch_speedup\": " << ratio << ", \"steps_us\": {";
+    for (std::size_t i = 0; i < rows.size(); ++i)
+      std::cout << (i ? ", " : "") << "\"" << rows[i].name << "\": " << rows[i].micros;
+    std::cout << "}}\n";
+    return;
+  }
+  std::cout << "one rollout step (one velocity), one thread, median of " << a.repeats << " runs:\n";
+  for (const Row& r : rows)
+    std::cout << "  " << r.name << ": "
+              << (r.micros < 0 ? std::string("-") : std::to_string(r.micros)) << " us  (" << r.note
+              << ")\n";
+  std::cout << "  engine vs LibTorch (imitation): " << ratio << "x\n";
+}
+
+}  // namespace
+
+void AddBenchDiffeoCommand(CLI::App* bench) {
+  auto a = std::make_shared<BenchDiffeoArgs>();
+  auto* cmd = bench->add_subcommand(
+      "diffeo", "diffeomorphic templates: time per rollout step, engine vs LibTorch");
+  cmd->add_option("--artifact", a->artifact, "exported template (run_dir/models/<shape>.h5)")
+      ->required();
+  cmd->add_option("--data-root", a->data_root, "data root for the JACO URDF (3-D artifacts)");
+  cmd->add_option("--calls", a->calls, "calls per timed run")->check(CLI::Range(10, 10000000));
+  cmd->add_option("--repeats", a->repeats, "timed runs (median reported)")
+      ->check(CLI::Range(1, 100));
+  cmd->add_flag("--json", a->json, "print one JSON object");
+  cmd->callback([a] { RunDiffeoBench(*a); });
+}
+
+}  // namespace foresight::app

@@ -1,0 +1,90 @@
+#!/usr/bin/env python3
+"""results/diffeo.md from the eval.json files experiments/diffeo.sh copies into results/."""
+import json
+import os
+import sys
+
+res = sys.argv[1] if len(sys.argv) > 1 else "results"
+
+
+def load(name):
+    path = os.path.join(res, name)
+    return json.load(open(path)) if os.path.exists(path) else None
+
+
+def f(v, nd=3):
+    return "-" if v is None else f"{v:.{nd}f}"
+
+
+lasa = load("diffeo_lasa.json")
+push = load("diffeo_jaco_push_box.json")
+lift = load("diffeo_jaco_lift_box.json")
+bench = load("diffeo_bench.json")
+out = ["# Diffeomorphic templates (thesis ch 8)", "",
+       "Regenerate: `experiments/diffeo.sh` (configs/diffeo/lasa.yaml, jaco_push_box.yaml, "
+       "jaco_lift_box.yaml; one seed). LASA figures are in normalised units (every shape scaled "
+       "into [-0.5, 0.5], goal at the origin, the same normalisation for both methods); JACO "
+       "figures in metres. F.D.: discrete Frechet distance between a rollout from a "
+       "demonstration's start and that demonstration, both resampled to 100 points by arc length, "
+       "mean over demonstrations; M.C.D.: maximum collision depth over all rollouts (the arm's "
+       "body balls for JACO). The obstacle-flow time and the EFlow repulsor gain are selected on "
+       "the fitted occupancy map from the training demonstrations' starts, never on the exact "
+       "obstacle the M.C.D. uses.", ""]
+if lasa:
+    m, shapes = lasa["mean"], lasa["shapes"]
+    n = lasa["shape_count"]
+    out += [f"## LASA, {n} shapes: imitation (5 of 7 demos trained on)", "",
+            "| method | F.D. all starts | F.D. held-out starts | reach rate (demo starts) | reach rate (grid of starts) |",
+            "|---|---|---|---|---|",
+            f"| ours (RBF flow) | {f(m.get('frechet'))} | {f(m.get('frechet_heldout'))} | {f(m.get('reach_rate'))} | {f(m.get('grid_reach_rate'))} |",
+            f"| Euclideanizing Flows | {f(m.get('eflow_frechet'))} | {f(m.get('eflow_frechet_heldout'))} | {f(m.get('eflow_reach_rate'))} | {f(m.get('eflow_grid_reach_rate'))} |",
+            ""]
+    if m.get("eflow_frechet"):
+        out += [f"Ours / EFlow mean F.D.: {m['frechet'] / m['eflow_frechet']:.3f} "
+                "(target: <= 1.10). Shapes whose grid of starts all reach the goal: ours "
+                f"{sum(1 for s in shapes.values() if s.get('grid_reach_rate') == 1)}/{n}, EFlow "
+                f"{sum(1 for s in shapes.values() if s.get('eflow_grid_reach_rate') == 1)}/{n}.", ""]
+    out += [f"## LASA, {n} shapes: an obstacle half-way along the demonstrations", "",
+            "| method | mean F.D. | mean M.C.D. | max M.C.D. | shapes with M.C.D. = 0 | reach rate |",
+            "|---|---|---|---|---|---|"]
+    for label, p in [("ours, with avoidance", "avoid_"), ("ours, no avoidance", ""),
+                     ("EFlow", "eflow_"), ("EFlow + repulsor", "eflow_repulsor_"),
+                     ("linear", "linear_")]:
+        key = p + "mcd"
+        if key not in m:
+            continue
+        zero = sum(1 for s in shapes.values() if s.get(key, 1) == 0)
+        mx = max(s.get(key, 0) for s in shapes.values())
+        out.append(f"| {label} | {f(m.get(p + 'frechet'))} | {f(m.get(key), 4)} | {f(mx, 4)} | {zero}/{n} | {f(m.get(p + 'reach_rate'))} |")
+    out += ["", "Per shape (F.D. ours / EFlow; with the obstacle: F.D. and M.C.D. of ours with "
+            "avoidance and of EFlow + repulsor; obstacle-flow time selected):", "",
+            "| shape | F.D. ours | F.D. EFlow | grid reach | avoid F.D. | avoid M.C.D. | EFlow+rep F.D. | EFlow+rep M.C.D. | flow time |",
+            "|---|---|---|---|---|---|---|---|---|"]
+    for name, s in sorted(shapes.items()):
+        out.append(f"| {name} | {f(s.get('frechet'))} | {f(s.get('eflow_frechet'))} | {f(s.get('grid_reach_rate'), 2)} | "
+                   f"{f(s.get('avoid_frechet'))} | {f(s.get('avoid_mcd'), 4)} | {f(s.get('eflow_repulsor_frechet'))} | "
+                   f"{f(s.get('eflow_repulsor_mcd'), 4)} | {f(s.get('obstacle_flow_time'), 4)} |")
+    out.append("")
+thesis = {"ours, with avoidance": ("0.124 / 0", "0.127 / 0"), "ours, no avoidance": ("0.070 / 0.012", "0.112 / 0.012"),
+          "EFlow": ("0.068 / 0.012", "0.093 / 0.152"), "EFlow + repulsor": ("0.168 / 0", "0.252 / 0.001"),
+          "linear": ("0.242 / 0.147", "0.205 / 0.031")}
+if push or lift:
+    out += ["## JACO arm in C-space: push box, lift box (F.D. / M.C.D., metres)", "",
+            "Task-space demonstrations are generated (the thesis's recordings are not public: "
+            "datasets/synthetic_demos.h), so the thesis columns are not the same data.", "",
+            "| method | push box | lift box | thesis push box | thesis lift box |", "|---|---|---|---|---|"]
+    for label, p in [("ours, with avoidance", "avoid_"), ("ours, no avoidance", ""),
+                     ("EFlow", "eflow_"), ("EFlow + repulsor", "eflow_repulsor_"), ("linear", "linear_")]:
+        cells = []
+        for r in (push, lift):
+            s = r["mean"] if r else {}
+            cells.append("-" if (p + "frechet") not in s else f"{f(s.get(p + 'frechet'))} / {f(s.get(p + 'mcd'), 4)}")
+        out.append(f"| {label} | {cells[0]} | {cells[1]} | {thesis[label][0]} | {thesis[label][1]} |")
+    out.append("")
+if bench:
+    out += ["## Time per rollout step (one core; `foresight bench diffeo`)", "", "| step | us |", "|---|---|"]
+    for part in ("planar", "cspace"):
+        for k, v in bench.get(part, {}).get("steps_us", {}).items():
+            out.append(f"| {k} | {f(v, 2)} |")
+    out.append("")
+print("\n".join(out))

@@ -1,0 +1,60 @@
+#pragma once
+/// A continuous occupancy map p(o = 1 | s) = sigmoid(w' phi(s) + b) on Gaussian RBF features
+/// (rbf_grid.h) in D = 2 or 3 dimensions: the Hilbert map (Ramos & Ott 2015) the obstacle
+/// transforms of thesis ch 8 differentiate. Gives p, grad p and the Hessian of p exactly:
+///   f = w' phi + b,  grad f = sum_t w_t (-2 g phi_t r_t),
+///   Hess f = sum_t w_t phi_t (4 g^2 r_t r_t' - 2 g I),
+///   grad p = p (1 - p) grad f,  Hess p = p (1 - p) [(1 - 2 p) grad f grad f' + Hess f].
+/// In 2-D it reads the mapping engine's Hilbert-map artifacts (FromHingeMap: the same features,
+/// tested against HingeMap::Query), so a map trained by `foresight train configs/occupancy/...`
+/// serves as the obstacle map; the imitation pipeline trains its own with FitOccupancyField
+/// (models/imitation/occupancy_fit.h) from occupancy samples of the new obstacle.
+
+#include <Eigen/Core>
+#include <memory>
+#include <string>
+
+#include "inference/imitation/rbf_grid.h"
+
+namespace foresight {
+class HingeMap;
+}
+
+namespace foresight::imitation {
+
+template <int D>
+struct OccupancyValue {
+  double p = 0;                      ///< p(o = 1 | s)
+  Vec<D> gradient = Vec<D>::Zero();  ///< d p / d s
+  Mat<D> hessian = Mat<D>::Zero();   ///< d^2 p / d s^2 (only when asked)
+};
+
+template <int D>
+class OccupancyField {
+ public:
+  OccupancyField() = default;
+  /// @param weights [m] (m = grid.size()), bias: finite (an Error naming `source` otherwise).
+  OccupancyField(RbfGrid<D> grid, Eigen::VectorXd weights, double bias,
+                 const std::string& source = "occupancy field");
+  /// The field of a 2-D Hilbert map of the mapping engine (kind occupancy.hilbert; the Bayesian
+  /// kinds by their mean weights). D = 2 only.
+  static OccupancyField FromHingeMap(const HingeMap& map);
+
+  const RbfGrid<D>& grid() const { return grid_; }
+  const Eigen::VectorXd& weights() const { return weights_; }
+  double bias() const { return bias_; }
+  /// Scratch per caller.
+  std::unique_ptr<RbfFeatures<D>> MakeWorkspace() const;
+
+  /// p, grad p and (with_hessian) Hess p at s. No allocation.
+  void Evaluate(const Vec<D>& s, RbfFeatures<D>* ws, bool with_hessian,
+                OccupancyValue<D>* out) const;
+  double Probability(const Vec<D>& s, RbfFeatures<D>* ws) const;
+
+ private:
+  RbfGrid<D> grid_;
+  Eigen::VectorXd weights_;
+  double bias_ = 0;
+};
+
+}  // namespace foresight::imitation

@@ -1,0 +1,81 @@
+#pragma once
+/// Gaussian radial basis functions on a regular grid of inducing states in D = 2 or 3 dimensions,
+/// truncated beyond a cut-off radius so that a query touches only the inducing states near it
+/// (thesis ch 8, eq. vecfieldeqn; errata: the Gaussian k(s, s_hat) = exp(-gamma ||s - s_hat||^2)).
+///   phi_t(s) = exp(-gamma ||s - c_t||^2) if ||s - c_t|| <= cutoff_radius, else 0,
+///   c_t = lower + spacing * (i_0, ..., i_{D-1}),  t = i_0 + counts_0 (i_1 + counts_1 i_2).
+/// The separable form exp(-gamma sum_a d_a^2) = prod_a exp(-gamma d_a^2) needs D * window
+/// exponentials per query.
+///
+/// The truncation makes phi_t jump by truncation() = exp(-gamma cutoff_radius^2) across the cut-off
+/// sphere, so fields built on it are discontinuous by up to that times their weights: flows are
+/// then invertible only to about that level (rbf_flow.h). Choose gamma cutoff_radius^2 >= ~18
+/// (truncation <= 1.5e-8) where exact inverses matter. Shared by the imitation flow (rbf_flow.h)
+/// and the obstacle occupancy field (occupancy_field.h); the LibTorch trainer (models/imitation)
+/// uses the same definition.
+
+#include <Eigen/Core>
+#include <array>
+#include <string>
+
+namespace foresight::imitation {
+
+template <int D>
+using Vec = Eigen::Matrix<double, D, 1>;
+template <int D>
+using Mat = Eigen::Matrix<double, D, D>;
+
+/// The grid. Valid when counts >= 1 on every axis, spacing > 0, gamma > 0, cutoff_radius > 0,
+/// at most 2^22 inducing states and at most RbfFeatures<D>::kCapacity states inside the cut-off
+/// window (2 floor(cutoff / spacing) + 1 per axis).
+template <int D>
+struct RbfGridSpec {
+  Vec<D> lower = Vec<D>::Zero();  ///< first inducing state
+  std::array<int, D> counts{};    ///< inducing states per axis
+  double spacing = 0.1;           ///< distance between neighbouring states
+  double gamma = 50;              ///< kernel exp(-gamma d^2)
+  double cutoff_radius = 0.3;     ///< features of states farther than this are zero
+};
+
+/// The non-zero features at one point, filled by RbfGrid::Evaluate. Fixed capacity (allocate one
+/// per workspace, on the heap for D = 3): no allocation per query.
+template <int D>
+struct RbfFeatures {
+  static constexpr int kCapacity = D == 2 ? 1024 : 4096;  // 32^2, 16^3
+  int count = 0;                                          ///< non-zero features
+  std::array<int, kCapacity> index;                       ///< inducing-state index t
+  std::array<double, kCapacity> phi;                      ///< phi_t(s)
+  std::array<Vec<D>, kCapacity> offset;  ///< s - c_t (gradient = -2 gamma phi offset)
+};
+
+template <int D>
+class RbfGrid {
+ public:
+  RbfGrid() = default;
+  /// Checks the spec; an Error naming the offending value otherwise (`source` prefixes it).
+  explicit RbfGrid(const RbfGridSpec<D>& spec, const std::string& source = "rbf grid");
+  /// The smallest grid covering [lo, hi] (per axis) padded by `margin` with `spacing`.
+  static RbfGridSpec<D> Covering(const Vec<D>& lo, const Vec<D>& hi, double margin, double spacing,
+                                 double gamma, double cutoff_radius);
+
+  const RbfGridSpec<D>& spec() const { return spec_; }
+  int size() const { return size_; }
+  double gamma() const { return spec_.gamma; }
+  /// exp(-gamma cutoff_radius^2): the largest jump of one feature at the cut-off.
+  double truncation() const { return truncation_; }
+  Vec<D> Centre(int t) const;
+
+  /// Non-zero features at s into `out` (no allocation). Non-finite s gives no features.
+  void Evaluate(const Vec<D>& s, RbfFeatures<D>* out) const;
+
+ private:
+  RbfGridSpec<D> spec_;
+  int size_ = 0;
+  int window_ = 0;
+  double truncation_ = 0;
+};
+
+// Derivatives from RbfFeatures (gamma g, offset r_t = s - c_t):
+//   d phi_t / ds = -2 g phi_t r_t,   d^2 phi_t / ds^2 = phi_t (4 g^2 r_t r_t' - 2 g I).
+
+}  // namespace foresight::imitation

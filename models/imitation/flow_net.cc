@@ -1,0 +1,196 @@
+#include "models/imitation/flow_net.h"
+
+#include <cmath>
+
+#include "core/error.h"
+
+namespace foresight::imitation {
+
+namespace {
+
+const auto kDouble = torch::TensorOptions().dtype(torch::kFloat64);
+
+bool AllFinite(const torch::Tensor& t) { return torch::isfinite(t).all().item<bool>(); }
+
+}  // namespace
+
+torch::Tensor NaturalGradientVelocity(const torch::Tensor& z, const torch::Tensor& jacobian,
+                                      const torch::Tensor& goal_image, const torch::Tensor& speed) {
+  const torch::Tensor diff = z - goal_image.unsqueeze(0);  // [B, d]
+  const torch::Tensor norm =
+      torch::sqrt(diff.square().sum(1, /*keepdim=*/true) + kGoalEpsilon * kGoalEpsilon);
+  const torch::Tensor grad = (diff / norm).unsqueeze(2);  // [B, d, 1]
+  return -speed * torch::linalg::solve(jacobian, grad, /*left=*/true).squeeze(2);
+}
+
+RbfFlowNetImpl::RbfFlowNetImpl(const torch::Tensor& centres, double gamma, double cutoff_radius,
+                               double time, int steps, double initial_speed)
+    : gamma_(gamma), cutoff_radius_(cutoff_radius), time_(time), steps_(steps) {
+  FS_THROW_UNLESS(centres.dim() == 2 && centres.size(0) >= 1 && centres.size(1) >= 1,
+                  "RbfFlowNet: centres must be [m, d] with m, d >= 1, got ", centres.sizes());
+  FS_THROW_UNLESS(std::isfinite(gamma) && gamma > 0, "RbfFlowNet: gamma must be > 0, got ", gamma);
+  FS_THROW_UNLESS(std::isfinite(cutoff_radius) && cutoff_radius > 0,
+                  "RbfFlowNet: cutoff_radius must be > 0, got ", cutoff_radius);
+  FS_THROW_UNLESS(std::isfinite(time) && time > 0, "RbfFlowNet: time must be > 0, got ", time);
+  FS_THROW_UNLESS(steps >= 1, "RbfFlowNet: steps must be >= 1, got ", steps);
+  FS_THROW_UNLESS(std::isfinite(initial_speed) && initial_speed > 0,
+                  "RbfFlowNet: initial_speed must be > 0, got ", initial_speed);
+  const torch::Tensor c = centres.detach().to(torch::kFloat64).contiguous().clone();
+  FS_THROW_UNLESS(AllFinite(c), "RbfFlowNet: centres contain a non-finite value");
+  centres_ = register_buffer("centres", c);
+  weights = register_parameter("weights", torch::zeros({c.size(0), c.size(1)}, kDouble));
+  log_speed = register_parameter("log_speed", torch::full({}, std::log(initial_speed), kDouble));
+}
+
+void RbfFlowNetImpl::CheckPoints(const torch::Tensor& x, const char* what) const {
+  FS_THROW_UNLESS(x.dim() == 2 && x.size(1) == centres_.size(1), "RbfFlowNet: ", what,
+                  " must be [B, ", centres_.size(1), "], got ", x.sizes());
+  FS_THROW_UNLESS(x.scalar_type() == torch::kFloat64, "RbfFlowNet: ", what,
+                  " must be kFloat64, got ", x.scalar_type());
+}
+
+std::pair<torch::Tensor, torch::Tensor> RbfFlowNetImpl::Features(const torch::Tensor& s) const {
+  const torch::Tensor offset = s.unsqueeze(1) - centres_.unsqueeze(0);  // [B, m, d]
+  const torch::Tensor d2 = offset.square().sum(2);                      // [B, m]
+  // The mask is a constant of the graph: the truncated features and their derivatives are 0.
+  const torch::Tensor inside = (d2 <= cutoff_radius_ * cutoff_radius_).to(torch::kFloat64);
+  return {torch::exp(-gamma_ * d2) * inside, offset};
+}
+
+std::pair<torch::Tensor, torch::Tensor> RbfFlowNetImpl::Field(const torch::Tensor& s) {
+  CheckPoints(s, "s");
+  auto [phi, offset] = Features(s);
+  const torch::Tensor v = torch::matmul(phi, weights);  // [B, d]
+  // d phi_t/ds = -2 gamma phi_t (s - c_t): [B, m, d]; DV = W' dphi/ds: [d, m] x [B, m, d].
+  const torch::Tensor dphi = (-2 * gamma_) * phi.unsqueeze(2) * offset;
+  return {v, torch::matmul(weights.t(), dphi)};
+}
+
+torch::Tensor RbfFlowNetImpl::Integrate(const torch::Tensor& x, torch::Tensor* jacobian) {
+  const double h = time_ / steps_;
+  const std::int64_t b = x.size(0), d = x.size(1);
+  torch::Tensor s = x;
+  torch::Tensor j;
+  if (jacobian) j = torch::eye(d, kDouble).expand({b, d, d});
+  for (int k = 0; k < steps_; ++k) {
+    auto [phi, offset] = Features(s);
+    if (jacobian) {
+      const torch::Tensor dphi = (-2 * gamma_) * phi.unsqueeze(2) * offset;
+      const torch::Tensor dv = torch::matmul(weights.t(), dphi);  // [B, d, d]
+      j = j + h * torch::matmul(dv, j);
+    }
+    s = s + h * torch::matmul(phi, weights);
+  }
+  if (jacobian) *jacobian = j;
+  return s;
+}
+
+std::pair<torch::Tensor, torch::Tensor> RbfFlowNetImpl::Forward(const torch::Tensor& x) {
+  CheckPoints(x, "x");
+  torch::Tensor j;
+  torch::Tensor z = Integrate(x, &j);
+  return {z, j};
+}
+
+torch::Tensor RbfFlowNetImpl::Map(const torch::Tensor& x) {
+  CheckPoints(x, "x");
+  return Integrate(x, nullptr);
+}
+
+torch::Tensor RbfFlowNetImpl::Velocity(const torch::Tensor& x, const torch::Tensor& goal) {
+  CheckPoints(x, "x");
+  FS_THROW_UNLESS(goal.dim() == 1 && goal.size(0) == centres_.size(1), "RbfFlowNet: goal must be [",
+                  centres_.size(1), "], got ", goal.sizes());
+  // One pass over [x; goal]: z_e is computed by the very same operations as psi(x).
+  const std::int64_t b = x.size(0);
+  torch::Tensor j;
+  const torch::Tensor z = Integrate(torch::cat({x, goal.to(torch::kFloat64).unsqueeze(0)}), &j);
+  return NaturalGradientVelocity(z.narrow(0, 0, b), j.narrow(0, 0, b), z[b], torch::exp(log_speed));
+}
+
+torch::Tensor RbfFlowNetImpl::InvertibilityPenalty(const torch::Tensor& x) {
+  CheckPoints(x, "x");
+  const double h = time_ / steps_;
+  torch::Tensor s = x;
+  torch::Tensor total = torch::zeros({}, x.options());
+  for (int k = 0; k < steps_; ++k) {
+    auto [phi, offset] = Features(s);
+    const torch::Tensor dphi = (-2 * gamma_) * phi.unsqueeze(2) * offset;
+    const torch::Tensor dv = torch::matmul(weights.t(), dphi);  // [B, d, d]
+    const torch::Tensor norm = torch::sqrt(dv.square().sum({1, 2}) + 1e-30);
+    total = total + torch::relu(h * norm - kStepLipschitz).square().mean();
+    s = s + h * torch::matmul(phi, weights);
+  }
+  return total / steps_;
+}
+
+Eigen::MatrixXd RbfFlowNetImpl::WeightsAsEigen() const {
+  const torch::Tensor w = weights.detach().contiguous();
+  return Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
+      w.data_ptr<double>(), w.size(0), w.size(1));
+}
+
+double RbfFlowNetImpl::speed() const { return std::exp(log_speed.item<double>()); }
+
+torch::Tensor VelocityLoss(const torch::Tensor& predicted, const torch::Tensor& target) {
+  FS_THROW_UNLESS(predicted.dim() == 2 && predicted.sizes() == target.sizes(),
+                  "VelocityLoss: predicted ", predicted.sizes(), " and target ", target.sizes(),
+                  " must be the same [B, d]");
+  return (predicted - target).square().sum(1).mean();
+}
+
+ImitationTask::ImitationTask(std::shared_ptr<VelocityModel> model, torch::Tensor positions,
+                             torch::Tensor velocities, torch::Tensor val_positions,
+                             torch::Tensor val_velocities, torch::Tensor goal,
+                             torch::Tensor penalty_points, double penalty_weight)
+    : model_(std::move(model)),
+      positions_(positions.detach().to(torch::kFloat64).contiguous()),
+      velocities_(velocities.detach().to(torch::kFloat64).contiguous()),
+      val_positions_(val_positions.detach().to(torch::kFloat64).contiguous()),
+      val_velocities_(val_velocities.detach().to(torch::kFloat64).contiguous()),
+      goal_(goal.detach().to(torch::kFloat64).contiguous()),
+      penalty_weight_(penalty_weight) {
+  FS_THROW_UNLESS(model_ != nullptr, "ImitationTask: no model");
+  FS_THROW_UNLESS(goal_.dim() == 1 && goal_.size(0) >= 1, "ImitationTask: goal must be [d], got ",
+                  goal_.sizes());
+  const std::int64_t d = goal_.size(0);
+  const auto check = [d](const torch::Tensor& t, const char* name) {
+    FS_THROW_UNLESS(t.dim() == 2 && t.size(0) >= 1 && t.size(1) == d, "ImitationTask: ", name,
+                    " must be [N, ", d, "] with N >= 1, got ", t.sizes());
+    FS_THROW_UNLESS(AllFinite(t), "ImitationTask: ", name, " contain a non-finite value");
+  };
+  check(positions_, "positions");
+  check(velocities_, "velocities");
+  check(val_positions_, "validation positions");
+  check(val_velocities_, "validation velocities");
+  FS_THROW_UNLESS(AllFinite(goal_), "ImitationTask: goal contains a non-finite value");
+  FS_THROW_UNLESS(positions_.size(0) == velocities_.size(0), "ImitationTask: ", positions_.size(0),
+                  " positions but ", velocities_.size(0), " velocities");
+  FS_THROW_UNLESS(penalty_weight >= 0 && std::isfinite(penalty_weight),
+                  "ImitationTask: penalty weight ", penalty_weight, " must be finite and >= 0");
+  if (penalty_points.defined() && penalty_points.numel() > 0) {
+    penalty_points_ = penalty_points.detach().to(torch::kFloat64).contiguous();
+    check(penalty_points_, "penalty points");
+  }
+  FS_THROW_UNLESS(val_positions_.size(0) == val_velocities_.size(0),
+                  "ImitationTask: ", val_positions_.size(0), " validation positions but ",
+                  val_velocities_.size(0), " validation velocities");
+}
+
+torch::Tensor ImitationTask::BatchLoss(const torch::Tensor& indices) {
+  const torch::Tensor i = indices.to(torch::kInt64);
+  const torch::Tensor x = positions_.index_select(0, i);
+  torch::Tensor loss = VelocityLoss(model_->Velocity(x, goal_), velocities_.index_select(0, i));
+  if (penalty_weight_ > 0)
+    loss = loss +
+           penalty_weight_ * model_->InvertibilityPenalty(
+                                 penalty_points_.defined() ? torch::cat({x, penalty_points_}) : x);
+  return loss;
+}
+
+double ImitationTask::ValidationLoss() {
+  torch::NoGradGuard no_grad;
+  return VelocityLoss(model_->Velocity(val_positions_, goal_), val_velocities_).item<double>();
+}
+
+}  // namespace foresight::imitation

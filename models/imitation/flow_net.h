@@ -1,0 +1,138 @@
+#pragma once
+/// LibTorch learners of the imitation transform psi_i (thesis ch 8, "Learning Infinitesimal
+/// Generators from Demonstrations"), double precision (kFloat64) throughout.
+///
+/// RbfFlowNet computes exactly the function of the torch-free engine
+/// (inference/imitation/rbf_flow.h) so that WeightsAsEigen() and speed() exported into RbfFlow /
+/// ImitationSystem give the same velocities:
+///   phi_t(s) = exp(-gamma ||s - c_t||^2) if ||s - c_t|| <= cutoff_radius, else 0   (errata ch 8)
+///   V(s) = W' phi(s),  s_0 = x,  s_{k+1} = s_k + h V(s_k),  psi(x) = s_K,  h = T / K,
+///   J_0 = I,  J_{k+1} = (I + h DV(s_k)) J_k,  DV(s) = sum_t W_t (d phi_t/ds)',
+///   d phi_t/ds = -2 gamma phi_t (s - c_t).
+/// J is propagated explicitly (not by autograd), so autograd differentiates the training loss
+/// through the Euler integration and through J.
+///
+/// The natural-gradient system (thesis eq. naturalDesc; errata: solve with J, never form G^-1):
+///   f(x) = -speed * J(x)^-1 (z - z_e) / ||z - z_e||,  z = psi(x),  z_e = psi(x_goal),
+/// trained by the thesis's eq. learn_cost, the mean squared error ||x_dot - f(x)||^2 over the
+/// demonstrated (position, velocity) pairs (VelocityLoss). speed = exp(log_speed) > 0 is learned.
+
+#include <torch/torch.h>
+
+#include <Eigen/Core>
+#include <memory>
+#include <utility>
+
+#include "training/trainer.h"
+
+namespace foresight::imitation {
+
+/// Regularises ||z - z_e|| as sqrt(||z - z_e||^2 + kGoalEpsilon^2) (length units of z): at the
+/// goal (z = z_e up to rounding, ~1e-16) the velocity is 0 (below speed * 1e-6) with a finite
+/// gradient, and elsewhere the relative change of the velocity is kGoalEpsilon^2 / (2 ||z -
+/// z_e||^2) (below 1e-12 for ||z - z_e|| > 1e-3). The engines use the exact norm (0 at z = z_e).
+inline constexpr double kGoalEpsilon = 1e-9;
+
+/// -speed * J^-1 (z - z_e) / sqrt(||z - z_e||^2 + kGoalEpsilon^2) by torch::linalg::solve.
+/// @param z [B, d] images psi(x); @param jacobian [B, d, d] d psi/dx; @param goal_image [d];
+/// @param speed scalar tensor. @return [B, d].
+torch::Tensor NaturalGradientVelocity(const torch::Tensor& z, const torch::Tensor& jacobian,
+                                      const torch::Tensor& goal_image, const torch::Tensor& speed);
+
+/// A module with a stable velocity field x_dot = f(x; goal), trained by ImitationTask.
+class VelocityModel : public torch::nn::Module {
+ public:
+  /// @param x [B, d] positions; @param goal [d]. @return [B, d] velocities (differentiable).
+  virtual torch::Tensor Velocity(const torch::Tensor& x, const torch::Tensor& goal) = 0;
+  /// A penalty that keeps the model invertible where it is evaluated at x [B, d] (scalar, >= 0,
+  /// differentiable); 0 for models invertible by construction (the default).
+  virtual torch::Tensor InvertibilityPenalty(const torch::Tensor& x) {
+    return torch::zeros({}, x.options());
+  }
+};
+
+/// The RBF flow psi_i (see the file comment).
+class RbfFlowNetImpl : public VelocityModel {
+ public:
+  /// @param centres [m, d] inducing states c_t (as RbfGrid::Centre(t)), d >= 1;
+  /// @param gamma > 0 kernel width; @param cutoff_radius > 0; @param time T > 0;
+  /// @param steps K >= 1 Euler steps; @param initial_speed > 0.
+  /// W starts at zero (psi = identity), log_speed at log(initial_speed). Bad values are an Error.
+  RbfFlowNetImpl(const torch::Tensor& centres, double gamma, double cutoff_radius, double time,
+                 int steps, double initial_speed);
+
+  /// z = psi(x) [B, d] and J = d psi/dx [B, d, d] for x [B, d].
+  std::pair<torch::Tensor, torch::Tensor> Forward(const torch::Tensor& x);
+  /// psi(x) [B, d] only (no Jacobian).
+  torch::Tensor Map(const torch::Tensor& x);
+  /// V(s) [B, d] and DV(s) [B, d, d] of the field at s [B, d].
+  std::pair<torch::Tensor, torch::Tensor> Field(const torch::Tensor& s);
+  /// The natural-gradient velocity (file comment); z_e = psi(goal) is computed in the same pass as
+  /// psi(x) (differentiable).
+  torch::Tensor Velocity(const torch::Tensor& x, const torch::Tensor& goal) override;
+  /// Each Euler step s -> s + h V(s) is a contraction-perturbed identity, hence invertible (and
+  /// its inverse found by the engine's fixed-point iteration), where h ||DV(s)||_2 < 1. The penalty
+  /// is the mean over the points x and the K steps of max(0, h ||DV(s_k)||_F - kStepLipschitz)^2
+  /// (the Frobenius norm bounds the spectral norm): zero when every step is safely contracting.
+  torch::Tensor InvertibilityPenalty(const torch::Tensor& x) override;
+  static constexpr double kStepLipschitz = 0.7;
+
+  /// W [m, d] as the engine's weights matrix.
+  Eigen::MatrixXd WeightsAsEigen() const;
+  double speed() const;
+  int dimension() const { return static_cast<int>(centres_.size(1)); }
+  int num_centres() const { return static_cast<int>(centres_.size(0)); }
+
+  torch::Tensor weights;    ///< W [m, d], parameter "weights"
+  torch::Tensor log_speed;  ///< scalar, parameter "log_speed"
+
+ private:
+  /// The Euler integration; J is computed when `jacobian` is not null.
+  torch::Tensor Integrate(const torch::Tensor& x, torch::Tensor* jacobian);
+  /// phi [B, m] (zero beyond the cut-off) and s - c_t [B, m, d].
+  std::pair<torch::Tensor, torch::Tensor> Features(const torch::Tensor& s) const;
+  void CheckPoints(const torch::Tensor& x, const char* what) const;
+
+  torch::Tensor centres_;  // buffer "centres" [m, d]
+  double gamma_, cutoff_radius_, time_;
+  int steps_;
+};
+TORCH_MODULE(RbfFlowNet);
+
+/// Thesis eq. learn_cost: mean over the batch of ||predicted - target||^2 (squared Euclidean norm
+/// per row). With predicted = f(x) = -speed J^-1 grad Phi this is ||x_dot + speed J^-1 grad
+/// Phi||^2.
+/// @param predicted, target [B, d] (same shape; an Error otherwise).
+torch::Tensor VelocityLoss(const torch::Tensor& predicted, const torch::Tensor& target);
+
+/// Demonstrations for a VelocityModel: BatchLoss(indices) = VelocityLoss on those training rows,
+/// ValidationLoss = VelocityLoss on the validation pairs, without gradients.
+class ImitationTask : public TrainingTask {
+ public:
+  /// @param positions, velocities [N, d] training pairs (N >= 1);
+  /// @param val_positions, val_velocities [N_v, d] validation pairs (N_v >= 1);
+  /// @param goal [d] the attractor. Converted to kFloat64; bad shapes or non-finite values are an
+  /// Error.
+  /// @param penalty_points [R, d] where the model must stay invertible besides the batch (e.g. a
+  /// lattice over the region it is used in); @param penalty_weight >= 0 multiplies
+  /// VelocityModel::InvertibilityPenalty over [batch; penalty_points] in BatchLoss.
+  ImitationTask(std::shared_ptr<VelocityModel> model, torch::Tensor positions,
+                torch::Tensor velocities, torch::Tensor val_positions, torch::Tensor val_velocities,
+                torch::Tensor goal, torch::Tensor penalty_points = {}, double penalty_weight = 0);
+
+  torch::nn::Module& module() override { return *model_; }
+  std::int64_t num_train() const override { return positions_.size(0); }
+  torch::Tensor BatchLoss(const torch::Tensor& indices) override;
+  double ValidationLoss() override;
+
+  VelocityModel& model() { return *model_; }
+  const torch::Tensor& goal() const { return goal_; }
+
+ private:
+  std::shared_ptr<VelocityModel> model_;
+  torch::Tensor positions_, velocities_, val_positions_, val_velocities_, goal_;
+  torch::Tensor penalty_points_;
+  double penalty_weight_ = 0;
+};
+
+}  // namespace foresight::imitation

@@ -1,0 +1,263 @@
+// RbfFlowNet: the explicit variational Jacobian against autograd and central differences, the
+// loss gradient against finite differences, the goal, a short training on an analytic arc, and
+// (with the engine library) parity with RbfFlow / ImitationSystem.
+#include "models/imitation/flow_net.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "tests/test_util.h"
+
+#ifdef FORESIGHT_HAVE_RBF_FLOW_ENGINE
+#include "inference/imitation/rbf_flow.h"
+#include "inference/imitation/rbf_grid.h"
+#endif
+
+namespace foresight::imitation {
+namespace {
+
+using testing::ExpectErrorContains;
+
+const auto kDouble = torch::TensorOptions().dtype(torch::kFloat64);
+
+/// Centres of a regular grid over [lo, hi]^2 with n per axis, in RbfGrid order (x fastest).
+torch::Tensor GridCentres(double lo, double hi, int n) {
+  torch::Tensor c = torch::empty({n * n, 2}, kDouble);
+  const double spacing = (hi - lo) / (n - 1);
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      c[j * n + i][0] = lo + spacing * i;
+      c[j * n + i][1] = lo + spacing * j;
+    }
+  return c;
+}
+
+/// A net on a 6 x 6 grid over [-1, 1]^2 with random weights (a clearly non-linear psi).
+RbfFlowNet RandomNet(std::uint64_t seed, int steps = 8) {
+  RbfFlowNet net(GridCentres(-1, 1, 6), /*gamma=*/6.0, /*cutoff_radius=*/1.0, /*time=*/1.0, steps,
+                 /*initial_speed=*/1.3);
+  torch::manual_seed(seed);
+  torch::NoGradGuard no_grad;
+  net->weights.copy_(0.4 * torch::randn({36, 2}, kDouble));
+  return net;
+}
+
+torch::Tensor RandomPoints(int n, std::uint64_t seed) {
+  torch::manual_seed(seed);
+  return torch::rand({n, 2}, kDouble) * 1.6 - 0.8;
+}
+
+TEST(RbfFlowNet, JacobianMatchesAutograd) {
+  RbfFlowNet net = RandomNet(1);
+  const torch::Tensor x = RandomPoints(6, 2).requires_grad_(true);
+  auto [z, j] = net->Forward(x);
+  // Rows of d z / d x by autograd: samples are independent, so grad of sum_b z[b, i] is row i.
+  for (int i = 0; i < 2; ++i) {
+    const torch::Tensor row =
+        torch::autograd::grad({z.select(1, i).sum()}, {x}, {}, /*retain_graph=*/true)[0];
+    EXPECT_LT((row - j.select(1, i)).abs().max().item<double>(), 1e-12) << "row " << i;
+  }
+  EXPECT_GT((j - torch::eye(2, kDouble)).abs().max().item<double>(), 0.1);  // not trivial
+}
+
+TEST(RbfFlowNet, JacobianMatchesCentralDifferences) {
+  RbfFlowNet net = RandomNet(3);
+  torch::NoGradGuard no_grad;
+  const torch::Tensor x = RandomPoints(6, 4);
+  const torch::Tensor j = net->Forward(x).second;
+  const double h = 1e-6;
+  for (int c = 0; c < 2; ++c) {
+    torch::Tensor xp = x.clone(), xm = x.clone();
+    xp.select(1, c).add_(h);
+    xm.select(1, c).sub_(h);
+    const torch::Tensor fd = (net->Map(xp) - net->Map(xm)) / (2 * h);
+    EXPECT_LT((fd - j.select(2, c)).abs().max().item<double>(), 1e-8) << "column " << c;
+  }
+  // Map is Forward's z.
+  EXPECT_TRUE(torch::equal(net->Map(x), net->Forward(x).first));
+}
+
+TEST(RbfFlowNet, LossGradientMatchesFiniteDifferences) {
+  RbfFlowNet net = RandomNet(5, /*steps=*/5);
+  const torch::Tensor x = RandomPoints(8, 6);
+  torch::manual_seed(7);
+  const torch::Tensor target = torch::randn({8, 2}, kDouble);
+  const torch::Tensor goal = torch::tensor({0.1, -0.2}, kDouble);
+  const auto loss = [&] { return VelocityLoss(net->Velocity(x, goal), target); };
+  net->zero_grad();
+  loss().backward();
+  const torch::Tensor grad_w = net->weights.grad().clone();
+  const double grad_speed = net->log_speed.grad().item<double>();
+  EXPECT_GT(grad_w.abs().max().item<double>(), 1e-3);
+
+  torch::NoGradGuard no_grad;
+  const double h = 1e-6;
+  const auto central = [&](torch::Tensor p) {
+    const double v = p.item<double>();
+    p.fill_(v + h);
+    const double up = loss().item<double>();
+    p.fill_(v - h);
+    const double down = loss().item<double>();
+    p.fill_(v);
+    return (up - down) / (2 * h);
+  };
+  // Every weight near the data (the others have zero gradient) and the speed.
+  int checked = 0;
+  for (int t = 0; t < 36; ++t)
+    for (int c = 0; c < 2; ++c) {
+      const double g = grad_w[t][c].item<double>();
+      const double fd = central(net->weights[t][c]);
+      EXPECT_NEAR(g, fd, 1e-6 * std::max(1.0, std::abs(fd))) << "W[" << t << "][" << c << "]";
+      checked += std::abs(fd) > 1e-4;
+    }
+  EXPECT_GT(checked, 20);
+  EXPECT_NEAR(grad_speed, central(net->log_speed), 1e-6);
+}
+
+TEST(RbfFlowNet, VelocityAtTheGoalIsZeroWithFiniteGradients) {
+  RbfFlowNet net = RandomNet(8);
+  const torch::Tensor goal = torch::tensor({0.25, -0.3}, kDouble);
+  const torch::Tensor x = torch::stack({goal, torch::tensor({-0.5, 0.5}, kDouble)});
+  const torch::Tensor v = net->Velocity(x, goal);
+  EXPECT_LE(v[0].abs().max().item<double>(), 1e-6);  // kGoalEpsilon: rounding-level z - z_e
+  EXPECT_GT(v[1].norm().item<double>(), 0.1);
+  net->zero_grad();
+  VelocityLoss(v, torch::ones({2, 2}, kDouble)).backward();
+  EXPECT_TRUE(torch::isfinite(net->weights.grad()).all().item<bool>());
+  EXPECT_TRUE(std::isfinite(net->log_speed.grad().item<double>()));
+  EXPECT_GT(net->weights.grad().abs().max().item<double>(), 0);
+}
+
+TEST(RbfFlowNet, VelocityIsTheNaturalGradient) {
+  // J f = -speed (z - z_e)/||z - z_e||: the image of the system is the unit-speed attractor.
+  RbfFlowNet net = RandomNet(9);
+  torch::NoGradGuard no_grad;
+  const torch::Tensor x = RandomPoints(5, 10);
+  const torch::Tensor goal = torch::tensor({0.0, 0.1}, kDouble);
+  const torch::Tensor v = net->Velocity(x, goal);
+  auto [z, j] = net->Forward(x);
+  const torch::Tensor diff = z - net->Map(goal.unsqueeze(0));
+  const torch::Tensor expected = -net->speed() * diff / diff.norm(2, 1, true);
+  EXPECT_LT((torch::matmul(j, v.unsqueeze(2)).squeeze(2) - expected).abs().max().item<double>(),
+            1e-12);
+}
+
+/// A quarter circle of radius 1 ending at the origin at unit speed:
+///   p(theta) = (sin theta, 1 - cos theta),  theta from pi/2 down to 0,  p_dot = -(cos, sin).
+void Arc(int n, double offset, torch::Tensor* positions, torch::Tensor* velocities) {
+  *positions = torch::empty({n, 2}, kDouble);
+  *velocities = torch::empty({n, 2}, kDouble);
+  for (int i = 0; i < n; ++i) {
+    const double theta = (M_PI / 2) * (i + offset) / n;
+    (*positions)[i][0] = std::sin(theta);
+    (*positions)[i][1] = 1 - std::cos(theta);
+    (*velocities)[i][0] = -std::cos(theta);
+    (*velocities)[i][1] = -std::sin(theta);
+  }
+}
+
+TEST(RbfFlowNet, TrainingOnAnArcLowersTheValidationLoss) {
+  torch::Tensor p, v, pv, vv;
+  Arc(40, 0.25, &p, &v);
+  Arc(15, 0.6, &pv, &vv);
+  // 8 x 8 grid over [-0.4, 1.4]^2, spacing 0.257: gamma = 1 / (2 spacing^2), cut-off 3 spacings.
+  const double spacing = 1.8 / 7;
+  auto net = std::make_shared<RbfFlowNetImpl>(
+      GridCentres(-0.4, 1.4, 8), 1 / (2 * spacing * spacing), 3 * spacing, 1.0, 10, 1.0);
+  ImitationTask task(net, p, v, pv, vv, torch::zeros({2}, kDouble));
+  EXPECT_EQ(task.num_train(), 40);
+  const double before = task.ValidationLoss();
+  torch::optim::Adam adam(net->parameters(), torch::optim::AdamOptions(0.05));
+  const torch::Tensor all = torch::arange(40, torch::kInt64);
+  for (int it = 0; it < 60; ++it) {
+    adam.zero_grad();
+    task.BatchLoss(all).backward();
+    adam.step();
+  }
+  const double after = task.ValidationLoss();
+  EXPECT_GT(before, 0.05);
+  EXPECT_LT(after, before / 20) << "before " << before << ", after " << after;
+}
+
+TEST(RbfFlowNet, BadArgumentsAreErrors) {
+  const torch::Tensor c = GridCentres(0, 1, 3);
+  ExpectErrorContains([&] { RbfFlowNet(c, -1, 0.5, 1, 4, 1); }, {"gamma", "-1"});
+  ExpectErrorContains([&] { RbfFlowNet(c, 1, 0.5, 1, 0, 1); }, {"steps", "0"});
+  ExpectErrorContains([&] { RbfFlowNet(c, 1, 0.5, 1, 4, 0); }, {"initial_speed"});
+  ExpectErrorContains([&] { RbfFlowNet(torch::zeros({3}, kDouble), 1, 0.5, 1, 4, 1); },
+                      {"centres"});
+  RbfFlowNet net(c, 1, 0.5, 1, 4, 1);
+  ExpectErrorContains([&] { net->Forward(torch::zeros({2, 3}, kDouble)); }, {"x", "[B, 2]"});
+  ExpectErrorContains([&] { net->Forward(torch::zeros({2, 2})); }, {"kFloat64"});
+  ExpectErrorContains(
+      [&] {
+        VelocityLoss(torch::zeros({2, 2}), torch::zeros({3, 2}));
+      },
+      {"VelocityLoss"});
+  const torch::Tensor p = torch::zeros({4, 2}, kDouble);
+  ExpectErrorContains(
+      [&] {
+        ImitationTask(std::make_shared<RbfFlowNetImpl>(c, 1, 0.5, 1, 4, 1), p,
+                      torch::zeros({3, 2}, kDouble), p, p, torch::zeros({2}, kDouble));
+      },
+      {"4 positions", "3 velocities"});
+  torch::Tensor bad = p.clone();
+  bad[1][1] = std::nan("");
+  ExpectErrorContains(
+      [&] {
+        ImitationTask(std::make_shared<RbfFlowNetImpl>(c, 1, 0.5, 1, 4, 1), p, p, bad, p,
+                      torch::zeros({2}, kDouble));
+      },
+      {"validation positions", "non-finite"});
+}
+
+#ifdef FORESIGHT_HAVE_RBF_FLOW_ENGINE
+TEST(RbfFlowNet, EngineParity) {
+  RbfGridSpec<2> spec;
+  spec.lower = Vec<2>(-1.0, -0.8);
+  spec.counts = {9, 7};
+  spec.spacing = 0.25;
+  spec.gamma = 8;
+  spec.cutoff_radius = 0.6;
+  const RbfGrid<2> grid(spec);
+  torch::Tensor centres = torch::empty({grid.size(), 2}, kDouble);
+  for (int t = 0; t < grid.size(); ++t) {
+    centres[t][0] = grid.Centre(t)[0];
+    centres[t][1] = grid.Centre(t)[1];
+  }
+  RbfFlowNet net(centres, spec.gamma, spec.cutoff_radius, 0.8, 7, 1.4);
+  torch::manual_seed(11);
+  {
+    torch::NoGradGuard no_grad;
+    net->weights.copy_(0.3 * torch::randn({grid.size(), 2}, kDouble));
+  }
+  const Vec<2> goal(0.13, 0.21);  // off the lattice: no centre at exactly the cut-off radius
+  const ImitationSystem<2> system(RbfFlow<2>(grid, net->WeightsAsEigen(), FlowSettings<2>{0.8, 7}),
+                                  goal, net->speed());
+  FlowWorkspace<2> ws = system.flow().MakeWorkspace();
+
+  torch::NoGradGuard no_grad;
+  const torch::Tensor x = RandomPoints(30, 12) * 1.2;
+  auto [z, j] = net->Forward(x);
+  const torch::Tensor v = net->Velocity(x, torch::tensor({goal[0], goal[1]}, kDouble));
+  const torch::Tensor ze = net->Map(torch::tensor({{goal[0], goal[1]}}, kDouble));
+  EXPECT_NEAR(system.goal_image()[0], ze[0][0].item<double>(), 1e-12);
+  EXPECT_NEAR(system.goal_image()[1], ze[0][1].item<double>(), 1e-12);
+  for (int b = 0; b < 30; ++b) {
+    const Vec<2> xb(x[b][0].item<double>(), x[b][1].item<double>());
+    Mat<2> jb;
+    const Vec<2> zb = system.flow().Forward(xb, &ws, &jb);
+    const Vec<2> vb = system.Velocity(xb, &ws);
+    for (int i = 0; i < 2; ++i) {
+      EXPECT_NEAR(zb[i], z[b][i].item<double>(), 1e-12);
+      EXPECT_NEAR(vb[i], v[b][i].item<double>(), 1e-12 * std::max(1.0, std::abs(vb[i])));
+      for (int k = 0; k < 2; ++k) EXPECT_NEAR(jb(i, k), j[b][i][k].item<double>(), 1e-12);
+    }
+  }
+}
+#endif
+
+}  // namespace
+}  // namespace foresight::imitation

@@ -1,0 +1,198 @@
+// The occupancy field against central finite differences and the mapping engine's HingeMap; the
+// occupancy fit (IRLS) recovering a disc and a sphere from lattice samples.
+
+#include "inference/imitation/occupancy_field.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "inference/mapping/hinge_map.h"
+#include "models/imitation/occupancy_fit.h"
+#include "tests/occupancy_test_util.h"
+#include "tests/test_util.h"
+
+namespace foresight::imitation {
+namespace {
+
+// No truncation inside [-0.3, 0.3]^D: the field is smooth there.
+template <int D>
+RbfGridSpec<D> SmoothGrid() {
+  RbfGridSpec<D> s;
+  s.lower = Vec<D>::Constant(D == 2 ? -0.3 : -0.2);
+  s.counts.fill(D == 2 ? 7 : 5);
+  s.spacing = 0.1;
+  s.gamma = 30;
+  s.cutoff_radius = D == 2 ? 1.0 : 0.75;
+  return s;
+}
+
+template <int D>
+Vec<D> RandomPoint(std::mt19937_64* rng, double lo, double hi) {
+  std::uniform_real_distribution<double> u(lo, hi);
+  Vec<D> p;
+  for (int a = 0; a < D; ++a) p[a] = u(*rng);
+  return p;
+}
+
+template <int D>
+void CheckDerivatives(std::uint64_t seed) {
+  const RbfGrid<D> grid(SmoothGrid<D>());
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> n01;
+  Eigen::VectorXd w(grid.size());
+  for (auto& v : w) v = 1.5 * n01(rng);
+  const OccupancyField<D> field(grid, w, -0.3);
+  auto ws = field.MakeWorkspace();
+  const double h = 1e-5;
+  for (int n = 0; n < 20; ++n) {
+    const Vec<D> s = RandomPoint<D>(&rng, -0.15, 0.15);
+    OccupancyValue<D> v, plus, minus;
+    field.Evaluate(s, ws.get(), true, &v);
+    EXPECT_GT(v.p, 0);
+    EXPECT_LT(v.p, 1);
+    EXPECT_EQ(field.Probability(s, ws.get()), v.p);
+    // Independent p: dense features over all states.
+    double f = -0.3;
+    for (int t = 0; t < grid.size(); ++t)
+      f += w[t] * std::exp(-30 * (s - grid.Centre(t)).squaredNorm());
+    EXPECT_NEAR(v.p, 1 / (1 + std::exp(-f)), 1e-14);
+    Vec<D> grad_fd;
+    Mat<D> hess_fd;
+    for (int a = 0; a < D; ++a) {
+      Vec<D> e = Vec<D>::Zero();
+      e[a] = h;
+      field.Evaluate(s + e, ws.get(), false, &plus);
+      field.Evaluate(s - e, ws.get(), false, &minus);
+      grad_fd[a] = (plus.p - minus.p) / (2 * h);
+      hess_fd.col(a) = (plus.gradient - minus.gradient) / (2 * h);
+    }
+    EXPECT_TRUE(testing::MatricesNear(v.gradient, grad_fd, 1e-7 * (1 + v.gradient.norm())));
+    EXPECT_TRUE(testing::MatricesNear(v.hessian, hess_fd, 1e-6 * (1 + v.hessian.norm())));
+    EXPECT_TRUE(testing::MatricesNear(v.hessian, v.hessian.transpose(), 1e-12));
+    OccupancyValue<D> no_hessian;
+    field.Evaluate(s, ws.get(), false, &no_hessian);
+    EXPECT_EQ(no_hessian.p, v.p);
+    EXPECT_TRUE(testing::MatricesNear(no_hessian.gradient, v.gradient, 0));
+  }
+}
+
+TEST(OccupancyField, DerivativesMatchFiniteDifferences2D) { CheckDerivatives<2>(1); }
+TEST(OccupancyField, DerivativesMatchFiniteDifferences3D) { CheckDerivatives<3>(2); }
+
+TEST(OccupancyField, FromHingeMapEqualsHingeMapQuery) {
+  HingeGridConfig c;
+  c.x_min = -1;
+  c.x_max = 4;
+  c.y_min = 0.5;
+  c.y_max = 4.5;
+  c.spacing = 0.25;
+  c.gamma = 12;
+  c.cutoff_radius = 0.8;
+  const HingeGrid grid(c);
+  const HingeMap map = testing::RandomHingeMap(HingeMapKind::kHilbert, grid, 3);
+  const OccupancyField<2> field = OccupancyField<2>::FromHingeMap(map);
+  EXPECT_EQ(field.grid().size(), grid.size());
+  MapWorkspace mws = map.MakeWorkspace();
+  auto ws = field.MakeWorkspace();
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> ux(-1, 3.75), uy(0.5, 4.25);
+  for (int n = 0; n < 300; ++n) {
+    const Vec<2> s(ux(rng), uy(rng));
+    const OccupancyQuery q = map.Query(s[0], s[1], &mws);
+    OccupancyValue<2> v;
+    field.Evaluate(s, ws.get(), false, &v);
+    EXPECT_NEAR(v.p, q.probability, 1e-12) << s.transpose();
+    EXPECT_NEAR(v.gradient[0], q.dp_dx, 1e-10);
+    EXPECT_NEAR(v.gradient[1], q.dp_dy, 1e-10);
+  }
+  testing::ExpectErrorContains([&] { OccupancyField<3>::FromHingeMap(map); }, {"2-D"});
+}
+
+TEST(OccupancyField, BadInputIsAnError) {
+  const RbfGrid<2> grid(SmoothGrid<2>());
+  testing::ExpectErrorContains(
+      [&] { OccupancyField<2> f(grid, Eigen::VectorXd::Zero(3), 0, "obstacle map"); },
+      {"obstacle map", "3 weights", "49"});
+  testing::ExpectErrorContains(
+      [&] { OccupancyField<2> f(grid, Eigen::VectorXd::Zero(49), std::nan("")); }, {"bias"});
+}
+
+// ---- occupancy fit ----------------------------------------------------------------------------
+
+template <int D>
+void CheckFitRecoversBall(const Vec<D>& centre, double radius, double box, double sample_spacing,
+                          const RbfGridSpec<D>& grid_spec, std::uint64_t seed) {
+  const auto sdf = [&](const Vec<D>& s) { return (s - centre).norm() - radius; };
+  Eigen::Matrix<double, D, Eigen::Dynamic> points;
+  std::vector<std::uint8_t> occupied;
+  SampleObstacleOccupancy<D>(sdf, Vec<D>::Constant(-box), Vec<D>::Constant(box), sample_spacing,
+                             &points, &occupied);
+  const long per_axis = std::lround(2 * box / sample_spacing) + 1;
+  ASSERT_EQ(points.cols(), static_cast<long>(std::pow(per_axis, D)));
+  for (Eigen::Index i = 0; i < points.cols(); i += 37)
+    EXPECT_EQ(occupied[static_cast<std::size_t>(i)], sdf(points.col(i)) <= 0 ? 1 : 0);
+  const RbfGrid<D> grid(grid_spec);
+  const OccupancyField<D> field = FitOccupancyField<D>(grid, points, occupied, 0.1, "ball");
+  auto ws = field.MakeWorkspace();
+  // Held-out points: uniform in the box.
+  std::mt19937_64 rng(seed);
+  int correct = 0;
+  const int n = 2000;
+  for (int i = 0; i < n; ++i) {
+    const Vec<D> s = RandomPoint<D>(&rng, -box, box);
+    correct += (field.Probability(s, ws.get()) > 0.5) == (sdf(s) <= 0);
+  }
+  EXPECT_GT(static_cast<double>(correct) / n, 0.97);
+  EXPECT_GT(field.Probability(centre, ws.get()), 0.5);
+  for (int a = 0; a < D; ++a)
+    for (double sign : {-1.0, 1.0}) {
+      Vec<D> far = centre;
+      far[a] += sign * 2 * radius;
+      EXPECT_LT(field.Probability(far, ws.get()), 0.1) << far.transpose();
+    }
+}
+
+TEST(FitOccupancyField, RecoversADisc) {
+  const RbfGridSpec<2> g = RbfGrid<2>::Covering(Vec<2>(-1, -1), Vec<2>(1, 1), 0.2, 0.1, 120, 0.4);
+  CheckFitRecoversBall<2>(Vec<2>(0.2, -0.1), 0.3, 1.0, 0.04, g, 4);
+}
+
+TEST(FitOccupancyField, RecoversASphere) {
+  const RbfGridSpec<3> g =
+      RbfGrid<3>::Covering(Vec<3>::Constant(-0.6), Vec<3>::Constant(0.6), 0.2, 0.2, 40, 0.5);
+  CheckFitRecoversBall<3>(Vec<3>(0.05, 0, -0.05), 0.25, 0.6, 0.1, g, 5);
+}
+
+TEST(FitOccupancyField, BadInputIsAnError) {
+  const RbfGrid<2> grid(RbfGrid<2>::Covering(Vec<2>(-1, -1), Vec<2>(1, 1), 0, 0.1, 120, 0.4));
+  Eigen::Matrix<double, 2, -1> pts = Eigen::Matrix<double, 2, -1>::Random(2, 10);
+  std::vector<std::uint8_t> labels(10, 1);
+  testing::ExpectErrorContains([&] { FitOccupancyField<2>(grid, pts, labels, 0.1, "scan 7"); },
+                               {"scan 7", "one class"});
+  labels[3] = 0;
+  testing::ExpectErrorContains(
+      [&] { FitOccupancyField<2>(grid, pts, std::vector<std::uint8_t>(9, 1), 0.1, "scan 7"); },
+      {"scan 7", "10 points", "9"});
+  pts(1, 4) = std::nan("");
+  testing::ExpectErrorContains([&] { FitOccupancyField<2>(grid, pts, labels, 0.1, "scan 7"); },
+                               {"scan 7", "not finite"});
+  pts(1, 4) = 0;
+  testing::ExpectErrorContains([&] { FitOccupancyField<2>(grid, pts, labels, 0, "scan 7"); },
+                               {"l2"});
+  Eigen::Matrix<double, 2, -1> far = pts.array() + 100.0;
+  testing::ExpectErrorContains([&] { FitOccupancyField<2>(grid, far, labels, 0.1, "scan 7"); },
+                               {"cut-off"});
+  Eigen::Matrix<double, 2, -1> samples;
+  std::vector<std::uint8_t> occ;
+  testing::ExpectErrorContains(
+      [&] {
+        SampleObstacleOccupancy<2>([](const Vec<2>&) { return 0.0; }, Vec<2>(0, 0), Vec<2>(1, -1),
+                                   0.1, &samples, &occ);
+      },
+      {"box"});
+}
+
+}  // namespace
+}  // namespace foresight::imitation

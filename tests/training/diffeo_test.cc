@@ -1,0 +1,78 @@
+// Diffeomorphic templates as a run (thesis ch 8): a resumed run whose last shape lost its baseline
+// and artifacts ends with the same models and figures as the uninterrupted one; an obstacle placed
+// on the goal is refused with the reason. The engines, learners, data and metrics have their own
+// tests (tests/imitation/); the kind's train/export/eval contract is in experiment_test.cc.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "core/config.h"
+#include "inference/imitation/eflow.h"
+#include "inference/imitation/template_artifact.h"
+#include "tests/test_util.h"
+#include "training/diffeo/config.h"
+#include "training/diffeo/pipeline.h"
+#include "training/run_dir.h"
+
+namespace foresight {
+namespace {
+namespace fs = std::filesystem;
+
+DiffeoConfig Tiny(const std::vector<std::string>& overrides = {}) {
+  return config::ExperimentConfigFromYaml<DiffeoConfig>(
+      "model: diffeo\ndata: {source: synthetic, synthetic_demos: 3, synthetic_points: 40, "
+      "downsample: 1, held_out: [2]}\nflow: {spacing: 0.1, gamma: 200, cutoff_radius: 0.3, steps: "
+      "4}\ntrain: {epochs: 3, batch_size: 32, progress: none}\neflow: {layers: 2, features: 8, "
+      "train: {epochs: 3, batch_size: 32, progress: none}}\nobstacle: {times: [0.002, 0.004], "
+      "repulsor_gains: [0.1, 1]}\neval: {max_steps: 300, grid: 2, plots: false}\n",
+      "<tiny diffeo>", overrides);
+}
+
+TEST(DiffeoRun, ResumeAfterLosingTheLastArtifactsGivesTheSameModelsAndFigures) {
+  const testing::TempDir dir;
+  const DiffeoConfig c = Tiny();
+  const std::string run = dir.File("run");
+  ASSERT_TRUE(TrainDiffeoRun(c, run, false, nullptr));
+  const std::string eval = EvaluateDiffeoRun(c, run);
+  const auto shape = imitation::LoadTemplate<2>(run + "/models/s_curve.h5");
+  const auto eflow = imitation::EFlowModel::Load(run + "/models/s_curve.eflow.h5");
+  // As if killed after the flow finished: the baseline's checkpoints and every artifact are gone.
+  fs::remove_all(run + "/models");
+  fs::remove_all(run + "/shapes/s_curve/eflow");
+  fs::remove(run + "/eval.json");
+  ASSERT_TRUE(TrainDiffeoRun(c, run, true, nullptr));
+  EXPECT_EQ(EvaluateDiffeoRun(c, run), eval);
+  const auto shape2 = imitation::LoadTemplate<2>(run + "/models/s_curve.h5");
+  const auto eflow2 = imitation::EFlowModel::Load(run + "/models/s_curve.eflow.h5");
+  EXPECT_EQ(shape2.system.flow().weights(), shape.system.flow().weights());
+  EXPECT_EQ(shape2.system.speed(), shape.system.speed());
+  const Eigen::Vector2d x(0.2, -0.1);
+  EXPECT_EQ(eflow2.Velocity(x), eflow.Velocity(x));
+  // A fresh start in the finished directory is refused (naming what is there).
+  testing::ExpectErrorContains([&] { TrainDiffeoRun(c, run, false, nullptr); }, {run});
+}
+
+TEST(DiffeoRun, AnObstacleOnTheGoalIsRefused) {
+  const testing::TempDir dir;
+  const DiffeoConfig c = Tiny({"obstacle.fraction=1.0"});
+  const std::string run = dir.File("run");
+  ASSERT_TRUE(TrainDiffeoRun(c, run, false, nullptr));
+  testing::ExpectErrorContains([&] { EvaluateDiffeoRun(c, run); },
+                               {"s_curve", "covers the goal", "obstacle.fraction"});
+}
+
+TEST(DiffeoConfig, RulesAcrossKeysNameTheKey) {
+  testing::ExpectErrorContains([] { Tiny({"data.held_out=[1, 1]"}); }, {"data.held_out", "twice"});
+  testing::ExpectErrorContains([] { Tiny({"obstacle.times=[0.004, 0.002]"}); },
+                               {"obstacle.times", "not increasing"});
+  testing::ExpectErrorContains([] { Tiny({"data.task=stack_box"}); }, {"data.task", "stack_box"});
+  testing::ExpectErrorContains(
+      [] {
+        Tiny({"bias.enabled=true", "bias.target=[0.1]"});
+      },
+      {"bias.target", "expected 2"});
+}
+
+}  // namespace
+}  // namespace foresight

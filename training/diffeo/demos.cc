@@ -1,0 +1,80 @@
+#include "training/diffeo/demos.h"
+
+#include <algorithm>
+
+#include "core/error.h"
+#include "datasets/data_root.h"
+#include "datasets/lasa.h"
+#include "datasets/synthetic_demos.h"
+
+namespace foresight {
+namespace {
+
+PreparedDemos Prepare(const DiffeoConfig& c, const DemoSet& raw) {
+  PreparedDemos p;
+  p.name = raw.name;
+  p.spread = CheckDemonstrations(raw, c.data.goal_tolerance);
+  const int n = static_cast<int>(raw.demos.size());
+  for (int i : c.data.held_out)
+    FS_THROW_UNLESS(i < n, raw.name, ": data.held_out: demo ", i, " does not exist (", n,
+                    " demos)");
+  const auto [train_set, held_set] = SplitByDemo(raw, c.data.held_out);
+  (void)held_set;
+  for (int i = 0; i < n; ++i)
+    (std::find(c.data.held_out.begin(), c.data.held_out.end(), i) == c.data.held_out.end()
+         ? p.train
+         : p.held_out)
+        .push_back(i);
+  p.norm = FitNormalisation(train_set, c.data.half_range);
+  p.demos = ApplyNormalisation(Downsample(raw, c.data.downsample), p.norm);
+  return p;
+}
+
+}  // namespace
+
+std::vector<PreparedDemos> LoadDiffeoDemos(const DiffeoConfig& c) {
+  std::vector<DemoSet> sets;
+  switch (c.data.source) {
+    case DemoSource::kLasa: {
+      const std::string dir = ResolveDataFile(c.data.root, "lasa_handwriting");
+      std::vector<std::string> shapes = c.data.shapes;
+      if (shapes.size() == 1 && shapes[0] == "all") shapes = ListLasaShapes(dir);
+      for (const std::string& s : shapes) sets.push_back(ReadLasaShape(dir, s));
+      break;
+    }
+    case DemoSource::kSynthetic: {
+      SyntheticDemoConfig s;
+      s.demos = c.data.synthetic_demos;
+      s.points = c.data.synthetic_points;
+      s.noise = c.data.synthetic_noise;
+      s.seed = static_cast<std::uint64_t>(c.seed);
+      s.shape = c.data.synthetic_shape;
+      sets.push_back(SyntheticDemos2d(s));
+      break;
+    }
+    case DemoSource::kTaskSpace:
+      sets.push_back(
+          TaskSpaceDemos(c.data.task, c.data.task_demos, static_cast<std::uint64_t>(c.seed)));
+      break;
+  }
+  std::vector<PreparedDemos> out;
+  for (const DemoSet& s : sets) out.push_back(Prepare(c, s));
+  return out;
+}
+
+void StackDemos(const DemoSet& set, const std::vector<int>& ids, Eigen::MatrixXd* positions,
+                Eigen::MatrixXd* velocities) {
+  Eigen::Index n = 0;
+  for (int i : ids) n += set.demos[static_cast<std::size_t>(i)].position.cols();
+  positions->resize(set.dimension, n);
+  velocities->resize(set.dimension, n);
+  Eigen::Index at = 0;
+  for (int i : ids) {
+    const Demonstration& d = set.demos[static_cast<std::size_t>(i)];
+    positions->middleCols(at, d.position.cols()) = d.position;
+    velocities->middleCols(at, d.position.cols()) = d.velocity;
+    at += d.position.cols();
+  }
+}
+
+}  // namespace foresight

@@ -1,0 +1,32 @@
+#pragma once
+/// The demonstrations of a diffeomorphic-templates run, read, checked, split and normalised as the
+/// config says. Torch-free.
+
+#include <string>
+#include <vector>
+
+#include "datasets/demonstrations.h"
+#include "training/diffeo/config.h"
+
+namespace foresight {
+
+/// One shape (or task) ready to train on: every demo normalised by the training demos' goal and
+/// extent (x_n = (x - offset) * scale, goal at the origin), downsampled as configured.
+struct PreparedDemos {
+  std::string name;                  ///< shape or task name (also the file stem of its artifacts)
+  DemoSet demos;                     ///< normalised, all demos in their original order
+  DemoNormalisation norm;            ///< fitted on the training demos
+  std::vector<int> train, held_out;  ///< demo indices
+  GoalSpread spread;                 ///< of the raw demos
+};
+
+/// Reads the demonstrations the config names (every LASA shape asked for, one synthetic family,
+/// or one task-space task), checks them (CheckDemonstrations with data.goal_tolerance: differing
+/// dimensions, NaN, no common goal are Errors naming the set and demo) and prepares them.
+std::vector<PreparedDemos> LoadDiffeoDemos(const DiffeoConfig& c);
+
+/// Positions and velocities [d x n] of the given demos, concatenated.
+void StackDemos(const DemoSet& set, const std::vector<int>& ids, Eigen::MatrixXd* positions,
+                Eigen::MatrixXd* velocities);
+
+}  // namespace foresight

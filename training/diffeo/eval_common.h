@@ -1,0 +1,244 @@
+#pragma once
+/// Shared pieces of the diffeomorphic-templates evaluation (eval_planar.cc, eval_task_space.cc):
+/// path sets and their scores, start grids, the obstacle map and the outer transforms.
+/// Torch-free.
+
+#include <Eigen/Core>
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "inference/imitation/metrics.h"
+#include "inference/imitation/transforms.h"
+#include "models/imitation/occupancy_fit.h"
+#include "training/diffeo/config.h"
+#include "training/diffeo/demos.h"
+#include "training/diffeo/eval.h"
+
+namespace foresight {
+
+/// Rolled-out paths [d x n_k] with whether each reached the goal.
+struct PathSet {
+  std::vector<Eigen::MatrixXd> paths;
+  std::vector<char> reached;
+};
+
+template <int D>
+PathSet ToPaths(const std::vector<imitation::Rollout<D>>& rollouts) {
+  PathSet p;
+  for (const auto& r : rollouts) {
+    p.paths.push_back(r.path);
+    p.reached.push_back(r.reached && r.finite ? 1 : 0);
+  }
+  return p;
+}
+
+template <int D>
+double ReachRate(const std::vector<imitation::Rollout<D>>& rollouts) {
+  if (rollouts.empty()) return 0;
+  double n = 0;
+  for (const auto& r : rollouts) n += (r.reached && r.finite) ? 1 : 0;
+  return n / static_cast<double>(rollouts.size());
+}
+
+/// prefix + frechet (mean over the paths), frechet_heldout (mean over paths from held-out demos,
+/// when there are any) and reach_rate. Path k starts at demo ids[k] (all demos when ids is empty)
+/// and is compared with it after both are resampled to `resample` points by arc length.
+/// `scale` converts to the reported unit (1: normalised; 1 / norm.scale: data units).
+void AddPathScores(const std::string& prefix, const PathSet& paths, const PreparedDemos& demos,
+                   int resample, DiffeoScores* s, const std::vector<int>& ids = {},
+                   double scale = 1.0);
+
+/// g^D starts on a regular grid over the demonstrations' box grown by `margin` on every side.
+template <int D>
+std::vector<imitation::Vec<D>> GridStarts(const DemoSet& set, int g, double margin) {
+  Eigen::Matrix<double, D, 1> lo = Eigen::Matrix<double, D, 1>::Constant(1e300), hi = -lo;
+  for (const Demonstration& d : set.demos) {
+    lo = lo.cwiseMin(d.position.rowwise().minCoeff());
+    hi = hi.cwiseMax(d.position.rowwise().maxCoeff());
+  }
+  lo.array() -= margin;
+  hi.array() += margin;
+  std::vector<imitation::Vec<D>> out;
+  int total = 1;
+  for (int a = 0; a < D; ++a) total *= g;
+  for (int k = 0; k < total; ++k) {
+    imitation::Vec<D> p;
+    int r = k;
+    for (int a = 0; a < D; ++a) {
+      p[a] = lo[a] + (hi[a] - lo[a]) * (r % g) / (g - 1.0);
+      r /= g;
+    }
+    out.push_back(p);
+  }
+  return out;
+}
+
+/// The starts outside an obstacle.
+template <int D, class Obstacle>
+std::vector<imitation::Vec<D>> FreeOf(const std::vector<imitation::Vec<D>>& starts,
+                                      const Obstacle& o) {
+  std::vector<imitation::Vec<D>> out;
+  for (const auto& p : starts)
+    if (o.SignedDistance(p) > 0) out.push_back(p);
+  return out;
+}
+
+/// MCD of point paths against an obstacle (points, body radius 0).
+template <class Obstacle>
+double MaxDepth(const PathSet& paths, const Obstacle& o, double scale = 1.0) {
+  double worst = 0;
+  for (const Eigen::MatrixXd& p : paths.paths)
+    worst = std::max(worst, imitation::MaxCollisionDepth(p, o, 0.0));
+  return worst * scale;
+}
+
+/// The occupancy map of an obstacle: a Hilbert map on a grid around it, fitted on a lattice of
+/// labelled samples (exact signed distance <= 0 is occupied).
+template <int D>
+imitation::OccupancyField<D> FitObstacleMap(
+    const DiffeoObstacleConfig& o,
+    const std::function<double(const imitation::Vec<D>&)>& signed_distance,
+    const imitation::Vec<D>& lo_in, const imitation::Vec<D>& hi_in, const std::string& source) {
+  const imitation::Vec<D> lo = lo_in.array() - o.sample_margin;
+  const imitation::Vec<D> hi = hi_in.array() + o.sample_margin;
+  Eigen::Matrix<double, D, Eigen::Dynamic> points;
+  std::vector<std::uint8_t> occupied;
+  // Labels from the obstacle grown by map_inflate: a margin between the map's boundary and the
+  // exact obstacle the metrics use.
+  imitation::SampleObstacleOccupancy<D>(
+      [&](const imitation::Vec<D>& p) { return signed_distance(p) - o.map_inflate; }, lo, hi,
+      o.sample_spacing, &points, &occupied);
+  const imitation::RbfGrid<D> grid(
+      imitation::RbfGrid<D>::Covering(lo, hi, 0.0, o.map_spacing, o.map_gamma, o.map_cutoff),
+      source + ": obstacle map");
+  return imitation::FitOccupancyField<D>(grid, points, occupied, o.map_l2,
+                                         source + ": obstacle map");
+}
+
+/// The same for a ball-shaped 2-D obstacle given by its centre and radius.
+template <int D>
+imitation::OccupancyField<D> FitObstacleMap(
+    const DiffeoObstacleConfig& o,
+    const std::function<double(const imitation::Vec<D>&)>& signed_distance,
+    const imitation::Vec<D>& centre, double radius, const std::string& source) {
+  return FitObstacleMap<D>(o, signed_distance, imitation::Vec<D>(centre.array() - radius),
+                           imitation::Vec<D>(centre.array() + radius), source);
+}
+
+/// Largest |grad p| and spectral norm of Hess p of a map on a lattice over [lo, hi].
+template <int D>
+std::pair<double, double> MapSlopes(const imitation::OccupancyField<D>& field,
+                                    const imitation::Vec<D>& lo, const imitation::Vec<D>& hi,
+                                    double spacing) {
+  auto ws = field.MakeWorkspace();
+  std::array<int, D> n{};
+  int total = 1;
+  for (int a = 0; a < D; ++a) {
+    n[a] = std::max(2, static_cast<int>(std::ceil((hi[a] - lo[a]) / spacing)) + 1);
+    total *= n[a];
+  }
+  double g = 0, h = 0;
+  imitation::OccupancyValue<D> v;
+  for (int k = 0; k < total; ++k) {
+    imitation::Vec<D> y;
+    int r = k;
+    for (int a = 0; a < D; ++a) {
+      y[a] = lo[a] + (hi[a] - lo[a]) * (r % n[a]) / (n[a] - 1.0);
+      r /= n[a];
+    }
+    field.Evaluate(y, ws.get(), true, &v);
+    g = std::max(g, v.gradient.norm());
+    h = std::max(
+        h, v.hessian.template selfadjointView<Eigen::Lower>().eigenvalues().cwiseAbs().maxCoeff());
+  }
+  return {g, h};
+}
+
+/// The Euler step of an obstacle flow: obstacle.step, or less where the map is steeper, so that
+/// h ||Hess p|| <= 0.5 (each step a contraction-perturbed identity: invertible).
+inline double ObstacleStep(const DiffeoObstacleConfig& o, double max_hessian) {
+  return std::min(o.step, 0.5 / std::max(max_hessian, 1e-12));
+}
+
+/// Euler steps of an obstacle flow of time `time` with step h: ceil(time / h).
+inline int ObstacleSteps(double time, double h) {
+  return std::max(1, static_cast<int>(std::ceil(time / h - 1e-9)));
+}
+
+template <int D>
+imitation::OuterTransform<D> ObstacleOuter(const imitation::OccupancyField<D>& field, double time,
+                                           double h) {
+  imitation::OuterTransform<D> t;
+  t.type = imitation::OuterTransform<D>::Type::kObstacle;
+  imitation::FlowSettings<D> fs;
+  fs.time = time;
+  fs.steps = ObstacleSteps(time, h);
+  t.obstacle = imitation::ObstacleTransform<D>(field, fs);
+  return t;
+}
+
+/// Whether psi_o^-1(psi_o(y)) = y (to 1e-8) on a lattice of spacing `spacing` over [lo, hi]: the
+/// settings keep the Euler map invertible there.
+template <int D>
+bool ObstacleInvertible(const imitation::ObstacleTransform<D>& t, const imitation::Vec<D>& lo,
+                        const imitation::Vec<D>& hi, double spacing) {
+  auto ws = t.MakeWorkspace();
+  std::array<int, D> n{};
+  int total = 1;
+  for (int a = 0; a < D; ++a) {
+    n[a] = std::max(2, static_cast<int>(std::ceil((hi[a] - lo[a]) / spacing)) + 1);
+    total *= n[a];
+  }
+  for (int k = 0; k < total; ++k) {
+    imitation::Vec<D> y;
+    int r = k;
+    for (int a = 0; a < D; ++a) {
+      y[a] = lo[a] + (hi[a] - lo[a]) * (r % n[a]) / (n[a] - 1.0);
+      r /= n[a];
+    }
+    imitation::Vec<D> back;
+    if (!t.Inverse(t.Forward(y, ws.get()), ws.get(), &back) || (back - y).norm() > 1e-8)
+      return false;
+  }
+  return true;
+}
+
+/// The bias transform toward `target`: samples on a lattice within bias.region of it.
+template <int D>
+imitation::RbfFlow<D> FitBias(const DiffeoBiasConfig& b, const imitation::RbfGridSpec<D>& spec,
+                              const imitation::Vec<D>& target) {
+  std::vector<imitation::Vec<D>> samples;
+  const imitation::RbfGrid<D> grid(spec, "bias grid");
+  for (int t = 0; t < grid.size(); ++t)
+    if ((grid.Centre(t) - target).norm() <= b.region) samples.push_back(grid.Centre(t));
+  FS_THROW_UNLESS(samples.size() >= 2, "bias.region (", b.region,
+                  ") holds fewer than 2 inducing states around the target");
+  Eigen::Matrix<double, D, Eigen::Dynamic> m(D, static_cast<Eigen::Index>(samples.size()));
+  for (std::size_t i = 0; i < samples.size(); ++i) m.col(static_cast<Eigen::Index>(i)) = samples[i];
+  imitation::FlowSettings<D> fs;
+  fs.time = b.time;
+  fs.steps = b.steps;
+  return imitation::FitBiasTransform<D>(grid, m, target, 1e-6, fs);
+}
+
+/// `count` points from a to b.
+inline Eigen::MatrixXd LinePath(const Eigen::VectorXd& a, const Eigen::VectorXd& b, int count) {
+  Eigen::MatrixXd p(a.size(), count);
+  for (int k = 0; k < count; ++k) p.col(k) = a + (b - a) * (k / (count - 1.0));
+  return p;
+}
+
+/// The smallest distance of any path point to `target`.
+inline double ClosestApproach(const PathSet& paths, const Eigen::VectorXd& target) {
+  double best = 1e300;
+  for (const Eigen::MatrixXd& p : paths.paths)
+    best = std::min(best, (p.colwise() - target).colwise().norm().minCoeff());
+  return best;
+}
+
+}  // namespace foresight

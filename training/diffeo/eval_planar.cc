@@ -1,0 +1,238 @@
+// Evaluation of 2-D sets (LASA, synthetic): see eval.h.
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <functional>
+#include <limits>
+
+#include "core/error.h"
+#include "core/log.h"
+#include "inference/imitation/eflow.h"
+#include "inference/imitation/metrics.h"
+#include "inference/imitation/template_artifact.h"
+#include "inference/imitation/transforms.h"
+#include "models/imitation/occupancy_fit.h"
+#include "training/diffeo/eval.h"
+#include "training/diffeo/eval_common.h"
+#include "training/diffeo/plots.h"
+
+namespace foresight {
+namespace {
+
+using namespace imitation;  // NOLINT: the imitation engine throughout this file
+using V2 = Vec<2>;
+
+RolloutSettings Rollouts(const DiffeoConfig& c) {
+  RolloutSettings r;
+  r.dt = c.eval.dt;
+  r.max_steps = c.eval.max_steps;
+  r.goal_tolerance = c.eval.goal_tolerance;
+  r.max_step_length = c.eval.max_step_length;
+  return r;
+}
+
+/// Rollouts of `velocity` from every demo start (or the given starts).
+std::vector<Rollout<2>> RollAll(const std::function<V2(const V2&)>& velocity,
+                                const std::vector<V2>& starts, const V2& goal,
+                                const RolloutSettings& r) {
+  std::vector<Rollout<2>> out;
+  out.reserve(starts.size());
+  for (const V2& s : starts) out.push_back(RollOut<2>(velocity, s, goal, r));
+  return out;
+}
+
+/// The largest map probability along the rollouts (for the selection of obstacle settings).
+double MaxMapProbability(const OccupancyField<2>& field, const std::vector<Rollout<2>>& paths) {
+  auto ws = field.MakeWorkspace();
+  double worst = 0;
+  for (const Rollout<2>& r : paths) {
+    if (!r.finite) return 1;
+    for (Eigen::Index k = 0; k < r.path.cols(); ++k)
+      worst = std::max(worst, field.Probability(r.path.col(k), ws.get()));
+  }
+  return worst;
+}
+
+bool AllReached(const std::vector<Rollout<2>>& paths) {
+  return std::all_of(paths.begin(), paths.end(),
+                     [](const Rollout<2>& r) { return r.reached && r.finite; });
+}
+
+}  // namespace
+
+DiffeoScores EvaluatePlanarShape(const DiffeoConfig& c, const PreparedDemos& demos,
+                                 const std::string& template_path, const std::string& eflow_path,
+                                 const std::string& plot_dir) {
+  const TemplateArtifact<2> art = LoadTemplate<2>(template_path);
+  const ImitationSystem<2>& system = art.system;
+  const V2 goal = system.goal();
+  const RolloutSettings roll = Rollouts(c);
+  const int n = static_cast<int>(demos.demos.demos.size());
+  std::vector<V2> starts;
+  for (const Demonstration& d : demos.demos.demos) starts.push_back(d.position.col(0));
+
+  DiffeoScores s;
+  PlanarPicture pic;
+  pic.demos = &demos.demos;
+  // ---- imitation ------------------------------------------------------------------------------
+  FlowWorkspace<2> fws = system.flow().MakeWorkspace();
+  const auto f_i = [&](const V2& x) { return system.Velocity(x, &fws); };
+  const std::vector<Rollout<2>> imit = RollAll(f_i, starts, goal, roll);
+  AddPathScores("", ToPaths(imit), demos, c.eval.resample, &s);
+  const std::vector<V2> grid = GridStarts<2>(demos.demos, c.eval.grid, 0.1);
+  s.push_back({"grid_reach_rate", ReachRate(RollAll(f_i, grid, goal, roll))});
+  pic.field = f_i;
+  pic.rollouts = ToPaths(imit);
+
+  // ---- Euclideanizing Flows ---------------------------------------------------------------------
+  std::unique_ptr<EFlowModel> eflow;
+  std::function<V2(const V2&)> f_e;
+  if (!eflow_path.empty()) {
+    eflow = std::make_unique<EFlowModel>(EFlowModel::Load(eflow_path));
+    f_e = [&](const V2& x) -> V2 { return eflow->Velocity(x); };
+    const std::vector<Rollout<2>> er = RollAll(f_e, starts, goal, roll);
+    AddPathScores("eflow_", ToPaths(er), demos, c.eval.resample, &s);
+    s.push_back({"eflow_grid_reach_rate", ReachRate(RollAll(f_e, grid, goal, roll))});
+    pic.eflow = ToPaths(er);
+  }
+
+  // ---- an obstacle on the demonstrations --------------------------------------------------------
+  if (c.obstacle.enabled) {
+    SphereObstacle disc;
+    disc.centre = PointAlongDemos(demos.demos, c.obstacle.fraction);
+    disc.radius = c.obstacle.radius;
+    FS_THROW_UNLESS(disc.SignedDistance(goal) > c.eval.goal_tolerance, demos.name,
+                    ": the obstacle (centre ", disc.centre.transpose(), ", radius ", disc.radius,
+                    ") covers the goal; move it (obstacle.fraction) or shrink it");
+    const OccupancyField<2> field = FitObstacleMap<2>(
+        c.obstacle, [&](const V2& p) { return disc.SignedDistance(p); }, V2(disc.centre),
+        disc.radius, demos.name);
+    {
+      auto ws = field.MakeWorkspace();
+      FS_THROW_UNLESS(field.Probability(goal, ws.get()) < c.obstacle.clear_probability, demos.name,
+                      ": the obstacle map covers the goal (p = ", field.Probability(goal, ws.get()),
+                      ")");
+    }
+    // Starts inside the obstacle cannot be evaluated; they are counted.
+    std::vector<V2> free_starts;
+    std::vector<int> free_ids, train_free;
+    for (int i = 0; i < n; ++i)
+      if (disc.SignedDistance(starts[static_cast<std::size_t>(i)]) > 0) {
+        free_starts.push_back(starts[static_cast<std::size_t>(i)]);
+        free_ids.push_back(i);
+      }
+    for (int i : demos.train)
+      if (disc.SignedDistance(starts[static_cast<std::size_t>(i)]) > 0)
+        train_free.push_back(
+            static_cast<int>(std::find(free_ids.begin(), free_ids.end(), i) - free_ids.begin()));
+    s.push_back({"starts_in_obstacle", static_cast<double>(n - static_cast<int>(free_ids.size()))});
+    s.push_back({"mcd", MaxDepth(ToPaths(imit), disc)});
+    if (eflow) s.push_back({"eflow_mcd", MaxDepth(pic.eflow, disc)});
+
+    // Our composed system: the smallest obstacle-flow time whose rollouts from the training starts
+    // keep the map clear (selected on the map, scored on the exact disc).
+    std::vector<V2> train_starts;
+    for (int k : train_free) train_starts.push_back(free_starts[static_cast<std::size_t>(k)]);
+    const V2 box_lo = disc.centre.array() - disc.radius - c.obstacle.sample_margin;
+    const V2 box_hi = disc.centre.array() + disc.radius + c.obstacle.sample_margin;
+    const auto [max_grad, max_hess] =
+        MapSlopes<2>(field, box_lo, box_hi, c.obstacle.sample_spacing);
+    const double h = ObstacleStep(c.obstacle, max_hess);
+    log::Info(demos.name, ": obstacle map max |grad p| ", max_grad, ", max |Hess p| ", max_hess,
+              ", obstacle-flow step ", h);
+    double chosen = -1;
+    bool cleared = false;
+    for (double t : c.obstacle.times) {
+      const OuterTransform<2> outer = ObstacleOuter<2>(field, t, h);
+      // Larger times only bend the map further: stop at the first non-invertible one.
+      if (!ObstacleInvertible<2>(outer.obstacle, box_lo, box_hi, c.obstacle.sample_spacing * 2))
+        break;
+      chosen = t;
+      const ComposedSystem<2> sys(system, {outer});
+      auto ws = sys.MakeWorkspace();
+      const auto vel = [&](const V2& y) { return sys.Velocity(y, &ws); };
+      const auto rs = RollAll(vel, train_starts, goal, roll);
+      if (AllReached(rs) && MaxMapProbability(field, rs) < c.obstacle.clear_probability) {
+        cleared = true;
+        break;
+      }
+    }
+    FS_THROW_UNLESS(chosen > 0, demos.name, ": obstacle.times[0] = ", c.obstacle.times[0],
+                    " with obstacle.step ", c.obstacle.step,
+                    " already makes the obstacle flow non-invertible; lower both");
+    const ComposedSystem<2> avoid(system, {ObstacleOuter<2>(field, chosen, h)});
+    auto aws = avoid.MakeWorkspace();
+    const auto f_o = [&](const V2& y) { return avoid.Velocity(y, &aws); };
+    const std::vector<Rollout<2>> ar = RollAll(f_o, free_starts, goal, roll);
+    s.push_back({"obstacle_flow_time", chosen});
+    s.push_back({"obstacle_flow_steps", static_cast<double>(ObstacleSteps(chosen, h))});
+    s.push_back({"obstacle_cleared_on_map", cleared ? 1.0 : 0.0});
+    AddPathScores("avoid_", ToPaths(ar), demos, c.eval.resample, &s, free_ids);
+    s.push_back({"avoid_mcd", MaxDepth(ToPaths(ar), disc)});
+    s.push_back({"avoid_grid_reach_rate", ReachRate(RollAll(f_o, FreeOf(grid, disc), goal, roll))});
+    pic.obstacle_centre = disc.centre;
+    pic.obstacle_radius = disc.radius;
+    pic.avoid = ToPaths(ar);
+
+    if (eflow) {  // EFlow + repulsor, gain selected on the map the same way
+      auto ws = field.MakeWorkspace();
+      double gain = c.obstacle.repulsor_gains.back();
+      bool rep_cleared = false;
+      const auto rep = [&](double beta) {
+        return [&, beta](const V2& x) -> V2 {
+          OccupancyValue<2> v;
+          field.Evaluate(x, ws.get(), false, &v);
+          return eflow->VelocityWithRepulsor(x, v.gradient, beta);
+        };
+      };
+      for (double beta : c.obstacle.repulsor_gains) {
+        const auto rs = RollAll(rep(beta), train_starts, goal, roll);
+        if (AllReached(rs) && MaxMapProbability(field, rs) < c.obstacle.clear_probability) {
+          gain = beta;
+          rep_cleared = true;
+          break;
+        }
+      }
+      const std::vector<Rollout<2>> rr = RollAll(rep(gain), free_starts, goal, roll);
+      s.push_back({"eflow_repulsor_gain", gain});
+      s.push_back({"eflow_repulsor_cleared_on_map", rep_cleared ? 1.0 : 0.0});
+      AddPathScores("eflow_repulsor_", ToPaths(rr), demos, c.eval.resample, &s, free_ids);
+      s.push_back({"eflow_repulsor_mcd", MaxDepth(ToPaths(rr), disc)});
+      pic.eflow_repulsor = ToPaths(rr);
+    }
+    // Linear motion from each start to the goal.
+    PathSet lines;
+    for (const V2& st : free_starts) {
+      lines.paths.push_back(LinePath(st, goal, c.eval.resample));
+      lines.reached.push_back(1);
+    }
+    AddPathScores("linear_", lines, demos, c.eval.resample, &s, free_ids);
+    s.push_back({"linear_mcd", MaxDepth(lines, disc)});
+  }
+
+  // ---- a user bias ----------------------------------------------------------------------------
+  if (c.bias.enabled) {
+    const V2 target(c.bias.target[0], c.bias.target[1]);
+    const RbfFlow<2> bias = FitBias<2>(c.bias, system.flow().grid().spec(), target);
+    OuterTransform<2> o;
+    o.type = OuterTransform<2>::Type::kBias;
+    o.bias = bias;
+    const ComposedSystem<2> biased(system, {o});
+    auto bws = biased.MakeWorkspace();
+    const auto f_b = [&](const V2& y) { return biased.Velocity(y, &bws); };
+    const auto br = RollAll(f_b, starts, goal, roll);
+    s.push_back({"bias_reach_rate", ReachRate(br)});
+    s.push_back({"bias_closest", ClosestApproach(ToPaths(br), target)});
+    s.push_back({"closest_unbiased", ClosestApproach(ToPaths(imit), target)});
+    pic.biased = ToPaths(br);
+  }
+
+  if (!plot_dir.empty()) {
+    std::filesystem::create_directories(plot_dir);
+    DrawPlanar(pic, plot_dir + "/" + demos.name + ".png");
+  }
+  return s;
+}
+
+}  // namespace foresight

@@ -1,0 +1,207 @@
+#include "training/diffeo/train.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <numeric>
+#include <random>
+
+#include "core/config.h"
+#include "core/error.h"
+#include "core/log.h"
+#include "inference/imitation/template_artifact.h"
+#include "models/imitation/eflow_net.h"
+#include "models/imitation/flow_net.h"
+#include "training/trainer.h"
+
+namespace foresight {
+namespace fs = std::filesystem;
+using namespace imitation;  // NOLINT: the imitation learners and engines throughout this file
+
+namespace {
+
+/// [d x n] -> [n, d] float64.
+torch::Tensor Rows(const Eigen::MatrixXd& m) {
+  torch::Tensor t = torch::empty({m.cols(), m.rows()}, torch::kFloat64);
+  auto a = t.accessor<double, 2>();
+  for (Eigen::Index i = 0; i < m.cols(); ++i)
+    for (Eigen::Index k = 0; k < m.rows(); ++k) a[i][k] = m(k, i);
+  return t;
+}
+
+/// The grid of inducing states over the training demonstrations (grown by flow.margin).
+template <int D>
+RbfGridSpec<D> ShapeGrid(const DiffeoConfig& c, const Eigen::MatrixXd& positions) {
+  const Vec<D> lo = positions.rowwise().minCoeff(), hi = positions.rowwise().maxCoeff();
+  return RbfGrid<D>::Covering(lo, hi, c.flow.margin, c.flow.spacing, c.flow.gamma,
+                              c.flow.cutoff_radius);
+}
+
+template <int D>
+torch::Tensor Centres(const RbfGridSpec<D>& spec) {
+  const RbfGrid<D> grid(spec, "flow grid");
+  torch::Tensor t = torch::empty({grid.size(), D}, torch::kFloat64);
+  auto a = t.accessor<double, 2>();
+  for (int i = 0; i < grid.size(); ++i)
+    for (int k = 0; k < D; ++k) a[i][k] = grid.Centre(i)[k];
+  return t;
+}
+
+/// penalty_lattice^D points over the grid's box (where the flow must stay invertible), [n, D].
+template <int D>
+torch::Tensor PenaltyLattice(const RbfGridSpec<D>& spec, int per_axis) {
+  int total = 1;
+  for (int a = 0; a < D; ++a) total *= per_axis;
+  torch::Tensor t = torch::empty({total, D}, torch::kFloat64);
+  auto acc = t.accessor<double, 2>();
+  for (int k = 0; k < total; ++k) {
+    int r = k;
+    for (int a = 0; a < D; ++a) {
+      const double extent = spec.spacing * (spec.counts[static_cast<std::size_t>(a)] - 1);
+      acc[k][a] = spec.lower[a] + extent * ((r % per_axis) + 0.5) / per_axis;
+      r /= per_axis;
+    }
+  }
+  return t;
+}
+
+/// Everything a shape's networks are built from (deterministic in the config and the data).
+struct ShapeData {
+  Eigen::MatrixXd positions, velocities;  // training demos [d x n]
+  torch::Tensor train_x, train_v, val_x, val_v, goal;
+  torch::Tensor penalty_points;  // lattice over the flow grid's box
+  double initial_speed = 1;
+  int dimension = 2;
+};
+
+ShapeData Prepare(const DiffeoConfig& c, const PreparedDemos& d) {
+  ShapeData s;
+  s.dimension = d.demos.dimension;
+  StackDemos(d.demos, d.train, &s.positions, &s.velocities);
+  const Eigen::Index n = s.positions.cols();
+  std::vector<Eigen::Index> order(static_cast<std::size_t>(n));
+  std::iota(order.begin(), order.end(), 0);
+  std::mt19937_64 rng(static_cast<std::uint64_t>(c.seed) + 3);
+  std::shuffle(order.begin(), order.end(), rng);
+  const Eigen::Index n_val =
+      c.val_fraction > 0 ? std::max<Eigen::Index>(1, std::llround(c.val_fraction * n)) : 0;
+  FS_THROW_UNLESS(n - n_val >= 1, d.name, ": too few samples to train (", n, ")");
+  const auto pick = [&](Eigen::Index from, Eigen::Index to, const Eigen::MatrixXd& m) {
+    Eigen::MatrixXd out(m.rows(), to - from);
+    for (Eigen::Index i = from; i < to; ++i)
+      out.col(i - from) = m.col(order[static_cast<std::size_t>(i)]);
+    return out;
+  };
+  s.val_x = Rows(n_val > 0 ? pick(0, n_val, s.positions) : s.positions);
+  s.val_v = Rows(n_val > 0 ? pick(0, n_val, s.velocities) : s.velocities);
+  s.train_x = Rows(pick(n_val, n, s.positions));
+  s.train_v = Rows(pick(n_val, n, s.velocities));
+  s.goal = torch::zeros({s.dimension}, torch::kFloat64);  // normalised: the goal is the origin
+  Eigen::VectorXd speeds = s.velocities.colwise().norm();
+  std::sort(speeds.data(), speeds.data() + speeds.size());
+  s.initial_speed = std::max(1e-6, speeds[speeds.size() / 2]);
+  s.penalty_points = s.dimension == 2
+                         ? PenaltyLattice<2>(ShapeGrid<2>(c, s.positions), c.flow.penalty_lattice)
+                         : PenaltyLattice<3>(ShapeGrid<3>(c, s.positions), c.flow.penalty_lattice);
+  return s;
+}
+
+RbfFlowNet MakeFlowNet(const DiffeoConfig& c, const ShapeData& s) {
+  const torch::Tensor centres = s.dimension == 2 ? Centres<2>(ShapeGrid<2>(c, s.positions))
+                                                 : Centres<3>(ShapeGrid<3>(c, s.positions));
+  return RbfFlowNet(centres, c.flow.gamma, c.flow.cutoff_radius, c.flow.time, c.flow.steps,
+                    s.initial_speed);
+}
+
+EFlowNet MakeEflowNet(const DiffeoConfig& c, const ShapeData& s) {
+  EFlowNetOptions o;
+  o.dimension = s.dimension;
+  o.layers = c.eflow.layers;
+  o.features = c.eflow.features;
+  o.bandwidth = c.eflow.bandwidth;
+  o.initial_speed = s.initial_speed;
+  o.seed = static_cast<std::uint64_t>(c.seed) + 17;
+  return EFlowNet(o);
+}
+
+/// Trains one model in `dir`; false when interrupted.
+bool TrainModel(std::shared_ptr<VelocityModel> model, const ShapeData& s, const TrainConfig& tc,
+                double penalty_weight, const std::string& dir, std::uint64_t seed, bool resume,
+                const std::atomic<bool>* interrupt, const std::string& what) {
+  ImitationTask task(std::move(model), s.train_x, s.train_v, s.val_x, s.val_v, s.goal,
+                     s.penalty_points, penalty_weight);
+  RunPaths run{dir};
+  fs::create_directories(dir);
+  TrainHooks hooks;
+  hooks.interrupt = interrupt;
+  const TrainingSummary summary =
+      Train(&task, tc, run, seed, resume && fs::exists(run.Checkpoint()), hooks);
+  log::Info(what, ": ", summary.BriefReport());
+  FS_THROW_UNLESS(summary.reason != TerminationReason::kNonFiniteLoss, what,
+                  ": the loss became non-finite; lower train.learning_rate or flow.time");
+  return summary.reason != TerminationReason::kInterrupted;
+}
+
+template <int D>
+void ExportFlow(const DiffeoConfig& c, const PreparedDemos& d, const ShapeData& s, RbfFlowNet& net,
+                const std::string& path) {
+  const RbfGrid<D> grid(ShapeGrid<D>(c, s.positions), d.name + ": flow grid");
+  FlowSettings<D> settings;
+  settings.time = c.flow.time;
+  settings.steps = c.flow.steps;
+  const RbfFlow<D> flow(grid, net->WeightsAsEigen(), settings, d.name);
+  // Invertible where it is used: on the grid's box and at every training sample.
+  const Eigen::Matrix<double, D, Eigen::Dynamic> box = InvertibilityCheckPoints<D>(grid);
+  Eigen::Matrix<double, D, Eigen::Dynamic> points(D, box.cols() + s.positions.cols());
+  points << box, s.positions;
+  const InvertibilityReport report = CheckInvertible<D>(flow, points, c.flow.inverse_tolerance);
+  FS_THROW_UNLESS(report.ok, d.name, ": the trained flow is not invertible with flow.time ",
+                  c.flow.time, " and flow.steps ", c.flow.steps, " (", report.Describe(),
+                  "); use more flow.steps or a shorter flow.time");
+  const ImitationSystem<D> system(flow, Vec<D>::Zero(), net->speed());
+  TemplateNormalisation norm;
+  norm.offset = d.norm.offset;
+  norm.scale = d.norm.scale;
+  SaveTemplate<D>(path, system, norm, config::ToYaml(c), c.seed);
+}
+
+}  // namespace
+
+bool ShapeExported(const DiffeoConfig& c, const DiffeoShapePaths& paths) {
+  return fs::exists(paths.Template()) && (!c.eflow.enabled || fs::exists(paths.Eflow()));
+}
+
+bool TrainShape(const DiffeoConfig& c, const PreparedDemos& demos, const DiffeoShapePaths& paths,
+                bool resume, const std::atomic<bool>* interrupt) {
+  const ShapeData s = Prepare(c, demos);
+  const auto seed = static_cast<std::uint64_t>(c.seed);
+  RbfFlowNet flow = MakeFlowNet(c, s);
+  if (!TrainModel(flow.ptr(), s, c.train, c.flow.invertibility_weight, paths.FlowDir(), seed,
+                  resume, interrupt, demos.name + " flow"))
+    return false;
+  if (!c.eflow.enabled) return true;
+  EFlowNet eflow = MakeEflowNet(c, s);
+  return TrainModel(eflow.ptr(), s, c.eflow.train, 0.0, paths.EflowDir(), seed + 1, resume,
+                    interrupt, demos.name + " eflow");
+}
+
+void ExportShape(const DiffeoConfig& c, const PreparedDemos& demos, const DiffeoShapePaths& paths) {
+  const ShapeData s = Prepare(c, demos);
+  fs::create_directories(fs::path(paths.Template()).parent_path());
+  RbfFlowNet flow = MakeFlowNet(c, s);
+  const std::string best = RunPaths{paths.FlowDir()}.BestCheckpoint();
+  FS_THROW_UNLESS(fs::exists(best), demos.name, ": ", best, " is missing; train the run first");
+  LoadCheckpointModel(best, flow.get());
+  if (s.dimension == 2)
+    ExportFlow<2>(c, demos, s, flow, paths.Template());
+  else
+    ExportFlow<3>(c, demos, s, flow, paths.Template());
+  if (!c.eflow.enabled) return;
+  EFlowNet eflow = MakeEflowNet(c, s);
+  const std::string ebest = RunPaths{paths.EflowDir()}.BestCheckpoint();
+  FS_THROW_UNLESS(fs::exists(ebest), demos.name, ": ", ebest, " is missing; train the run first");
+  LoadCheckpointModel(ebest, eflow.get());
+  eflow->ToEngine(Eigen::VectorXd::Zero(s.dimension))
+      .Save(paths.Eflow(), config::ToYaml(c), c.seed);
+}
+
+}  // namespace foresight

@@ -1,0 +1,36 @@
+#pragma once
+/// Training and export of one shape of a diffeomorphic-templates run (LibTorch inside, torch-free
+/// header): the imitation transform (models/imitation/flow_net.h) and the Euclideanizing-Flows
+/// baseline (eflow_net.h), each by the trainer on the velocity loss of thesis eq. learn_cost,
+/// with its own checkpoints; export writes the engines' artifacts from the best checkpoints.
+
+#include <atomic>
+#include <string>
+
+#include "training/diffeo/config.h"
+#include "training/diffeo/demos.h"
+
+namespace foresight {
+
+/// Where one shape's files live in a run directory.
+struct DiffeoShapePaths {
+  DiffeoShapePaths(std::string run, std::string shape)
+      : run_dir(std::move(run)), name(std::move(shape)) {}
+  std::string run_dir, name;
+  std::string FlowDir() const { return run_dir + "/shapes/" + name + "/flow"; }
+  std::string EflowDir() const { return run_dir + "/shapes/" + name + "/eflow"; }
+  std::string Template() const { return run_dir + "/models/" + name + ".h5"; }
+  std::string Eflow() const { return run_dir + "/models/" + name + ".eflow.h5"; }
+};
+
+/// Whether every artifact of the shape exists (a resumed run skips it).
+bool ShapeExported(const DiffeoConfig& c, const DiffeoShapePaths& paths);
+/// Trains the shape's networks (continuing their checkpoints when `resume` and they exist).
+/// @return false when interrupted.
+bool TrainShape(const DiffeoConfig& c, const PreparedDemos& demos, const DiffeoShapePaths& paths,
+                bool resume, const std::atomic<bool>* interrupt);
+/// Writes the artifacts from the best checkpoints; refuses a flow that is not invertible on the
+/// grid and the demonstrations (CheckInvertible with flow.inverse_tolerance), naming the settings.
+void ExportShape(const DiffeoConfig& c, const PreparedDemos& demos, const DiffeoShapePaths& paths);
+
+}  // namespace foresight
