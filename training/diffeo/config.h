@@ -127,7 +127,7 @@ struct DiffeoEflowConfig {
 /// The obstacle placed on the demonstrations, its occupancy map and the avoidance transforms.
 struct DiffeoObstacleConfig {
   bool enabled = true;
-  double fraction = 0.5;  ///< centre: the mean demo point at this share of the arc length
+  double fraction = 0.5;  ///< centre: the first training demo's point at this share of its length
   /// Radius: 2-D in normalised units; task space in metres (thesis: a 15 cm diameter cylinder).
   double radius = 0.06;
   double height = 0.4;  ///< task space: cylinder height (m), standing on z = 0
@@ -156,7 +156,7 @@ struct DiffeoObstacleConfig {
     using config::Range;
     a->Visit("enabled", &enabled, Range::Any(), "place an obstacle and evaluate avoidance");
     a->Visit("fraction", &fraction, Range::Closed(0, 1),
-             "obstacle centre along the mean demonstration (share of arc length)");
+             "obstacle centre along the first training demonstration (share of arc length)");
     a->Visit("radius", &radius, Range::Positive(),
              "obstacle radius (2-D normalised units; task m)");
     a->Visit("height", &height, Range::Positive(), "task space: cylinder height (m)");

@@ -226,6 +226,17 @@ imitation::RbfFlow<D> FitBias(const DiffeoBiasConfig& b, const imitation::RbfGri
   return imitation::FitBiasTransform<D>(grid, m, target, 1e-6, fs);
 }
 
+/// Where the obstacle goes: the point at arc-length share `fraction` of the first training
+/// demonstration (on a demonstrated path even when the demos are of different shapes, as in
+/// LASA's Multi_Models, whose mean path can pass through the goal).
+inline Eigen::VectorXd ObstacleCentre(const PreparedDemos& demos, double fraction) {
+  DemoSet first;
+  first.name = demos.demos.name;
+  first.dimension = demos.demos.dimension;
+  first.demos.push_back(demos.demos.demos[static_cast<std::size_t>(demos.train.front())]);
+  return PointAlongDemos(first, fraction);
+}
+
 /// `count` points from a to b.
 inline Eigen::MatrixXd LinePath(const Eigen::VectorXd& a, const Eigen::VectorXd& b, int count) {
   Eigen::MatrixXd p(a.size(), count);

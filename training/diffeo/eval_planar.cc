@@ -100,7 +100,7 @@ DiffeoScores EvaluatePlanarShape(const DiffeoConfig& c, const PreparedDemos& dem
   // ---- an obstacle on the demonstrations --------------------------------------------------------
   if (c.obstacle.enabled) {
     SphereObstacle disc;
-    disc.centre = PointAlongDemos(demos.demos, c.obstacle.fraction);
+    disc.centre = ObstacleCentre(demos, c.obstacle.fraction);
     disc.radius = c.obstacle.radius;
     FS_THROW_UNLESS(disc.SignedDistance(goal) > c.eval.goal_tolerance, demos.name,
                     ": the obstacle (centre ", disc.centre.transpose(), ", radius ", disc.radius,

@@ -191,7 +191,7 @@ DiffeoScores EvaluateTaskSpaceShape(const DiffeoConfig& c, const PreparedDemos& 
   // ---- the cylinder on the demonstrations
   // --------------------------------------------------------
   if (c.obstacle.enabled) {
-    const Eigen::Vector3d mid = tn.ToWorld(PointAlongDemos(demos.demos, c.obstacle.fraction));
+    const Eigen::Vector3d mid = tn.ToWorld(ObstacleCentre(demos, c.obstacle.fraction));
     CylinderObstacle cyl;
     cyl.axis_xy = mid.head<2>();
     cyl.z_min = 0;
