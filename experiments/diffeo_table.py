@@ -33,6 +33,10 @@ out = ["# Diffeomorphic templates (thesis ch 8)", "",
 if lasa:
     m, shapes = lasa["mean"], lasa["shapes"]
     n = lasa["shape_count"]
+    if n < 24:
+        out += [f"**Partial**: {n} shapes ({', '.join(sorted(shapes))}). A stopped run is finished by "
+                "`RESUME=1 experiments/diffeo.sh`; these figures came from `foresight eval "
+                "runs/diffeo_lasa \"data.shapes=[...]\"` over the trained shapes.", ""]
     out += [f"## LASA, {n} shapes: imitation (5 of 7 demos trained on)", "",
             "| method | F.D. all starts | F.D. held-out starts | reach rate (demo starts) | reach rate (grid of starts) |",
             "|---|---|---|---|---|",
