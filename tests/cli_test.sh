@@ -185,5 +185,14 @@ if [ "${FORESIGHT_WITH_TORCH:-1}" = "1" ] || [ "${FORESIGHT_WITH_TORCH}" = "ON" 
   expect_error "expected 'directional_map'" bench directional --artifact "$RUN/model.h5"
   "$BIN" bench directional --artifact "$DIR_RUN/model.h5" --json --calls 200 --repeats 2 | grep -q engine_batch1024_us ||
     fail "bench directional"
+  # Diffeomorphic templates: a tiny synthetic run, then the step-time benchmark on its template.
+  DIFF_RUN="$TMP/diffeo"
+  "$BIN" train configs/diffeo/synthetic.yaml --run-dir "$DIFF_RUN" data.synthetic_demos=3 data.synthetic_points=40 \
+    "data.held_out=[2]" train.epochs=2 eflow.train.epochs=2 eflow.layers=2 eval.plots=false eval.grid=2 \
+    "obstacle.times=[0.002]" >/dev/null 2>"$TMP/diffeo.log" || { cat "$TMP/diffeo.log"; fail "diffeo train"; }
+  check_json "$DIFF_RUN/eval.json"
+  "$BIN" bench diffeo --artifact "$DIFF_RUN/models/s_curve.h5" --json --calls 20 --repeats 1 |
+    grep -q engine_vs_libtorch_speedup || fail "bench diffeo"
+  expect_error "expected 'diffeo_template'" bench diffeo --artifact "$DIR_RUN/model.h5"
 fi
 echo "cli ok"
