@@ -32,3 +32,9 @@ rm -rf runs/plan_quickstart
 # against the uniform one on 6 others (runs/gfcs_quickstart/eval.json).
 rm -rf runs/gfcs_quickstart
 ./build/bin/foresight train configs/gfcs/synthetic.yaml --run-dir runs/gfcs_quickstart
+# Diffeomorphic templates (thesis ch 8): a synthetic S-shaped family, EFlow in the same run, an
+# obstacle on the demonstrations (runs/diffeo_quickstart/eval.json, plots/s_curve.png), then the
+# step-time benchmark.
+rm -rf runs/diffeo_quickstart
+./build/bin/foresight train configs/diffeo/synthetic.yaml --run-dir runs/diffeo_quickstart
+./build/bin/foresight bench diffeo --artifact runs/diffeo_quickstart/models/s_curve.h5
