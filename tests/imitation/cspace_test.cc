@@ -17,30 +17,9 @@
 #include <vector>
 
 #include "models/imitation/occupancy_fit.h"
-#include "tests/alloc_counter.h"  // replaces operator new: one per binary
+#define FORESIGHT_ALLOC_COUNTER_MALLOC  // count Eigen's malloc too
+#include "tests/alloc_counter.h"        // replaces operator new: one per binary
 #include "tests/test_util.h"
-
-#if defined(__GLIBC__) && !defined(__SANITIZE_ADDRESS__)
-// Eigen's heap goes through std::malloc, not operator new: count malloc/calloc/realloc too (glibc
-// lets the executable interpose them). Not under AddressSanitizer, which owns malloc.
-extern "C" {
-void* __libc_malloc(std::size_t);
-void* __libc_calloc(std::size_t, std::size_t);
-void* __libc_realloc(void*, std::size_t);
-void* malloc(std::size_t n) {
-  if (g_counting) ++g_allocations;
-  return __libc_malloc(n);
-}
-void* calloc(std::size_t n, std::size_t size) {
-  if (g_counting) ++g_allocations;
-  return __libc_calloc(n, size);
-}
-void* realloc(void* p, std::size_t n) {
-  if (g_counting) ++g_allocations;
-  return __libc_realloc(p, n);
-}
-}
-#endif
 
 namespace foresight::imitation {
 namespace {

@@ -24,32 +24,9 @@
 #include <string>
 #include <vector>
 
-#include "tests/alloc_counter.h"  // replaces operator new: one per binary
+#define FORESIGHT_ALLOC_COUNTER_MALLOC  // count Eigen's malloc too
+#include "tests/alloc_counter.h"        // replaces operator new: one per binary
 #include "tests/test_util.h"
-
-#if defined(__GLIBC__) && !defined(__SANITIZE_ADDRESS__)
-// Eigen's heap goes through std::malloc, not operator new: count malloc/calloc/realloc as well
-// (glibc lets the executable interpose them; the real allocator stays glibc's). Not under
-// AddressSanitizer, which owns malloc itself.
-#define FORESIGHT_COUNTS_MALLOC 1
-extern "C" {
-void* __libc_malloc(std::size_t);
-void* __libc_calloc(std::size_t, std::size_t);
-void* __libc_realloc(void*, std::size_t);
-void* malloc(std::size_t n) {
-  if (g_counting) ++g_allocations;
-  return __libc_malloc(n);
-}
-void* calloc(std::size_t n, std::size_t size) {
-  if (g_counting) ++g_allocations;
-  return __libc_calloc(n, size);
-}
-void* realloc(void* p, std::size_t n) {
-  if (g_counting) ++g_allocations;
-  return __libc_realloc(p, n);
-}
-}
-#endif
 
 namespace foresight::manipulation {
 namespace {
