@@ -16,6 +16,7 @@
 #include <utility>
 
 #include "core/error.h"
+#include "inference/manipulation/urdf_util.h"
 
 namespace foresight::imitation {
 namespace {
@@ -34,61 +35,8 @@ std::string Join(const std::vector<std::string>& items) {
   return out;
 }
 
-/// While alive, collects urdfdom's error messages (console_bridge, a global handler: one capture
-/// at a time) so that a failed parse can say why, instead of printing them.
-class UrdfErrorCapture : public console_bridge::OutputHandler {
- public:
-  UrdfErrorCapture() : lock_(Mutex()) { console_bridge::useOutputHandler(this); }
-  ~UrdfErrorCapture() override { console_bridge::restorePreviousOutputHandler(); }
-  UrdfErrorCapture(const UrdfErrorCapture&) = delete;
-  UrdfErrorCapture& operator=(const UrdfErrorCapture&) = delete;
-
-  void log(const std::string& text, console_bridge::LogLevel level, const char* /*filename*/,
-           int /*line*/) override {
-    if (level < console_bridge::CONSOLE_BRIDGE_LOG_ERROR) return;
-    std::string one_line = text;
-    std::replace(one_line.begin(), one_line.end(), '\n', ' ');
-    messages_ += (messages_.empty() ? "" : "; ") + one_line;
-  }
-  const std::string& messages() const { return messages_; }
-
- private:
-  static std::mutex& Mutex() {
-    static std::mutex mutex;
-    return mutex;
-  }
-  std::lock_guard<std::mutex> lock_;
-  std::string messages_;
-};
-
-Eigen::Isometry3d ToIsometry(const urdf::Pose& pose) {
-  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
-  X.linear() =
-      Eigen::Quaterniond(pose.rotation.w, pose.rotation.x, pose.rotation.y, pose.rotation.z)
-          .normalized()
-          .toRotationMatrix();
-  X.translation() << pose.position.x, pose.position.y, pose.position.z;
-  return X;
-}
-
-const char* JointTypeName(int type) {
-  switch (type) {
-    case urdf::Joint::REVOLUTE:
-      return "revolute";
-    case urdf::Joint::CONTINUOUS:
-      return "continuous";
-    case urdf::Joint::PRISMATIC:
-      return "prismatic";
-    case urdf::Joint::FLOATING:
-      return "floating";
-    case urdf::Joint::PLANAR:
-      return "planar";
-    case urdf::Joint::FIXED:
-      return "fixed";
-    default:
-      return "unknown";
-  }
-}
+using urdf_util::JointTypeName;
+using urdf_util::ToIsometry;
 
 /// Balls covering a cylinder (radius r, length L, axis a through c, in a link frame): n =
 /// clamp(ceil(L / 2r), 1, 3) slices, each covered by the ball through its rim.
@@ -114,7 +62,7 @@ SerialChain SerialChain::FromText(const std::string& urdf_text, const std::strin
                                   std::vector<BodyPoint> points) {
   urdf::ModelInterfaceSharedPtr urdf;
   {
-    UrdfErrorCapture errors;
+    urdf_util::CaptureUrdfdomErrors errors;
     urdf = urdf::parseURDF(urdf_text);
     FS_THROW_UNLESS(urdf != nullptr, source, ": not a valid URDF: ",
                     errors.messages().empty() ? "urdfdom gave no reason" : errors.messages());
@@ -238,7 +186,7 @@ SerialChain SerialChain::LoadJaco(const std::string& jaco_dir) {
   const std::string text = ReadWholeFile(path);
   std::string base;
   {
-    UrdfErrorCapture errors;
+    urdf_util::CaptureUrdfdomErrors errors;
     const urdf::ModelInterfaceSharedPtr urdf = urdf::parseURDF(text);
     FS_THROW_UNLESS(urdf != nullptr, path, ": not a valid URDF: ",
                     errors.messages().empty() ? "urdfdom gave no reason" : errors.messages());

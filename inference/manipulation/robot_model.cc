@@ -16,6 +16,7 @@
 #include <utility>
 
 #include "core/error.h"
+#include "inference/manipulation/urdf_util.h"
 
 namespace foresight::manipulation {
 namespace {
@@ -30,73 +31,14 @@ std::string ReadWholeFile(const std::string& path, const char* what) {
   return text.str();
 }
 
-/// `text` with line breaks replaced by spaces (error messages are one line).
-std::string OneLine(std::string text) {
-  std::replace(text.begin(), text.end(), '\n', ' ');
-  std::replace(text.begin(), text.end(), '\r', ' ');
-  while (!text.empty() && text.back() == ' ') text.pop_back();
-  return text;
-}
-
 std::string Join(const std::vector<std::string>& items) {
   std::string out;
   for (const auto& item : items) out += (out.empty() ? "" : ", ") + item;
   return out;
 }
 
-/// Collects urdfdom's error messages (console_bridge) while alive, instead of printing them, so
-/// that a failed parse can say why. console_bridge's handler is global: one capture at a time.
-class CaptureUrdfdomErrors : public console_bridge::OutputHandler {
- public:
-  CaptureUrdfdomErrors() : lock_(Mutex()) { console_bridge::useOutputHandler(this); }
-  ~CaptureUrdfdomErrors() override { console_bridge::restorePreviousOutputHandler(); }
-  CaptureUrdfdomErrors(const CaptureUrdfdomErrors&) = delete;
-  CaptureUrdfdomErrors& operator=(const CaptureUrdfdomErrors&) = delete;
-
-  void log(const std::string& text, console_bridge::LogLevel level, const char* /*filename*/,
-           int /*line*/) override {
-    if (level < console_bridge::CONSOLE_BRIDGE_LOG_ERROR) return;
-    messages_ += (messages_.empty() ? "" : "; ") + OneLine(text);
-  }
-  const std::string& messages() const { return messages_; }
-
- private:
-  static std::mutex& Mutex() {
-    static std::mutex mutex;
-    return mutex;
-  }
-  std::lock_guard<std::mutex> lock_;
-  std::string messages_;
-};
-
-Eigen::Isometry3d ToIsometry(const urdf::Pose& pose) {
-  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
-  X.linear() =
-      Eigen::Quaterniond(pose.rotation.w, pose.rotation.x, pose.rotation.y, pose.rotation.z)
-          .normalized()
-          .toRotationMatrix();
-  X.translation() << pose.position.x, pose.position.y, pose.position.z;
-  return X;
-}
-
-const char* JointTypeName(int type) {
-  switch (type) {
-    case urdf::Joint::REVOLUTE:
-      return "revolute";
-    case urdf::Joint::CONTINUOUS:
-      return "continuous";
-    case urdf::Joint::PRISMATIC:
-      return "prismatic";
-    case urdf::Joint::FLOATING:
-      return "floating";
-    case urdf::Joint::PLANAR:
-      return "planar";
-    case urdf::Joint::FIXED:
-      return "fixed";
-    default:
-      return "unknown";
-  }
-}
+using urdf_util::JointTypeName;
+using urdf_util::ToIsometry;
 
 /// A field of a CSV row as a finite double; throws naming file:line and the column.
 double ParseNumber(const std::string& field, const std::string& column, const std::string& where) {
@@ -267,7 +209,7 @@ RobotModel RobotModel::FromTexts(const std::string& urdf_text, const std::string
   // Kinematic tree (urdfdom), depth first from the root so parents precede children.
   urdf::ModelInterfaceSharedPtr urdf;
   {
-    CaptureUrdfdomErrors errors;
+    urdf_util::CaptureUrdfdomErrors errors;
     urdf = urdf::parseURDF(urdf_text);
     FS_THROW_UNLESS(urdf != nullptr, urdf_name, ": not a valid URDF: ",
                     errors.messages().empty() ? "urdfdom gave no reason" : errors.messages());
