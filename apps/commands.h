@@ -20,6 +20,7 @@ void AddBenchMapCommand(CLI::App* bench);  // bench map (under `bench`)
 void AddBenchDirectionalCommand(CLI::App* bench);
 /// `bench diffeo --artifact FILE` (under `bench`; needs LibTorch for the comparison).
 void AddBenchDiffeoCommand(CLI::App* bench);
+void AddBenchOtnetCommand(CLI::App* bench);
 /// `navigate CONFIG --run-dir DIR [--episodes N]` (SPAN and baselines in a crowd scenario).
 void AddNavigateCommand(CLI::App* app);
 /// `plan CONFIG [--problems A-B] --run-dir DIR` (GFCS, fabric and planners on manipulation

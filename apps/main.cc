@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
 #ifdef FORESIGHT_WITH_TORCH
     foresight::app::AddBenchDirectionalCommand(app.get_subcommand("bench"));
     foresight::app::AddBenchDiffeoCommand(app.get_subcommand("bench"));
+    foresight::app::AddBenchOtnetCommand(app.get_subcommand("bench"));
 #endif
     foresight::app::AddMapCommands(&app);
     foresight::app::AddNavigateCommand(&app);

@@ -38,3 +38,9 @@ rm -rf runs/gfcs_quickstart
 rm -rf runs/diffeo_quickstart
 ./build/bin/foresight train configs/diffeo/synthetic.yaml --run-dir runs/diffeo_quickstart
 ./build/bin/foresight bench diffeo --artifact runs/diffeo_quickstart/models/s_curve.h5
+# OTNet (thesis ch 6): synthetic rooms and corridors, trajectories generated on unseen maps against
+# k-NN and the mean trajectory (runs/otnet_quickstart/eval.json, plots/test_maps.png), then the
+# encode-and-generate benchmark.
+rm -rf runs/otnet_quickstart
+./build/bin/foresight train configs/otnet/synthetic.yaml --run-dir runs/otnet_quickstart
+./build/bin/foresight bench otnet --artifact runs/otnet_quickstart/model.h5

@@ -194,5 +194,16 @@ if [ "${FORESIGHT_WITH_TORCH:-1}" = "1" ] || [ "${FORESIGHT_WITH_TORCH}" = "ON" 
   "$BIN" bench diffeo --artifact "$DIFF_RUN/models/s_curve.h5" --json --calls 20 --repeats 1 |
     grep -q engine_vs_libtorch_speedup || fail "bench diffeo"
   expect_error "expected 'diffeo_template'" bench diffeo --artifact "$DIR_RUN/model.h5"
+  # OTNet: synthetic rooms, a few epochs, then the engine benchmark on its artifact.
+  OT_RUN="$TMP/otnet"
+  "$BIN" train configs/otnet/synthetic.yaml --run-dir "$OT_RUN" data.synthetic_maps=12 \
+    data.synthetic_trajectories=8 data.val_fraction=0.25 data.test_fraction=0.25 otnet.basis=6 \
+    "otnet.hidden=[8]" train.epochs=2 eval.generated=5 eval.points=20 eval.plot_maps=2 \
+    >/dev/null 2>"$TMP/otnet.log" || { cat "$TMP/otnet.log"; fail "otnet train"; }
+  check_json "$OT_RUN/eval.json"
+  test -f "$OT_RUN/plots/test_maps.png" || fail "otnet plots"
+  "$BIN" bench otnet --artifact "$OT_RUN/model.h5" --json --repeats 1 --count 5 |
+    grep -q libtorch_over_engine || fail "bench otnet"
+  expect_error "expected 'otnet'" bench otnet --artifact "$DIR_RUN/model.h5"
 fi
 echo "cli ok"

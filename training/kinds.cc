@@ -20,6 +20,7 @@ ExperimentRegistry BuiltinKinds() {
 #ifdef FORESIGHT_WITH_TORCH
   r.Add(GfcsKind());
   r.Add(DiffeoKind());
+  r.Add(OtnetKind());
   r.SetDefault("span_predictor");
 #endif
   return r;

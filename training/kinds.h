@@ -23,6 +23,7 @@ ExperimentKind SpanKind(const std::string& embedded_default);
 ExperimentKind DirectionalKind();
 ExperimentKind GfcsKind();
 ExperimentKind DiffeoKind();
+ExperimentKind OtnetKind();
 #endif
 
 /// The config of a train request: the file, or `embedded_default` (named `default_name` in

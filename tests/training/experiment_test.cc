@@ -139,6 +139,11 @@ const std::map<std::string, std::string>& TinyConfigs() {
        "4}\ntrain: {epochs: 2, batch_size: 32, progress: none}\neflow: {layers: 2, features: 8, "
        "train: {epochs: 2, batch_size: 32, progress: none}}\nobstacle: {times: [0.002, 0.004], "
        "repulsor_gains: [0.1, 1]}\neval: {max_steps: 300, grid: 2, plots: false}\n"},
+      {"otnet",
+       "model: otnet\ndata: {source: synthetic, synthetic_maps: 12, synthetic_trajectories: 8, "
+       "val_fraction: 0.25, test_fraction: 0.25}\notnet: {basis: 6, components: 2, hidden: [8]}\n"
+       "train: {epochs: 2, batch_size: 16, progress: none}\neval: {generated: 5, points: 20, "
+       "plots: false}\n"},
   };
   return configs;
 }

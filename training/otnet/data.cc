@@ -1,0 +1,179 @@
+#include "training/otnet/data.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "core/error.h"
+#include "core/log.h"
+#include "datasets/data_root.h"
+#include "datasets/synthetic_rooms.h"
+
+namespace foresight::otnet {
+
+int OtnetSplit::trajectories() const {
+  int n = 0;
+  for (const MapTrajectories& m : maps) n += static_cast<int>(m.trajectories.size());
+  return n;
+}
+
+namespace {
+
+void Truncate(MapTrajectories* m, int max_trajectories) {
+  if (max_trajectories > 0 && static_cast<int>(m->trajectories.size()) > max_trajectories)
+    m->trajectories.resize(max_trajectories);
+}
+
+void LogSplit(const char* name, const OtnetSplit& s) {
+  const ReadReport& r = s.report;
+  log::Info("otnet data: ", name, ": ", s.maps.size(), " maps, ", s.trajectories(), " trajectories",
+            r.trajectories > 0 ? "" : " (synthetic)");
+  if (r.dropped_outside + r.dropped_occupied + r.dropped_too_short > 0)
+    log::Warn("otnet data: ", name, ": dropped ", r.dropped_outside,
+              " trajectories with a waypoint outside the map, ", r.dropped_occupied,
+              " with a waypoint in an occupied cell, ", r.dropped_too_short,
+              " with fewer than 2 waypoints (of ", r.trajectories, " read)");
+}
+
+}  // namespace
+
+OtnetData LoadOtnetData(const OtnetConfig& c) {
+  const double val = c.data.val_fraction, test = c.data.test_fraction;
+  const auto seed = static_cast<std::uint64_t>(c.seed);
+  OtnetData d;
+  if (c.data.source == OtnetSource::kSynthetic) {
+    SyntheticRoomsOptions o;
+    o.size = c.data.map_size;
+    o.maps = c.data.synthetic_maps;
+    o.trajectories_per_map = c.data.synthetic_trajectories;
+    o.layouts = c.data.synthetic_layouts;
+    o.seed = seed;
+    std::vector<MapTrajectories> all = GenerateRoomsAndCorridors(o);
+    std::vector<std::string> ids;
+    for (const MapTrajectories& m : all) ids.push_back(m.id);
+    const MapSplit split = SplitMaps(ids, val, test, seed);
+    const auto take = [&](const std::vector<std::string>& part, OtnetSplit* out) {
+      for (const std::string& id : part)
+        for (MapTrajectories& m : all)
+          if (m.id == id) {
+            Truncate(&m, c.data.max_trajectories);
+            out->maps.push_back(m);
+          }
+    };
+    take(split.train, &d.train);
+    take(split.val, &d.val);
+    take(split.test, &d.test);
+  } else {
+    const std::string root = ResolveDataFile(c.data.root, "occ_traj120");
+    std::vector<std::string> ids = ListOccTrajMaps(root);
+    std::sort(ids.begin(), ids.end());
+    if (c.data.max_maps > 0 && static_cast<int>(ids.size()) > c.data.max_maps)
+      ids.resize(c.data.max_maps);
+    const MapSplit split = SplitMaps(ids, val, test, seed);
+    const BadWaypointPolicy policy = c.data.bad_waypoints == BadWaypoints::kError
+                                         ? BadWaypointPolicy::kError
+                                         : BadWaypointPolicy::kDrop;
+    const auto read = [&](const std::vector<std::string>& part, OtnetSplit* out) {
+      for (const std::string& id : part) {
+        ReadReport r;
+        MapTrajectories m = LoadOccTrajMap(root, id, c.data.map_size, policy, &r);
+        Truncate(&m, c.data.max_trajectories);
+        out->report.Add(r);
+        out->maps.push_back(std::move(m));
+      }
+    };
+    read(split.train, &d.train);
+    read(split.val, &d.val);
+    read(split.test, &d.test);
+  }
+  LogSplit("train", d.train);
+  LogSplit("val", d.val);
+  LogSplit("test", d.test);
+  FS_THROW_UNLESS(d.train.trajectories() > 0, "otnet data: the training maps hold no trajectories");
+  FS_THROW_UNLESS(d.val.trajectories() > 0,
+                  "otnet data: the validation maps hold no trajectories (raise data.val_fraction)");
+  FS_THROW_UNLESS(d.test.trajectories() > 0,
+                  "otnet data: the test maps hold no trajectories (raise data.test_fraction)");
+  return d;
+}
+
+TrajectoryBasis MakeBasis(const OtnetConfig& c) {
+  return TrajectoryBasis(c.otnet.basis, c.otnet.basis_gamma, c.otnet.ridge);
+}
+
+std::vector<int> ChooseDatabase(const std::vector<MapTrajectories>& maps, int database_size) {
+  const int n = static_cast<int>(maps.size());
+  std::vector<int> chosen;
+  if (database_size <= 0 || database_size >= n) {
+    for (int i = 0; i < n; ++i) chosen.push_back(i);
+    return chosen;
+  }
+  std::vector<std::vector<Eigen::Vector2i>> edges(n);
+  std::vector<std::vector<float>> fields(n);
+  for (int i = 0; i < n; ++i) {
+    const BinaryGrid& g = maps[i].map;
+    edges[i] = EdgeCells(g);
+    EdgeDistanceField(edges[i], g.width, g.height, &fields[i]);
+  }
+  // Greedy k-centre: each next map is the one farthest (delta_H) from the chosen ones.
+  std::vector<double> nearest(n, std::numeric_limits<double>::infinity());
+  int next = 0;
+  for (int k = 0; k < database_size; ++k) {
+    chosen.push_back(next);
+    const int width = maps[next].map.width;
+    int far = -1;
+    double far_d = -1;
+    for (int i = 0; i < n; ++i) {
+      const double d = 0.5 * (OneSidedHausdorff(edges[i], fields[next], width) +
+                              OneSidedHausdorff(edges[next], fields[i], width));
+      nearest[i] = std::min(nearest[i], d);
+      if (nearest[i] > far_d) {
+        far_d = nearest[i];
+        far = i;
+      }
+    }
+    next = far;
+  }
+  std::sort(chosen.begin(), chosen.end());
+  return chosen;
+}
+
+MapEncoder MakeEncoder(const OtnetConfig& c, const std::vector<MapTrajectories>& train) {
+  std::vector<BinaryGrid> database;
+  for (int i : ChooseDatabase(train, c.otnet.database_size)) database.push_back(train[i].map);
+  return MapEncoder(std::move(database), c.otnet.length_scale);
+}
+
+EncodedSplit EncodeSplit(const MapEncoder& encoder, const TrajectoryBasis& basis,
+                         const OtnetSplit& split) {
+  EncodedSplit e;
+  const int maps = static_cast<int>(split.maps.size());
+  e.phi.resize(maps, encoder.size());
+  e.w.resize(split.trajectories(), basis.weights());
+  MapEncoder::Workspace ws = encoder.MakeWorkspace();
+  Eigen::VectorXd phi(encoder.size());
+  int row = 0;
+  for (int m = 0; m < maps; ++m) {
+    encoder.Encode(split.maps[m].map, &ws, phi);
+    e.phi.row(m) = phi.transpose();
+    for (const Eigen::MatrixX2d& t : split.maps[m].trajectories) {
+      e.w.row(row++) = basis.Fit(t).transpose();
+      e.map_index.push_back(m);
+    }
+  }
+  return e;
+}
+
+double ReconstructionRmse(const TrajectoryBasis& basis, const OtnetSplit& split) {
+  double sum = 0;
+  long count = 0;
+  for (const MapTrajectories& m : split.maps)
+    for (const Eigen::MatrixX2d& t : m.trajectories) {
+      const Eigen::VectorXd taus = UniformTaus(static_cast<int>(t.rows()));
+      sum += (basis.Evaluate(basis.Fit(t), taus) - t).squaredNorm();
+      count += t.rows();
+    }
+  return count ? std::sqrt(sum / count) : 0.0;
+}
+
+}  // namespace foresight::otnet

@@ -1,0 +1,43 @@
+// OTNet as an experiment kind (thesis ch 6): trajectory distributions in maps never seen before.
+
+#include <iostream>
+
+#include "core/error.h"
+#include "training/kinds.h"
+#include "training/otnet/pipeline.h"
+#include "training/trainer.h"
+
+namespace foresight {
+
+ExperimentKind OtnetKind() {
+  ExperimentKind k;
+  k.tag = "otnet";
+  k.summary = "OTNet: trajectory distributions in new maps from Hausdorff map similarities (ch 6)";
+  k.configs = "configs/otnet/*.yaml";
+  k.resumable = true;
+  k.reference = [] { return config::ReferenceTable<OtnetConfig>(); };
+  k.train = [](const TrainRequest& req) {
+    FS_THROW_UNLESS(req.config != "default" && !req.config.empty(),
+                    "otnet has no embedded default config; name one (configs/otnet/*.yaml)");
+    const auto c = config::LoadExperimentConfig<OtnetConfig>(req.config, req.overrides);
+    bool done = false;
+    {
+      const ScopedInterruptFlag interrupt;
+      done = otnet::TrainOtnetRun(c, req.run_dir, req.resume, interrupt.flag());
+    }
+    if (!done) Fail("interrupted; continue with --resume --run-dir ", req.run_dir);
+    std::cout << "wrote " << req.run_dir << "/model.h5\n";
+    if (req.evaluate) {
+      otnet::EvaluateOtnetRun(c, req.run_dir);
+      std::cout << "wrote " << req.run_dir << "/eval.json\n";
+    }
+  };
+  k.export_run = otnet::ExportOtnetRun;
+  k.evaluate = [](const std::string& run_dir, const std::vector<std::string>& overrides) {
+    const auto c = LoadRunConfig<OtnetConfig>(run_dir, overrides);
+    return otnet::EvaluateOtnetRun(c, run_dir);
+  };
+  return k;
+}
+
+}  // namespace foresight
