@@ -42,6 +42,7 @@ if e:
             f"{f(e['knn_coverage_hausdorff'])} |",
             f"| mean trajectory | {f(e['mean_hausdorff'])} | {f(e['mean_frechet'])} | "
             f"{f(e['mean_anll'])} | {f(e['mean_coverage_hausdorff'])} |",
+            f"| control: OTNet's samples, one Gaussian per tau | - | - | {f(e.get('samples_anll'))} | - |",
             "| thesis OTNet (authors' test maps) | 1.98 | 2.13 | 29.83 | - |",
             "| thesis k-NN | 2.03 | 2.14 | 31.46 | - |", "",
             f"OTNet samples accepted (collision-free): {f(100 * e['acceptance_rate'], 1)} %; maps "

@@ -1,7 +1,6 @@
 #include "inference/otnet/map_encoding.h"
 
 #include <algorithm>
-#include <cassert>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -68,7 +67,9 @@ void ComputeField(const std::vector<Eigen::Vector2i>& edges, int width, int heig
   cv::Mat dst(height, width, CV_32FC1, out->data());
   cv::distanceTransform(src, dst, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
   // create() inside OpenCV keeps our buffer when size and type match; check it was not replaced.
-  assert(dst.data == reinterpret_cast<uchar*>(out->data()));
+  FS_THROW_UNLESS(dst.data == reinterpret_cast<uchar*>(out->data()),
+                  "EdgeDistanceField: OpenCV replaced the output buffer (", width, " x ", height,
+                  "); the distance field would be stale");
 }
 
 /// h(A, B) read off B's field; A must be non-empty and inside the field's grid.

@@ -155,6 +155,14 @@ OtnetModel::OtnetModel(MapEncoder encoder, TrajectoryBasis basis, Mlp mlp, Mixtu
   FS_THROW_UNLESS(mlp_.output_size() == head_.Total(), "OtnetModel: the MLP gives ",
                   mlp_.output_size(), " outputs; the head of ", components, " components over ",
                   head_.weights, " weights needs ", head_.Total());
+  log_scale_offset_ = Eigen::VectorXd::Zero(head_.weights);
+}
+
+void OtnetModel::SetLogScaleOffset(const Eigen::VectorXd& offset) {
+  FS_THROW_UNLESS(offset.size() == head_.weights, "OtnetModel::SetLogScaleOffset: ", offset.size(),
+                  " entries, expected ", head_.weights, " (2M)");
+  FS_THROW_UNLESS(offset.allFinite(), "OtnetModel::SetLogScaleOffset: a value is not finite");
+  log_scale_offset_ = offset;
 }
 
 OtnetModel OtnetModel::Load(const std::string& path) {
@@ -217,8 +225,17 @@ OtnetModel OtnetModel::Load(const std::string& path) {
                   components, " and /model/num_basis ", num_basis, " need ", head.Total(),
                   " = components (1 + 4 num_basis)");
   try {
-    return OtnetModel(MapEncoder(std::move(database), length_scale),
-                      TrajectoryBasis(num_basis, gamma, ridge), std::move(mlp), family, components);
+    OtnetModel model(MapEncoder(std::move(database), length_scale),
+                     TrajectoryBasis(num_basis, gamma, ridge), std::move(mlp), family, components);
+    if (f.Exists("/model/log_scale_offset")) {
+      const h5::Array<double> o = f.ReadDouble("/model/log_scale_offset");
+      FS_THROW_UNLESS(o.shape.size() == 1 && o.Size() == static_cast<std::size_t>(2 * num_basis),
+                      path, ": dataset /model/log_scale_offset has ", o.Size(),
+                      " values, expected ", 2 * num_basis, " (2 num_basis)");
+      model.SetLogScaleOffset(
+          Eigen::Map<const Eigen::VectorXd>(o.data.data(), static_cast<Eigen::Index>(o.Size())));
+    }
+    return model;
   } catch (const Error& e) {
     const std::string what = e.what();
     if (what.rfind(path, 0) == 0) throw;
@@ -249,6 +266,8 @@ void OtnetModel::Save(const std::string& path, const std::string& config_yaml,
     f->Write(
         "/model/database", db.data(),
         {static_cast<std::size_t>(d), static_cast<std::size_t>(h), static_cast<std::size_t>(w)});
+    f->Write("/model/log_scale_offset", log_scale_offset_.data(),
+             {static_cast<std::size_t>(log_scale_offset_.size())});
     mlp_.Save(f, "/weights/", LayerNames(static_cast<int>(mlp_.layers().size())));
   });
 }
@@ -313,9 +332,10 @@ void OtnetModel::PredictFromFeatures(const Eigen::Ref<const Eigen::VectorXd>& ph
   for (int q = 0; q < qn; ++q) {
     for (int j = 0; j < n; ++j) {
       out->mean(q, j) = y[head_.MeanOffset(q) + j];
-      const double z = std::clamp(static_cast<double>(y[head_.LogScaleOffset(q) + j]),
+      const double o = log_scale_offset_[j];
+      const double z = std::clamp(static_cast<double>(y[head_.LogScaleOffset(q) + j]) - o,
                                   OtnetHead::kLogScaleMin, OtnetHead::kLogScaleMax);
-      out->scale(q, j) = std::exp(z);
+      out->scale(q, j) = std::exp(z + o);
     }
   }
   out->family = family_;

@@ -125,6 +125,14 @@ class OtnetModel {
   int components() const { return head_.components; }
   const OtnetHead& head() const { return head_; }
 
+  /// Per-weight offset o [2M] of the log-scale clamp: the engine uses
+  /// exp(clamp(z - o, kLogScaleMin, kLogScaleMax) + o) for raw network output z. Training clamps
+  /// the standardised log-scale and the export folds log s_w into the last layer, so the export
+  /// sets o = log s_w and the engine clamps where training did. Default 0. Error on a wrong size
+  /// or a non-finite value. Stored in the artifact (/model/log_scale_offset).
+  void SetLogScaleOffset(const Eigen::VectorXd& offset);
+  const Eigen::VectorXd& log_scale_offset() const { return log_scale_offset_; }
+
   Workspace MakeWorkspace(int max_count = 100, int points = 100) const;
 
   /// The mixture for `map` (encode + network) into ws->mixture; returns it.
@@ -160,6 +168,7 @@ class OtnetModel {
   Mlp mlp_;
   MixtureFamily family_ = MixtureFamily::kNormal;
   OtnetHead head_;
+  Eigen::VectorXd log_scale_offset_;
 };
 
 }  // namespace foresight::otnet

@@ -370,6 +370,45 @@ TEST(ExportMlp, TheEngineReproducesTheNetOnRawPhi) {
 
 /// Two groups of maps (phi near one of two prototypes); each group's trajectories fall in two
 /// clusters of w. Returns raw phi [maps x D], map index per trajectory and raw w [N x 4].
+// Where the log-scale clamp is active (a collapsed component), the engine with the export's
+// log-scale offset clamps in the standardised space, as training does.
+TEST(ExportMlp, TheEngineClampsTheLogScaleWhereTrainingDid) {
+  const MapEncoder encoder = ThreeMapEncoder();
+  const TrajectoryBasis basis(6, 50, 1e-6);
+  OtnetNormalisation norm;
+  norm.input_mean = Eigen::Vector3d::Zero();
+  norm.input_std = Eigen::Vector3d::Ones();
+  norm.weight_mean = Eigen::VectorXd::Zero(12);
+  norm.weight_std = Eigen::VectorXd::LinSpaced(12, 2, 30);
+  OtnetNetOptions o;
+  o.inputs = 3;
+  o.hidden = {8};
+  o.components = 2;
+  o.weights = basis.weights();
+  torch::manual_seed(3);
+  OtnetNet net(o);
+  {  // Log-scale biases far outside [-7, 7] in both directions.
+    torch::NoGradGuard no_grad;
+    auto bias = net->linears().back()->bias;
+    const OtnetHead head{o.components, o.weights};
+    for (int q = 0; q < o.components; ++q)
+      for (int j = 0; j < o.weights; ++j)
+        bias[head.LogScaleOffset(q) + j] = (j % 2 ? 20.0f : -20.0f);
+    net->linears().back()->weight.zero_();
+  }
+  OtnetModel model(encoder, basis, ExportMlp(net, norm), MixtureFamily::kNormal, 2);
+  model.SetLogScaleOffset(norm.weight_std.array().log().matrix());
+  OtnetModel::Workspace ws = model.MakeWorkspace();
+  Mixture mixture;
+  model.PredictFromFeatures(Eigen::Vector3d(0.3, 0.2, 0.9), &ws, &mixture);
+  for (int q = 0; q < 2; ++q)
+    for (int j = 0; j < 12; ++j) {
+      const double trained =
+          std::exp(j % 2 ? OtnetHead::kLogScaleMax : OtnetHead::kLogScaleMin) * norm.weight_std[j];
+      EXPECT_NEAR(mixture.scale(q, j) / trained, 1.0, 1e-5) << q << " " << j;
+    }
+}
+
 struct Synthetic {
   Eigen::MatrixXd phi;
   std::vector<std::int64_t> map;

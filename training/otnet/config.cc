@@ -12,6 +12,8 @@ void OtnetConfig::Validate(const std::string& source) const {
   FS_THROW_UNLESS(data.val_fraction + data.test_fraction < 0.9, source,
                   ": data.val_fraction + data.test_fraction = ",
                   data.val_fraction + data.test_fraction, " leaves too few training maps");
+  FS_THROW_UNLESS(otnet.ridge > 0, source, ": otnet.ridge: ", otnet.ridge,
+                  " must be > 0 (the fit of M basis weights needs it when points are few)");
   FS_THROW_UNLESS(!otnet.hidden.empty(), source, ": otnet.hidden: empty (give >= 1 layer width)");
   for (std::size_t i = 0; i < otnet.hidden.size(); ++i)
     FS_THROW_UNLESS(otnet.hidden[i] >= 1 && otnet.hidden[i] <= 65536, source, ": otnet.hidden[", i,

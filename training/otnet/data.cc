@@ -8,6 +8,7 @@
 #include "core/log.h"
 #include "datasets/data_root.h"
 #include "datasets/synthetic_rooms.h"
+#include "inference/otnet/trajectory_metrics.h"
 
 namespace foresight::otnet {
 
@@ -49,16 +50,21 @@ OtnetData LoadOtnetData(const OtnetConfig& c) {
     o.layouts = c.data.synthetic_layouts;
     o.seed = seed;
     std::vector<MapTrajectories> all = GenerateRoomsAndCorridors(o);
+    // Maps of one layout family are near-copies: split families, not maps, so that the
+    // validation and test maps are layouts never trained on.
+    const int families = o.layouts > 0 ? std::min(o.layouts, o.maps) : o.maps;
     std::vector<std::string> ids;
-    for (const MapTrajectories& m : all) ids.push_back(m.id);
+    for (int k = 0; k < families; ++k) ids.push_back("family_" + std::to_string(k));
     const MapSplit split = SplitMaps(ids, val, test, seed);
     const auto take = [&](const std::vector<std::string>& part, OtnetSplit* out) {
-      for (const std::string& id : part)
-        for (MapTrajectories& m : all)
-          if (m.id == id) {
-            Truncate(&m, c.data.max_trajectories);
-            out->maps.push_back(m);
-          }
+      for (const std::string& id : part) {
+        const int family = std::stoi(id.substr(7));
+        for (int k = family; k < static_cast<int>(all.size()); k += families) {
+          MapTrajectories& m = all[k];
+          Truncate(&m, c.data.max_trajectories);
+          out->maps.push_back(m);
+        }
+      }
     };
     take(split.train, &d.train);
     take(split.val, &d.val);
@@ -132,6 +138,11 @@ std::vector<int> ChooseDatabase(const std::vector<MapTrajectories>& maps, int da
         far = i;
       }
     }
+    if (far_d <= 0) {
+      log::Warn("otnet: only ", chosen.size(), " distinct maps for a database of ", database_size,
+                "; using those");
+      break;
+    }
     next = far;
   }
   std::sort(chosen.begin(), chosen.end());
@@ -157,7 +168,7 @@ EncodedSplit EncodeSplit(const MapEncoder& encoder, const TrajectoryBasis& basis
     encoder.Encode(split.maps[m].map, &ws, phi);
     e.phi.row(m) = phi.transpose();
     for (const Eigen::MatrixX2d& t : split.maps[m].trajectories) {
-      e.w.row(row++) = basis.Fit(t).transpose();
+      e.w.row(row++) = basis.Fit(ResampleUniform(t, kFitPoints)).transpose();
       e.map_index.push_back(m);
     }
   }
@@ -169,9 +180,9 @@ double ReconstructionRmse(const TrajectoryBasis& basis, const OtnetSplit& split)
   long count = 0;
   for (const MapTrajectories& m : split.maps)
     for (const Eigen::MatrixX2d& t : m.trajectories) {
-      const Eigen::VectorXd taus = UniformTaus(static_cast<int>(t.rows()));
-      sum += (basis.Evaluate(basis.Fit(t), taus) - t).squaredNorm();
-      count += t.rows();
+      const Eigen::MatrixX2d r = ResampleUniform(t, kFitPoints);
+      sum += (basis.Evaluate(basis.Fit(r), UniformTaus(kFitPoints)) - r).squaredNorm();
+      count += kFitPoints;
     }
   return count ? std::sqrt(sum / count) : 0.0;
 }

@@ -15,6 +15,11 @@
 
 namespace foresight::otnet {
 
+/// Every trajectory is resampled to this many points at uniform normalised time (linear
+/// interpolation, as the authors' script) before its ridge fit: with fewer waypoints than basis
+/// functions the fit would sag between the waypoints.
+inline constexpr int kFitPoints = 100;
+
 struct OtnetSplit {
   std::vector<MapTrajectories> maps;
   ReadReport report;  ///< what the reader kept and dropped (zeros for synthetic data)
@@ -26,8 +31,8 @@ struct OtnetData {
 };
 
 /// Reads Occ-Traj120 (or generates the synthetic maps) and splits by map (SplitMaps with the
-/// config's seed). Logs the split sizes and every dropped trajectory count. Error when a split has
-/// no trajectories.
+/// config's seed; synthetic maps by layout family). Logs the split sizes and every dropped
+/// trajectory count. Error when a split has no trajectories.
 OtnetData LoadOtnetData(const OtnetConfig& c);
 
 TrajectoryBasis MakeBasis(const OtnetConfig& c);
@@ -46,8 +51,8 @@ struct EncodedSplit {
 EncodedSplit EncodeSplit(const MapEncoder& encoder, const TrajectoryBasis& basis,
                          const OtnetSplit& split);
 
-/// Root-mean-square distance between the waypoints of `split` and their basis reconstruction
-/// (cells): how much the representation loses.
+/// Root-mean-square distance (cells) between the resampled trajectories of `split` and their basis
+/// reconstruction at the kFitPoints uniform taus: how much the representation loses.
 double ReconstructionRmse(const TrajectoryBasis& basis, const OtnetSplit& split);
 
 }  // namespace foresight::otnet

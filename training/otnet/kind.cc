@@ -34,6 +34,11 @@ ExperimentKind OtnetKind() {
   };
   k.export_run = otnet::ExportOtnetRun;
   k.evaluate = [](const std::string& run_dir, const std::vector<std::string>& overrides) {
+    // The split is the run's: another seed or data section would score training maps as test.
+    for (const std::string& o : overrides)
+      FS_THROW_UNLESS(o.rfind("seed=", 0) != 0 && o.rfind("data.", 0) != 0, "eval ", run_dir,
+                      ": override '", o,
+                      "' would change the map split the run was trained on; train a new run");
     const auto c = LoadRunConfig<OtnetConfig>(run_dir, overrides);
     return otnet::EvaluateOtnetRun(c, run_dir);
   };

@@ -93,8 +93,10 @@ std::string ExportOtnet(const OtnetConfig& c, const OtnetPrepared& p, const std:
   OtnetNet net = MakeNet(c, p);
   LoadCheckpointModel(best, net.get());
   net->eval();
-  const OtnetModel model(p.encoder, p.basis, ExportMlp(net, Normalisation(p)), Family(c),
-                         c.otnet.components);
+  const OtnetNormalisation norm = Normalisation(p);
+  OtnetModel model(p.encoder, p.basis, ExportMlp(net, norm), Family(c), c.otnet.components);
+  // The engine clamps log-scales where training did (in standardised units).
+  model.SetLogScaleOffset(norm.weight_std.array().log().matrix());
   const std::string path = run_dir + "/model.h5";
   model.Save(path, config::ToYaml(c), c.seed);
   return path;

@@ -96,9 +96,15 @@ Scores TransferToOccupancyMap(const OtnetConfig& c, const OtnetModel& model,
                     ", ", side, "): no occupied edge in the section; choose another");
     const Mixture& mixture = model.Predict(grids[s], &ws);
     std::vector<Eigen::Vector2d> starts;
-    if (t.starts.empty())
+    if (t.starts.empty()) {
       starts = BorderOpenings(grids[s], t.openings);
-    else
+      if (starts.empty()) {
+        log::Warn("otnet transfer: section ", s,
+                  " has no opening in its border; starting at its "
+                  "centre");
+        starts.emplace_back(size / 2.0, size / 2.0);
+      }
+    } else
       for (std::size_t k = 0; k + 1 < t.starts.size(); k += 2)
         starts.emplace_back(t.starts[k], t.starts[k + 1]);
     for (std::size_t k = 0; k < starts.size(); ++k) {

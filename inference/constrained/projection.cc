@@ -1,0 +1,290 @@
+#include "inference/constrained/projection.h"
+
+#include <nlopt.h>
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <memory>
+
+#include "core/error.h"
+#include "inference/constrained/kl.h"
+
+namespace foresight::constrained {
+
+const char* ToString(ProjectionStatus s) {
+  switch (s) {
+    case ProjectionStatus::kAlreadyFeasible:
+      return "already_feasible";
+    case ProjectionStatus::kSolved:
+      return "solved";
+    case ProjectionStatus::kInfeasible:
+      return "infeasible";
+    case ProjectionStatus::kFailed:
+      return "failed";
+  }
+  return "unknown";
+}
+
+namespace {
+
+// NLopt's own nlopt_result_to_string drops the "NLOPT_" prefix the summary documents.
+const char* ResultName(nlopt_result r) {
+  switch (r) {
+    case NLOPT_FAILURE:
+      return "NLOPT_FAILURE";
+    case NLOPT_INVALID_ARGS:
+      return "NLOPT_INVALID_ARGS";
+    case NLOPT_OUT_OF_MEMORY:
+      return "NLOPT_OUT_OF_MEMORY";
+    case NLOPT_ROUNDOFF_LIMITED:
+      return "NLOPT_ROUNDOFF_LIMITED";
+    case NLOPT_FORCED_STOP:
+      return "NLOPT_FORCED_STOP";
+    case NLOPT_SUCCESS:
+      return "NLOPT_SUCCESS";
+    case NLOPT_STOPVAL_REACHED:
+      return "NLOPT_STOPVAL_REACHED";
+    case NLOPT_FTOL_REACHED:
+      return "NLOPT_FTOL_REACHED";
+    case NLOPT_XTOL_REACHED:
+      return "NLOPT_XTOL_REACHED";
+    case NLOPT_MAXEVAL_REACHED:
+      return "NLOPT_MAXEVAL_REACHED";
+    case NLOPT_MAXTIME_REACHED:
+      return "NLOPT_MAXTIME_REACHED";
+    default:
+      return "NLOPT_UNKNOWN_RESULT";
+  }
+}
+
+bool AllFinite(const ComponentParams& c) {
+  return c.mean.allFinite() && c.log_u.allFinite() && c.chol_v.allFinite();
+}
+
+/// State shared by the NLopt callbacks. KL and C are evaluated together at each new point (SLSQP
+/// asks for the objective and then the constraint at the same x), so every point visited can be
+/// judged for the best-so-far bookkeeping.
+struct Problem {
+  const ComponentParams* prior = nullptr;
+  const ConstraintFunction* cost = nullptr;
+  nlopt_opt opt = nullptr;
+  int basis = 0;
+  double epsilon = 0;
+  double feasible_limit = 0;  // epsilon + tolerance
+
+  // Cache of the last point evaluated.
+  bool cached = false;
+  Eigen::VectorXd x;
+  double kl = 0;
+  double c = 0;
+  Eigen::VectorXd kl_grad;
+  Eigen::VectorXd c_grad;
+  ComponentGradient work;
+
+  int evaluations = 0;
+  bool failed = false;
+
+  // Lowest-KL point meeting C <= epsilon + tolerance.
+  bool have_feasible = false;
+  Eigen::VectorXd best_feasible;
+  double best_feasible_kl = std::numeric_limits<double>::infinity();
+  double best_feasible_cost = 0;
+  // Returned on kInfeasible: the lowest-KL point among those whose C is within `tolerance` of the
+  // lowest C seen (the prior at the start), so that a flat constraint does not drag it far away.
+  double tolerance = 0;
+  double min_cost = 0;
+  bool fallback_moved = false;
+  Eigen::VectorXd fallback;
+  double fallback_cost = 0;
+  double fallback_kl = 0;
+};
+
+/// Evaluates KL and C (with gradients) at x unless cached. False after a failure (exception or a
+/// non-finite value), which also stops NLopt: its C API cannot carry exceptions.
+bool Evaluate(Problem* pb, const double* x, unsigned n) {
+  if (pb->failed) return false;
+  const Eigen::Map<const Eigen::VectorXd> xv(x, n);
+  if (pb->cached && pb->x == xv) return true;
+  try {
+    pb->x = xv;
+    pb->cached = false;
+    const ComponentParams p = ComponentParams::FromVector(pb->x, pb->basis);
+    pb->kl = MatrixNormalKl(p, *pb->prior, &pb->work);
+    pb->kl_grad = pb->work.ToVector(p);
+    pb->work.Resize(pb->basis);
+    pb->c = (*pb->cost)(p, &pb->work);
+    pb->c_grad = pb->work.ToVector(p);
+    if (!std::isfinite(pb->kl) || !std::isfinite(pb->c) || !pb->kl_grad.allFinite() ||
+        !pb->c_grad.allFinite()) {
+      pb->failed = true;
+    }
+  } catch (...) {  // foresight::Error, std::exception or anything else the constraint throws
+    pb->failed = true;
+  }
+  if (pb->failed) {
+    nlopt_force_stop(pb->opt);
+    return false;
+  }
+  pb->cached = true;
+  if (pb->c <= pb->feasible_limit && pb->kl < pb->best_feasible_kl) {
+    pb->have_feasible = true;
+    pb->best_feasible = pb->x;
+    pb->best_feasible_kl = pb->kl;
+    pb->best_feasible_cost = pb->c;
+  }
+  pb->min_cost = std::min(pb->min_cost, pb->c);
+  const bool fallback_stale = pb->fallback_cost > pb->min_cost + pb->tolerance;
+  if (pb->c <= pb->min_cost + pb->tolerance && (fallback_stale || pb->kl < pb->fallback_kl)) {
+    pb->fallback_moved = true;
+    pb->fallback = pb->x;
+    pb->fallback_cost = pb->c;
+    pb->fallback_kl = pb->kl;
+  }
+  return true;
+}
+
+double Objective(unsigned n, const double* x, double* grad, void* data) {
+  auto* pb = static_cast<Problem*>(data);
+  ++pb->evaluations;
+  if (!Evaluate(pb, x, n)) {
+    if (grad != nullptr) Eigen::Map<Eigen::VectorXd>(grad, n).setZero();
+    return HUGE_VAL;
+  }
+  if (grad != nullptr) Eigen::Map<Eigen::VectorXd>(grad, n) = pb->kl_grad;
+  return pb->kl;
+}
+
+double Constraint(unsigned n, const double* x, double* grad, void* data) {
+  auto* pb = static_cast<Problem*>(data);
+  if (!Evaluate(pb, x, n)) {
+    if (grad != nullptr) Eigen::Map<Eigen::VectorXd>(grad, n).setZero();
+    return HUGE_VAL;
+  }
+  if (grad != nullptr) Eigen::Map<Eigen::VectorXd>(grad, n) = pb->c_grad;
+  return pb->c - pb->epsilon;
+}
+
+struct OptDeleter {
+  void operator()(nlopt_opt o) const { nlopt_destroy(o); }
+};
+
+}  // namespace
+
+ProjectionSummary ProjectComponent(const ComponentParams& prior, const ConstraintFunction& cost,
+                                   const ProjectionOptions& options, ComponentParams* out) {
+  // Bad arguments are caller errors and throw; everything after them is reported as a status.
+  FS_THROW_UNLESS(out != nullptr, "ProjectComponent: out is null");
+  FS_THROW_UNLESS(static_cast<bool>(cost), "ProjectComponent: the constraint function is empty");
+  FS_THROW_UNLESS(std::isfinite(options.epsilon),
+                  "ProjectComponent: options.epsilon must be finite, got ", options.epsilon);
+  FS_THROW_UNLESS(std::isfinite(options.tolerance) && options.tolerance >= 0,
+                  "ProjectComponent: options.tolerance must be finite and >= 0, got ",
+                  options.tolerance);
+  FS_THROW_UNLESS(std::isfinite(options.xtol_rel) && options.xtol_rel >= 0,
+                  "ProjectComponent: options.xtol_rel must be finite and >= 0, got ",
+                  options.xtol_rel);
+  FS_THROW_UNLESS(options.max_evaluations >= 1,
+                  "ProjectComponent: options.max_evaluations must be >= 1, got ",
+                  options.max_evaluations);
+  FS_THROW_UNLESS(std::isfinite(options.max_seconds) && options.max_seconds >= 0,
+                  "ProjectComponent: options.max_seconds must be finite and >= 0, got ",
+                  options.max_seconds);
+  FS_THROW_UNLESS(prior.mean.cols() == 2 && prior.mean.rows() >= 1,
+                  "ProjectComponent: prior.mean must be m x 2 with m >= 1, got ", prior.mean.rows(),
+                  " x ", prior.mean.cols());
+  FS_THROW_UNLESS(prior.log_u.size() == prior.mean.rows(), "ProjectComponent: prior.log_u has ",
+                  prior.log_u.size(), " entries, the mean has ", prior.mean.rows(), " rows");
+
+  const auto start = std::chrono::steady_clock::now();
+  const auto elapsed = [&start] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
+  const ComponentParams prior_copy = prior;  // `out` may alias `prior`
+  ProjectionSummary summary;
+  summary.status = ProjectionStatus::kFailed;
+  const auto finish_with_prior = [&](ProjectionStatus status) {
+    summary.status = status;
+    summary.kl = 0;
+    summary.cost = summary.prior_cost;
+    summary.seconds = elapsed();
+    *out = prior_copy;
+    return summary;
+  };
+
+  // A prior that is not a valid component (non-finite, non-positive L_V diagonal) is a numeric
+  // failure of whatever produced it.
+  if (!AllFinite(prior) || !(prior.chol_v(0, 0) > 0) || !(prior.chol_v(1, 1) > 0)) {
+    summary.prior_cost = std::numeric_limits<double>::quiet_NaN();
+    return finish_with_prior(ProjectionStatus::kFailed);
+  }
+  try {
+    summary.prior_cost = cost(prior_copy, nullptr);
+  } catch (...) {
+    summary.prior_cost = std::numeric_limits<double>::quiet_NaN();
+  }
+  if (!std::isfinite(summary.prior_cost)) return finish_with_prior(ProjectionStatus::kFailed);
+  if (summary.prior_cost <= options.epsilon) {
+    return finish_with_prior(ProjectionStatus::kAlreadyFeasible);
+  }
+
+  const int m = prior.basis();
+  Eigen::VectorXd theta = prior_copy.ToVector();
+  const unsigned n = static_cast<unsigned>(theta.size());
+  std::unique_ptr<nlopt_opt_s, OptDeleter> opt(nlopt_create(NLOPT_LD_SLSQP, n));
+  if (!opt) return finish_with_prior(ProjectionStatus::kFailed);
+
+  Problem pb;
+  pb.prior = &prior_copy;
+  pb.cost = &cost;
+  pb.opt = opt.get();
+  pb.basis = m;
+  pb.epsilon = options.epsilon;
+  pb.feasible_limit = options.epsilon + options.tolerance;
+  pb.work.Resize(m);
+  pb.tolerance = options.tolerance;
+  pb.min_cost = summary.prior_cost;
+  pb.fallback = theta;
+  pb.fallback_cost = summary.prior_cost;
+  pb.fallback_kl = 0;
+
+  nlopt_result r = nlopt_set_min_objective(opt.get(), Objective, &pb);
+  if (r > 0) r = nlopt_add_inequality_constraint(opt.get(), Constraint, &pb, options.tolerance);
+  if (r > 0) r = nlopt_set_xtol_rel(opt.get(), options.xtol_rel);
+  if (r > 0) r = nlopt_set_maxeval(opt.get(), options.max_evaluations);
+  if (r > 0 && options.max_seconds > 0) r = nlopt_set_maxtime(opt.get(), options.max_seconds);
+  double final_kl = 0;
+  if (r > 0) r = nlopt_optimize(opt.get(), theta.data(), &final_kl);
+  summary.nlopt_result = ResultName(r);
+  summary.evaluations = pb.evaluations;
+
+  // Our forced stop (a callback failed) or an NLopt error proper: the prior is returned. Any other
+  // stop (converged, limits, round-off, SLSQP's generic failure such as incompatible linearised
+  // constraints) is judged by the points visited: the lowest-KL feasible one if any, else the
+  // (near-)lowest-cost one (the solver may end elsewhere).
+  if (pb.failed || r == NLOPT_FORCED_STOP || r == NLOPT_INVALID_ARGS || r == NLOPT_OUT_OF_MEMORY) {
+    return finish_with_prior(ProjectionStatus::kFailed);
+  }
+  try {
+    if (pb.have_feasible) {
+      summary.status = ProjectionStatus::kSolved;
+      summary.kl = pb.best_feasible_kl;
+      summary.cost = pb.best_feasible_cost;
+      *out = ComponentParams::FromVector(pb.best_feasible, m);
+    } else {
+      if (!pb.fallback_moved) return finish_with_prior(ProjectionStatus::kInfeasible);
+      summary.status = ProjectionStatus::kInfeasible;
+      summary.kl = pb.fallback_kl;
+      summary.cost = pb.fallback_cost;
+      *out = ComponentParams::FromVector(pb.fallback, m);
+    }
+  } catch (...) {  // not reached: every stored point was finite when evaluated
+    return finish_with_prior(ProjectionStatus::kFailed);
+  }
+  summary.seconds = elapsed();
+  return summary;
+}
+
+}  // namespace foresight::constrained
