@@ -250,7 +250,19 @@ ProjectionSummary ProjectComponent(const ComponentParams& prior, const Constrain
   pb.fallback_cost = summary.prior_cost;
   pb.fallback_kl = 0;
 
-  nlopt_result r = nlopt_set_min_objective(opt.get(), Objective, &pb);
+  // Box bounds around the prior keep every exp() finite during SLSQP's line searches: the
+  // log-variances of U and the log-diagonal of L_V move by at most kLogRange, the means are free.
+  constexpr double kLogRange = 8.0;
+  Eigen::VectorXd lower = Eigen::VectorXd::Constant(n, -HUGE_VAL);
+  Eigen::VectorXd upper = Eigen::VectorXd::Constant(n, HUGE_VAL);
+  for (int i = 2 * m; i < static_cast<int>(n); ++i) {
+    if (i == 3 * m + 1) continue;  // L_V(1, 0) is not a log
+    lower[i] = theta[i] - kLogRange;
+    upper[i] = theta[i] + kLogRange;
+  }
+  nlopt_result r = nlopt_set_lower_bounds(opt.get(), lower.data());
+  if (r > 0) r = nlopt_set_upper_bounds(opt.get(), upper.data());
+  if (r > 0) r = nlopt_set_min_objective(opt.get(), Objective, &pb);
   if (r > 0) r = nlopt_add_inequality_constraint(opt.get(), Constraint, &pb, options.tolerance);
   if (r > 0) r = nlopt_set_xtol_rel(opt.get(), options.xtol_rel);
   if (r > 0) r = nlopt_set_maxeval(opt.get(), options.max_evaluations);

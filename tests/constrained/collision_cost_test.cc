@@ -18,32 +18,12 @@
 #include "core/hinge_grid.h"
 #include "core/matrix_normal.h"
 #include "inference/mapping/hinge_map.h"
+#include "tests/constrained/half_plane_map.h"
 #include "tests/occupancy_test_util.h"
 #include "tests/test_util.h"
 
 namespace foresight::constrained {
 namespace {
-
-// p = sigmoid(k (a'x - b)) with its exact gradient k p (1 - p) a.
-class SmoothHalfPlane final : public OccupancyMap {
- public:
-  SmoothHalfPlane(Eigen::Vector2d a, double b, double k) : a_(a), b_(b), k_(k) {}
-  std::string model_type() const override { return "test.smooth_half_plane"; }
-  MapWorkspace MakeWorkspace() const override { return {}; }
-  OccupancyQuery Query(double x, double y, MapWorkspace*) const override {
-    OccupancyQuery q;
-    q.probability = 1 / (1 + std::exp(-k_ * (a_.x() * x + a_.y() * y - b_)));
-    const double d = k_ * q.probability * (1 - q.probability);
-    q.dp_dx = d * a_.x();
-    q.dp_dy = d * a_.y();
-    return q;
-  }
-  Eigen::Vector4d Extent() const override { return {-1e3, 1e3, -1e3, 1e3}; }
-
- private:
-  Eigen::Vector2d a_;
-  double b_, k_;
-};
 
 // p = 1[a'x > b], gradient 0.
 class HardHalfPlane final : public OccupancyMap {
