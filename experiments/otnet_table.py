@@ -58,7 +58,7 @@ if e:
     out += ["The ANLL's absolute level depends on its definition (the thesis does not print "
             "one); compare rows of this table, not with the thesis's 29.83.", "",
             "Pictures: otnet_test_maps.png (test maps: OTNet, k-NN, start-conditioned OTNet; "
-            "ground truth in blue), otnet_transfer.png (sections of the Intel-lab Fast-BHM map).", ""]
+            "ground truth in blue), otnet_transfer.png (sections of the Intel-lab Hilbert map; samples that fail the collision check drawn orange).", ""]
 if b:
     out += ["## Engine benchmark (`foresight bench otnet --artifact runs/otnet_chosen/model.h5 "
             "--json`, one core, medians)", "",
