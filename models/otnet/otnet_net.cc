@@ -13,10 +13,6 @@ namespace {
 
 using RowMajorF = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
-bool AllFinite(const torch::Tensor& t) {
-  return t.numel() == 0 || torch::isfinite(t).all().item<bool>();
-}
-
 OtnetHead HeadOf(const OtnetNetOptions& o) { return OtnetHead{o.components, o.weights}; }
 
 }  // namespace
