@@ -202,6 +202,7 @@ if [ "${FORESIGHT_WITH_TORCH:-1}" = "1" ] || [ "${FORESIGHT_WITH_TORCH}" = "ON" 
     >/dev/null 2>"$TMP/otnet.log" || { cat "$TMP/otnet.log"; fail "otnet train"; }
   check_json "$OT_RUN/eval.json"
   test -f "$OT_RUN/plots/test_maps.png" || fail "otnet plots"
+  expect_error "would change the map split" eval "$OT_RUN" seed=3
   "$BIN" bench otnet --artifact "$OT_RUN/model.h5" --json --repeats 1 --count 5 |
     grep -q libtorch_over_engine || fail "bench otnet"
   expect_error "expected 'otnet'" bench otnet --artifact "$DIR_RUN/model.h5"

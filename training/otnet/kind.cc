@@ -34,11 +34,13 @@ ExperimentKind OtnetKind() {
   };
   k.export_run = otnet::ExportOtnetRun;
   k.evaluate = [](const std::string& run_dir, const std::vector<std::string>& overrides) {
-    // The split is the run's: another seed or data section would score training maps as test.
+    // The split is the run's: another seed or data section would score training maps as test
+    // (data.root only says where the same files are).
     for (const std::string& o : overrides)
-      FS_THROW_UNLESS(o.rfind("seed=", 0) != 0 && o.rfind("data.", 0) != 0, "eval ", run_dir,
-                      ": override '", o,
-                      "' would change the map split the run was trained on; train a new run");
+      FS_THROW_UNLESS(
+          o.rfind("seed=", 0) != 0 && (o.rfind("data.", 0) != 0 || o.rfind("data.root=", 0) == 0),
+          "eval ", run_dir, ": override '", o,
+          "' would change the map split the run was trained on; train a new run");
     const auto c = LoadRunConfig<OtnetConfig>(run_dir, overrides);
     return otnet::EvaluateOtnetRun(c, run_dir);
   };
