@@ -115,8 +115,14 @@ MeanBaseline FitMeanBaseline(const OtnetSplit& train, int points, double floor) 
   return b;
 }
 
-/// The centre of the free cell nearest to p (p itself when its cell is free).
-Eigen::Vector2d NearestFree(const BinaryGrid& g, const Eigen::Vector2d& p) {
+std::uint64_t MapSeed(std::int64_t seed, std::size_t index, std::uint64_t salt) {
+  return static_cast<std::uint64_t>(seed) * 0x9E3779B97F4A7C15ull +
+         (index + 1) * 0xBF58476D1CE4E5B9ull + salt;
+}
+
+}  // namespace
+
+Eigen::Vector2d NearestFreeCentre(const BinaryGrid& g, const Eigen::Vector2d& p) {
   if (!g.OccupiedAt(p.x(), p.y())) return p;
   double best = std::numeric_limits<double>::infinity();
   Eigen::Vector2d out = p;
@@ -133,13 +139,6 @@ Eigen::Vector2d NearestFree(const BinaryGrid& g, const Eigen::Vector2d& p) {
   FS_THROW_UNLESS(std::isfinite(best), "otnet eval: the map has no free cell");
   return out;
 }
-
-std::uint64_t MapSeed(std::int64_t seed, std::size_t index, std::uint64_t salt) {
-  return static_cast<std::uint64_t>(seed) * 0x9E3779B97F4A7C15ull +
-         (index + 1) * 0xBF58476D1CE4E5B9ull + salt;
-}
-
-}  // namespace
 
 double MinimumDistance(const Eigen::MatrixX2d& generated,
                        const std::vector<Eigen::MatrixX2d>& truth, TrajectoryDistance d) {
@@ -236,7 +235,7 @@ Scores ScoreSplit(const OtnetConfig& c, const OtnetModel& model, const OtnetSpli
     std::vector<Eigen::MatrixX2d> conditioned, shifted;
     if (c.eval.conditioned) {
       for (const Eigen::MatrixX2d& t : m.trajectories) start += t.row(0).transpose();
-      start = NearestFree(m.map, start / static_cast<double>(m.trajectories.size()));
+      start = NearestFreeCentre(m.map, start / static_cast<double>(m.trajectories.size()));
       model.ConditionOnStart(mixture, start, ComponentSelection::kAll, &ws.conditioned);
       std::mt19937_64 crng(MapSeed(c.seed, mi, 2));
       GenerateStats cs = model.Generate(m.map, ws.conditioned, gen, &crng, &ws);

@@ -30,6 +30,10 @@ using Scores = std::vector<std::pair<std::string, double>>;
 double MinimumDistance(const Eigen::MatrixX2d& generated,
                        const std::vector<Eigen::MatrixX2d>& truth, TrajectoryDistance d);
 
+/// The centre of the free cell nearest to p (p itself when its cell is free). Error when the map
+/// has no free cell.
+Eigen::Vector2d NearestFreeCentre(const BinaryGrid& g, const Eigen::Vector2d& p);
+
 /// Scores of OTNet and the baselines on `split` (keys prefixed with `prefix`). `train` gives the
 /// k-NN database and the mean trajectory. When plot_png is not empty, draws the first maps.
 Scores ScoreSplit(const OtnetConfig& c, const OtnetModel& model, const OtnetSplit& train,

@@ -110,18 +110,7 @@ Scores TransferToOccupancyMap(const OtnetConfig& c, const OtnetModel& model,
     for (std::size_t k = 0; k < starts.size(); ++k) {
       Eigen::Vector2d start = starts[k];
       if (grids[s].OccupiedAt(start.x(), start.y())) {
-        // Move to the nearest free cell centre (logged).
-        double best = 1e300;
-        Eigen::Vector2d moved = start;
-        for (int r = 0; r < size; ++r)
-          for (int col = 0; col < size; ++col)
-            if (!grids[s].at(r, col)) {
-              const Eigen::Vector2d q(col + 0.5, r + 0.5);
-              if ((q - start).squaredNorm() < best) {
-                best = (q - start).squaredNorm();
-                moved = q;
-              }
-            }
+        const Eigen::Vector2d moved = NearestFreeCentre(grids[s], start);
         log::Info("otnet transfer: section ", s, ": start (", start.x(), ", ", start.y(),
                   ") is occupied; moved to (", moved.x(), ", ", moved.y(), ")");
         start = moved;
