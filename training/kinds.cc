@@ -21,6 +21,7 @@ ExperimentRegistry BuiltinKinds() {
   r.Add(GfcsKind());
   r.Add(DiffeoKind());
   r.Add(OtnetKind());
+  r.Add(ConstrainedKind());
   r.SetDefault("span_predictor");
 #endif
   return r;

@@ -24,6 +24,7 @@ ExperimentKind DirectionalKind();
 ExperimentKind GfcsKind();
 ExperimentKind DiffeoKind();
 ExperimentKind OtnetKind();
+ExperimentKind ConstrainedKind();
 #endif
 
 /// The config of a train request: the file, or `embedded_default` (named `default_name` in

@@ -41,6 +41,11 @@ void CheckComponent(const ComponentParams& c, int basis) {
                   " entries, the basis has ", basis);
 }
 
+void CheckOffset(const Eigen::Matrix2Xd& offset, Eigen::Index times) {
+  FS_THROW_UNLESS(offset.cols() == 0 || offset.cols() == times, "CollisionCost: offset is 2 x ",
+                  offset.cols(), ", expected 2 x ", times, " (one column per time) or empty");
+}
+
 }  // namespace
 
 double CollisionCost::Component(const ComponentParams& c, Workspace* ws,
@@ -48,6 +53,8 @@ double CollisionCost::Component(const ComponentParams& c, Workspace* ws,
   const int m = basis();
   CheckComponent(c, m);
   FS_THROW_UNLESS(ws != nullptr, "CollisionCost::Component: workspace is null");
+  CheckOffset(ws->offset, times_.size());
+  const bool has_offset = ws->offset.cols() != 0;
   const int nq = rule_.size();
   if (ws->points.cols() != nq) ws->points.resize(2, nq);
   if (ws->batch.probability.size() != nq) ws->batch.Resize(nq);
@@ -70,6 +77,7 @@ double CollisionCost::Component(const ComponentParams& c, Workspace* ws,
       mu[1] += c.mean(j, 1) * p;
       s2 += std::exp(c.log_u[j]) * p * p;
     }
+    if (has_offset) mu += ws->offset.col(k);
     const double s = std::sqrt(s2);
     // Change of variables through the Cholesky factor: x_q = mu + s L_V z_q.
     const Eigen::Matrix2d A = s * L;
@@ -130,15 +138,18 @@ double CollisionCost::Mixture(const std::vector<double>& alpha,
   return total;
 }
 
-Eigen::Matrix2Xd CollisionCost::Abscissae(const ComponentParams& c) const {
+Eigen::Matrix2Xd CollisionCost::Abscissae(const ComponentParams& c,
+                                          const Eigen::Matrix2Xd& offset) const {
   const int m = basis();
   CheckComponent(c, m);
+  CheckOffset(offset, times_.size());
   const int nq = rule_.size();
   const Eigen::VectorXd u = c.log_u.array().exp();
   Eigen::Matrix2Xd out(2, times_.size() * nq);
   for (Eigen::Index k = 0; k < times_.size(); ++k) {
     const Eigen::VectorXd phi = phi_.row(k).transpose();
-    const Eigen::Vector2d mu = c.mean.transpose() * phi;
+    Eigen::Vector2d mu = c.mean.transpose() * phi;
+    if (offset.cols() != 0) mu += offset.col(k);
     const double s = std::sqrt(phi.cwiseAbs2().dot(u));
     out.middleCols(k * nq, nq) = (s * c.chol_v * rule_.points).colwise() + mu;
   }

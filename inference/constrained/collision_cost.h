@@ -29,6 +29,10 @@ class CollisionCost {
     MapWorkspace map;
     MapQueryBatch batch;
     Eigen::Matrix2Xd points;  ///< abscissae of one time step [2 x q]
+    /// [2 x K] added to the mean at each time (e.g. origin + v t_k); empty = zero. A predicted
+    /// distribution's position mean is origin + v t + M' phi(t): the offset is constant in the
+    /// parameters, so the gradients do not change.
+    Eigen::Matrix2Xd offset;
   };
 
   /// @param map occupancy map (kept by pointer; must outlive this). @param basis the trajectory
@@ -41,14 +45,17 @@ class CollisionCost {
   const Eigen::VectorXd& times() const { return times_; }
   Workspace MakeWorkspace() const;
 
-  /// C_r of one component; with `gradient` not null also its derivatives (resized). No allocation
-  /// once the workspace and the gradient are sized. Error when the component's basis differs.
+  /// C_r of one component (mean M' phi(t_k) + ws->offset.col(k)); with `gradient` not null also its
+  /// derivatives (resized). No allocation once the workspace and the gradient are sized. Error when
+  /// the component's basis differs or ws->offset is neither empty nor [2 x K].
   double Component(const ComponentParams& c, Workspace* ws, ComponentGradient* gradient) const;
-  /// sum_r alpha_r C_r.
+  /// sum_r alpha_r C_r (every component with the workspace's offset).
   double Mixture(const std::vector<double>& alpha, const std::vector<ComponentParams>& components,
                  Workspace* ws) const;
-  /// The abscissae x_q at every time of component c, [2 x K q] (for pictures).
-  Eigen::Matrix2Xd Abscissae(const ComponentParams& c) const;
+  /// The abscissae x_q at every time of component c, [2 x K q] (for pictures); `offset` as
+  /// Workspace::offset ([2 x K] or empty = zero).
+  Eigen::Matrix2Xd Abscissae(const ComponentParams& c,
+                             const Eigen::Matrix2Xd& offset = Eigen::Matrix2Xd()) const;
 
  private:
   const OccupancyMap* map_ = nullptr;

@@ -104,6 +104,34 @@ void TrajectoryDistribution::SamplePath(
   }
 }
 
+void TrajectoryDistribution::SetComponent(int r, const Eigen::MatrixXd& mean,
+                                          const Eigen::MatrixXd& chol_u,
+                                          const Eigen::Matrix2d& chol_v) {
+  const int m = basis_size();
+  FS_THROW_UNLESS(r >= 0 && r < components(), "TrajectoryDistribution::SetComponent: component ", r,
+                  " out of range [0, ", components(), ")");
+  FS_THROW_UNLESS(mean.rows() == m && mean.cols() == 2,
+                  "TrajectoryDistribution::SetComponent: mean is ", mean.rows(), " x ", mean.cols(),
+                  ", expected ", m, " x 2");
+  FS_THROW_UNLESS(chol_u.rows() == m && chol_u.cols() == m,
+                  "TrajectoryDistribution::SetComponent: chol_u is ", chol_u.rows(), " x ",
+                  chol_u.cols(), ", expected ", m, " x ", m);
+  const auto k = static_cast<std::size_t>(r);
+  mean_[k] = mean;
+  chol_u_[k] = chol_u;
+  chol_v_[k] = chol_v;
+}
+
+void TrajectoryDistribution::SetFrame(const Eigen::Vector2d& origin,
+                                      const Eigen::Vector2d& velocity,
+                                      const Eigen::VectorXd& alpha) {
+  FS_THROW_UNLESS(alpha.size() == alpha_.size(), "TrajectoryDistribution::SetFrame: alpha has ",
+                  alpha.size(), " entries, the distribution has ", alpha_.size(), " components");
+  origin_ = origin;
+  velocity_ = velocity;
+  alpha_ = alpha;
+}
+
 // ---------------------------------------------------------------- SpanPredictor
 
 SpanPredictor SpanPredictor::Load(const std::string& path) {
@@ -133,7 +161,18 @@ SpanPredictor SpanPredictor::Load(const std::string& path) {
   } catch (const Error& e) {
     Fail(path, ": ", e.what());
   }
-  const int in = 2 * p.observed_;
+  int in = 2 * p.observed_;
+  if (f.Exists("/model/ktm_references")) {
+    // KTM input stage: K kernel features of the ego-frame past replace the raw points.
+    p.ktm_references_ = f.ReadMatrixD("/model/ktm_references");
+    FS_THROW_UNLESS(p.ktm_references_.rows() >= 1 && p.ktm_references_.cols() == in &&
+                        p.ktm_references_.allFinite(),
+                    path, ": /model/ktm_references is ", p.ktm_references_.rows(), " x ",
+                    p.ktm_references_.cols(),
+                    ", expected K >= 1 finite rows of 2 x observed = ", in);
+    p.ktm_lengthscale_ = art.DoubleAttr("/model", "ktm_lengthscale", 1e-9, 1e9);
+    in = static_cast<int>(p.ktm_references_.rows());
+  }
   p.input_mean_ = f.ReadMatrixD("/normalisation/input_mean", in, 1).col(0);
   p.input_std_ = f.ReadMatrixD("/normalisation/input_std", in, 1).col(0);
   FS_THROW_UNLESS((p.input_std_.array() > 0).all() && p.input_mean_.allFinite(), path,
@@ -152,7 +191,8 @@ SpanPredictor SpanPredictor::Load(const std::string& path) {
   }
   p.mlp_ = Mlp::Load(f, "/weights/", names);
   FS_THROW_UNLESS(p.mlp_.input_size() == in, path, ": network takes ", p.mlp_.input_size(),
-                  " inputs, expected 2 x observed = ", in);
+                  " inputs, expected ",
+                  p.ktm_references_.size() > 0 ? "K (KTM references) = " : "2 x observed = ", in);
   FS_THROW_UNLESS(p.mlp_.output_size() == p.layout_.Total(), path, ": network gives ",
                   p.mlp_.output_size(), " outputs, the head layout needs ", p.layout_.Total());
   for (const auto& l : p.mlp_.layers())
@@ -181,13 +221,18 @@ void SpanPredictor::Save(const std::string& path, const SpanPredictorWeights& w,
     for (const auto& name : w.layer_names) names += (names.empty() ? "" : ",") + name;
     f->SetAttr("/model", "dense_layers", names);
     w.mlp.Save(f, "/weights/", w.layer_names);
+    if (w.ktm_references.size() > 0) {
+      f->WriteMatrix("/model/ktm_references", w.ktm_references);
+      f->SetAttr("/model", "ktm_lengthscale", w.ktm_lengthscale);
+    }
   });
 }
 
 SpanPredictor::Workspace SpanPredictor::MakeWorkspace() const {
-  return {Eigen::VectorXf::Zero(2 * observed_), mlp_.MakeWorkspace(),
+  return {Eigen::VectorXf::Zero(mlp_.input_size()), mlp_.MakeWorkspace(),
           Eigen::VectorXd::Zero(layout_.Total()),
-          Eigen::Matrix<double, Eigen::Dynamic, 2>::Zero(observed_, 2)};
+          Eigen::Matrix<double, Eigen::Dynamic, 2>::Zero(observed_, 2),
+          Eigen::VectorXd::Zero(2 * observed_)};
 }
 
 TrajectoryDistribution SpanPredictor::MakeDistribution() const {
@@ -217,11 +262,22 @@ void SpanPredictor::RawOutput(
                   " observed points, got ", past.rows());
   FS_THROW_UNLESS(past.allFinite(), "SpanPredictor: observed track contains NaN or inf");
   const EgoFrame frame = FrameOf(past, rotate_);
-  for (int i = 0; i < observed_; ++i) {
-    const Eigen::Vector2d q = frame.ToEgo(Eigen::Vector2d(past(i, 0), past(i, 1)));
-    ws->input[2 * i] = static_cast<float>((q.x() - input_mean_[2 * i]) / input_std_[2 * i]);
-    ws->input[2 * i + 1] =
-        static_cast<float>((q.y() - input_mean_[2 * i + 1]) / input_std_[2 * i + 1]);
+  for (int i = 0; i < observed_; ++i)
+    ws->ego.segment<2>(2 * i) = frame.ToEgo(Eigen::Vector2d(past(i, 0), past(i, 1)));
+  if (ktm_references_.size() == 0) {
+    for (int i = 0; i < 2 * observed_; ++i)
+      ws->input[i] = static_cast<float>((ws->ego[i] - input_mean_[i]) / input_std_[i]);
+  } else {
+    // k(q, r) = exp(-d^2 / (2 l^2)), d^2 = (1/p) sum_i |q_i - r_i|^2 (RMS pointwise distance).
+    const double scale = 1.0 / (2.0 * observed_ * ktm_lengthscale_ * ktm_lengthscale_);
+    for (Eigen::Index k = 0; k < ktm_references_.rows(); ++k) {
+      double sq = 0.0;
+      for (int i = 0; i < 2 * observed_; ++i) {
+        const double d = ws->ego[i] - ktm_references_(k, i);
+        sq += d * d;
+      }
+      ws->input[k] = static_cast<float>((std::exp(-sq * scale) - input_mean_[k]) / input_std_[k]);
+    }
   }
   const auto out = mlp_.Forward(ws->input, &ws->mlp);
   ws->raw = out.cast<double>();

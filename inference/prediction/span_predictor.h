@@ -51,6 +51,18 @@ class TrajectoryDistribution {
   void SamplePath(const Eigen::Ref<const Eigen::VectorXd>& times, std::mt19937_64* rng,
                   Eigen::Ref<Eigen::Matrix<double, Eigen::Dynamic, 2>> path) const;
 
+  // Setters for runtimes that rewrite a predicted distribution (the constraint projection of
+  // inference/constrained) and for tests that build one by hand. They copy into the preallocated
+  // storage: no allocation when the shapes match.
+  /// Component r: mean M [m x 2], L_U [m x m] (lower), L_V [2 x 2] (lower). Error naming the sizes
+  /// when r is out of range or a shape differs from the distribution's.
+  void SetComponent(int r, const Eigen::MatrixXd& mean, const Eigen::MatrixXd& chol_u,
+                    const Eigen::Matrix2d& chol_v);
+  /// origin [2] (m) and velocity [2] (m/s) of o(t) = origin + v t + W' phi(t), and the mixture
+  /// weights alpha [R]. Error when alpha's length is not R.
+  void SetFrame(const Eigen::Vector2d& origin, const Eigen::Vector2d& velocity,
+                const Eigen::VectorXd& alpha);
+
  private:
   friend class SpanPredictor;
   TimeBasis basis_;
@@ -77,6 +89,11 @@ struct SpanPredictorWeights {
   std::vector<std::string>
       layer_names;  ///< module paths of the dense layers ("mlp.0", ..., "head")
   Mlp mlp;
+  /// Optional KTM input stage (Kernel Trajectory Maps, thesis ch 7 baseline): the net's inputs are
+  /// k(q, r_i) = exp(-d(q, r_i)^2 / (2 l^2)), d = RMS pointwise distance between the ego-frame
+  /// past q and reference r_i; input_mean/std then have K entries.
+  Eigen::MatrixXd ktm_references;  ///< [K x 2p] ego frame (m); empty: raw input
+  double ktm_lengthscale = 0;      ///< l (m); used when ktm_references is not empty
 };
 
 class SpanPredictor {
@@ -86,6 +103,7 @@ class SpanPredictor {
     Mlp::Workspace mlp;
     Eigen::VectorXd raw;
     Eigen::Matrix<double, Eigen::Dynamic, 2> past;  ///< batch row unpacked as [p x 2]
+    Eigen::VectorXd ego;  ///< [2p] ego-frame past (input of the KTM stage)
   };
 
   /// Loads an artifact written by `foresight export` (model_type "span_predictor").
@@ -99,6 +117,9 @@ class SpanPredictor {
   const HeadLayout& layout() const { return layout_; }
   const TimeBasis& basis() const { return basis_; }
   const Mlp& mlp() const { return mlp_; }
+  /// KTM references [K x 2p] (ego frame, m); empty when the net reads the past directly.
+  const Eigen::MatrixXd& ktm_references() const { return ktm_references_; }
+  double ktm_lengthscale() const { return ktm_lengthscale_; }
 
   Workspace MakeWorkspace() const;
   TrajectoryDistribution MakeDistribution() const;
@@ -111,6 +132,7 @@ class SpanPredictor {
   void PredictBatch(const Eigen::Ref<const Eigen::MatrixXd>& past_rows, Workspace* ws,
                     std::vector<TrajectoryDistribution>* out) const;
   /// Raw head outputs (before activations) for the normalised input of `past`: parity tests.
+  /// Leaves the normalised net input (2p ego points, or K KTM features) in ws->input.
   void RawOutput(const Eigen::Ref<const Eigen::Matrix<double, Eigen::Dynamic, 2>>& past,
                  Workspace* ws) const;
 
@@ -123,6 +145,8 @@ class SpanPredictor {
   TimeBasis basis_;
   Eigen::VectorXd input_mean_, input_std_;
   Mlp mlp_;
+  Eigen::MatrixXd ktm_references_;
+  double ktm_lengthscale_ = 0;
 };
 
 }  // namespace foresight

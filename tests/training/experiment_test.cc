@@ -144,6 +144,14 @@ const std::map<std::string, std::string>& TinyConfigs() {
        "val_fraction: 0.25, test_fraction: 0.25}\notnet: {basis: 6, components: 2, hidden: [8]}\n"
        "train: {epochs: 2, batch_size: 16, progress: none}\neval: {generated: 5, points: 20, "
        "plots: false}\n"},
+      {"constrained",
+       "model: constrained\ndata: {source: synthetic, max_maps: 4, synthetic_tracks: 12}\n"
+       "split: {by_scene: true, val_fraction: 0.25, test_fraction: 0.25}\n"
+       "windows: {observed: 6, predicted: 6, stride: 3}\nbasis: {num_centres: 4}\n"
+       "network: {hidden: [16], components: 2, u_param: diagonal}\n"
+       "train: {epochs: 2, batch_size: 32, progress: none}\nktm: {references: 8}\n"
+       "naive: {hidden: [16]}\neval: {max_windows: 6, accuracy_windows: 2, accuracy_samples: "
+       "500, plot_windows: 1, plot_samples: 3}\n"},
   };
   return configs;
 }

@@ -8,25 +8,10 @@
 #include <string>
 #include <vector>
 
+#include "training/map_canvas.h"
 #include "training/navigation/run.h"
 
 namespace foresight {
-
-/// World <-> image of a raster's extent at `pixels_per_metre`.
-class MapCanvas {
- public:
-  MapCanvas(const OccupancyRaster& raster, double pixels_per_metre);
-  cv::Mat Background() const { return background_.clone(); }
-  cv::Point Pixel(double x, double y) const;
-  int Length(double metres) const {
-    return std::max(1, static_cast<int>(std::lround(metres * scale_)));
-  }
-
- private:
-  Eigen::Vector4d extent_;
-  double scale_;
-  cv::Mat background_;
-};
 
 class VideoRecorder final : public EpisodeRecorder {
  public:

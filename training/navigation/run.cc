@@ -20,7 +20,7 @@
 #include "inference/navigation/cl_rrt_star.h"
 #include "inference/navigation/goal_distance.h"
 #include "inference/navigation/span_controller.h"
-#include "models/occupancy/fast_bhm.h"
+#include "models/occupancy/raster_map.h"
 #include "training/navigation/render.h"
 
 namespace foresight {
@@ -35,54 +35,12 @@ bool UsesPredictor(const NavigationExperimentConfig& c) { return c.Uses(Navigati
 /// Fast-BHM (or grid) map of the scenario's obstacles, saved as an artifact at `path`.
 void BuildScenarioMap(const NavigationExperimentConfig& c, const OccupancyRaster& raster,
                       const std::string& path) {
-  const Eigen::Vector4d e = raster.extent;
-  const double step = c.map.raster_resolution, margin = 1.0;
-  const int nx = static_cast<int>(std::ceil((e[1] - e[0] + 2 * margin) / step));
-  const int ny = static_cast<int>(std::ceil((e[3] - e[2] + 2 * margin) / step));
-  const std::string yaml = config::ToYaml(c);
-  if (c.map.kind == NavigationMapKind::kGrid) {
-    GridGeometry g;
-    g.x_min = e[0] - margin;
-    g.y_min = e[2] - margin;
-    g.resolution = step;
-    g.nx = nx;
-    g.ny = ny;
-    // Fraction of occupied raster samples in each cell (4 x 4 sub-samples), mapped to [0.05, 0.95].
-    Eigen::MatrixXf p(ny, nx);
-    for (int iy = 0; iy < ny; ++iy)
-      for (int ix = 0; ix < nx; ++ix) {
-        int occ = 0;
-        for (int sy = 0; sy < 4; ++sy)
-          for (int sx = 0; sx < 4; ++sx)
-            occ += raster.Occupied(g.x_min + (ix + (sx + 0.5) / 4) * step,
-                                   g.y_min + (iy + (sy + 0.5) / 4) * step);
-        p(iy, ix) = 0.05f + 0.9f * static_cast<float>(occ) / 16.0f;
-      }
-    GridMap(g, p, CellType::kFloat32).Save(path, yaml, c.seed);
-    return;
-  }
-  HingeGridConfig hg;
-  hg.x_min = e[0] - margin;
-  hg.x_max = e[1] + margin;
-  hg.y_min = e[2] - margin;
-  hg.y_max = e[3] + margin;
-  hg.spacing = c.map.spacing;
-  hg.gamma = 6.71 * std::pow(0.5 / c.map.spacing, 2);  // the thesis' 0.5 m / 6.71 pairing, rescaled
-  hg.cutoff_radius = 2.0 * c.map.spacing;
-  FastBhmLearner learner{HingeGrid(hg), FastBhmConfig{}};
-  // Labelled points on the raster's sampling grid, fed in row strips like scans.
-  Eigen::Matrix2Xd xy(2, nx);
-  std::vector<std::uint8_t> label(static_cast<std::size_t>(nx));
-  for (int iy = 0; iy < ny; ++iy) {
-    const double y = hg.y_min + (iy + 0.5) * step;
-    for (int ix = 0; ix < nx; ++ix) {
-      const double x = hg.x_min + (ix + 0.5) * step;
-      xy.col(ix) = Eigen::Vector2d(x, y);
-      label[static_cast<std::size_t>(ix)] = raster.Occupied(x, y) ? 1 : 0;
-    }
-    learner.Update(xy, label.data());
-  }
-  learner.ToMap().Save(path, yaml, c.seed);
+  RasterMapOptions o;
+  o.kind = c.map.kind == NavigationMapKind::kGrid ? RasterMapKind::kGrid : RasterMapKind::kFastBhm;
+  o.sample_step = c.map.raster_resolution;
+  o.spacing = c.map.spacing;
+  o.margin = 1.0;
+  WriteRasterMap(raster, o, path, config::ToYaml(c), c.seed);
 }
 
 /// Distance (m) from each raster cell to the nearest occupied cell or the outside of the raster

@@ -1,5 +1,6 @@
 #include "training/span/pipeline.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -18,57 +19,6 @@ namespace foresight {
 namespace fs = std::filesystem;
 
 namespace {
-
-HeadLayout LayoutOf(const SpanExperimentConfig& c) {
-  HeadLayout l;
-  l.basis = c.basis.num_centres;
-  l.components = c.network.components;
-  l.u_param = c.network.u_param;
-  return l;
-}
-
-torch::Tensor ToTensor(const Eigen::MatrixXd& m) {
-  Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> rm = m.cast<float>();
-  return torch::from_blob(rm.data(), {rm.rows(), rm.cols()}, torch::kFloat32).clone();
-}
-
-struct Normalisation {
-  Eigen::VectorXd mean, std;
-  Eigen::MatrixXd Apply(const Eigen::MatrixXd& x) const {
-    return (x.rowwise() - mean.transpose()).array().rowwise() / std.transpose().array();
-  }
-};
-
-Normalisation FitNormalisation(const Eigen::MatrixXd& x) {
-  Normalisation n;
-  n.mean = x.colwise().mean().transpose();
-  n.std = ((x.rowwise() - n.mean.transpose()).array().square().colwise().mean()).sqrt().transpose();
-  // Constant features (the ego origin) pass through. Nearly constant ones are floored at 1 cm:
-  // e.g. the ego y of the first point is 0 except in the rare windows too short to rotate (standing
-  // pedestrians), and dividing those by a micrometre-scale std feeds the network inputs of 1e3+
-  // (non-finite losses on crowd data with many standing pedestrians).
-  constexpr double kMinStd = 0.01;  // m
-  for (Eigen::Index i = 0; i < n.std.size(); ++i) {
-    if (!(n.std[i] > 1e-6))
-      n.std[i] = 1.0;
-    else
-      n.std[i] = std::max(n.std[i], kMinStd);
-  }
-  return n;
-}
-
-void WriteNormalisation(const std::string& path, const Normalisation& n) {
-  h5::WriteAtomically(path, [&](h5::File* f) {
-    f->WriteMatrix("/input_mean", n.mean);
-    f->WriteMatrix("/input_std", n.std);
-  });
-}
-
-Normalisation ReadNormalisation(const std::string& path) {
-  h5::File f = h5::File::Open(path);
-  return {f.ReadMatrixD("/input_mean").col(0), f.ReadMatrixD("/input_std").col(0)};
-}
-
 class SpanTask : public TrainingTask {
  public:
   SpanTask(SpanNet net, const HeadLayout& layout, torch::Tensor x_train, torch::Tensor w_train,
@@ -130,31 +80,122 @@ TrainingSummary TrainSpan(const SpanExperimentConfig& c, const std::string& run_
                   length, " points (",
                   c.data.val_files.empty() ? "raise data.val_fraction" : "check data.val_files",
                   "); the validation loss chooses the best checkpoint and drives early stopping");
-  const TimeBasis basis = MakeFutureBasis(c.basis, c.windows.predicted, train_w.seconds_per_step);
-  const SpanSamples train_s = MakeSpanSamples(train_w, basis, c.basis, c.network.rotate_to_heading,
-                                              c.network.residual_to_constant_velocity);
-  const SpanSamples val_s = MakeSpanSamples(val_w, basis, c.basis, c.network.rotate_to_heading,
-                                            c.network.residual_to_constant_velocity);
+  SpanModelSpec spec = SpanModelSpecOf(c);
+  spec.seconds_per_step = train_w.seconds_per_step;
+  return TrainSpanOnWindows(spec, train_w, val_w, c.train, c.seed, run_dir, resume, hooks);
+}
 
-  const std::string norm_path = run_dir + "/normalisation.h5";
-  const Normalisation norm =
-      resume ? ReadNormalisation(norm_path) : FitNormalisation(train_s.inputs);
-  if (!resume) WriteNormalisation(norm_path, norm);
+SpanModelSpec SpanModelSpecOf(const SpanExperimentConfig& c) {
+  SpanModelSpec s;
+  s.observed = c.windows.observed;
+  s.predicted = c.windows.predicted;
+  s.seconds_per_step = SecondsPerStep(c.data);
+  s.basis = c.basis;
+  s.network = c.network;
+  return s;
+}
 
-  const HeadLayout layout = LayoutOf(c);
-  torch::manual_seed(static_cast<std::uint64_t>(c.seed));
-  SpanNet net(2 * c.windows.observed, c.network, layout);
+HeadLayout LayoutOf(const SpanModelSpec& s) {
+  HeadLayout l;
+  l.basis = s.basis.num_centres;
+  l.components = s.network.components;
+  l.u_param = s.network.u_param;
+  return l;
+}
+
+SpanSamples MakeSpanSamples(const SpanModelSpec& s, const WindowSet& windows) {
+  const TimeBasis basis = MakeFutureBasis(s.basis, s.predicted, s.seconds_per_step);
+  return MakeSpanSamples(windows, basis, s.basis, s.network.rotate_to_heading,
+                         s.network.residual_to_constant_velocity);
+}
+
+torch::Tensor ToFloatTensor(const Eigen::MatrixXd& m) {
+  Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> rm = m.cast<float>();
+  return torch::from_blob(rm.data(), {rm.rows(), rm.cols()}, torch::kFloat32).clone();
+}
+
+Eigen::MatrixXd InputNormalisation::Apply(const Eigen::MatrixXd& x) const {
+  return (x.rowwise() - mean.transpose()).array().rowwise() / std.transpose().array();
+}
+
+InputNormalisation FitInputNormalisation(const Eigen::MatrixXd& x) {
+  InputNormalisation n;
+  n.mean = x.colwise().mean().transpose();
+  n.std = ((x.rowwise() - n.mean.transpose()).array().square().colwise().mean()).sqrt().transpose();
+  // Constant features (the ego origin) pass through. Nearly constant ones are floored at 1 cm:
+  // e.g. the ego y of the first point is 0 except in the rare windows too short to rotate (standing
+  // pedestrians), and dividing those by a micrometre-scale std feeds the network inputs of 1e3+
+  // (non-finite losses on crowd data with many standing pedestrians).
+  constexpr double kMinStd = 0.01;  // m
+  for (Eigen::Index i = 0; i < n.std.size(); ++i) {
+    if (!(n.std[i] > 1e-6))
+      n.std[i] = 1.0;
+    else
+      n.std[i] = std::max(n.std[i], kMinStd);
+  }
+  return n;
+}
+
+void WriteInputNormalisation(const std::string& path, const InputNormalisation& n) {
+  h5::WriteAtomically(path, [&](h5::File* f) {
+    f->WriteMatrix("/input_mean", n.mean);
+    f->WriteMatrix("/input_std", n.std);
+  });
+}
+
+InputNormalisation ReadInputNormalisation(const std::string& path) {
+  h5::File f = h5::File::Open(path);
+  return {f.ReadMatrixD("/input_mean").col(0), f.ReadMatrixD("/input_std").col(0)};
+}
+
+TrainingSummary TrainSpanNet(const SpanModelSpec& spec, const SpanSamples& train_s,
+                             const SpanSamples& val_s, const TrainConfig& train_config,
+                             std::int64_t seed, const std::string& run_dir, bool resume,
+                             const TrainHooks& hooks) {
+  FS_THROW_UNLESS(train_s.inputs.rows() > 0, run_dir, ": no training samples for the SPAN net");
+  FS_THROW_UNLESS(val_s.inputs.rows() > 0, run_dir,
+                  ": no validation samples for the SPAN net (the validation loss chooses the best "
+                  "checkpoint)");
+  const HeadLayout layout = LayoutOf(spec);
   const std::int64_t m = layout.basis;
-  auto w_train = ToTensor(train_s.targets).view({train_s.targets.rows(), m, 2});
-  auto w_val = ToTensor(val_s.targets).view({val_s.targets.rows(), m, 2});
-  SpanTask task(net, layout, ToTensor(norm.Apply(train_s.inputs)), w_train,
-                ToTensor(norm.Apply(val_s.inputs)), w_val);
-  return Train(&task, c.train, RunPaths{run_dir}, static_cast<std::uint64_t>(c.seed), resume,
+  FS_THROW_UNLESS(train_s.targets.cols() == 2 * m && val_s.targets.cols() == 2 * m &&
+                      val_s.inputs.cols() == train_s.inputs.cols(),
+                  run_dir, ": SPAN samples of ", train_s.inputs.cols(), " / ", val_s.inputs.cols(),
+                  " inputs and ", train_s.targets.cols(), " / ", val_s.targets.cols(),
+                  " targets, expected equal inputs and 2 x basis = ", 2 * m, " targets");
+  std::filesystem::create_directories(run_dir);
+  const std::string norm_path = run_dir + "/normalisation.h5";
+  const InputNormalisation norm =
+      resume ? ReadInputNormalisation(norm_path) : FitInputNormalisation(train_s.inputs);
+  FS_THROW_UNLESS(norm.mean.size() == train_s.inputs.cols(), norm_path, ": normalisation of ",
+                  norm.mean.size(), " inputs, the samples have ", train_s.inputs.cols());
+  if (!resume) WriteInputNormalisation(norm_path, norm);
+
+  torch::manual_seed(static_cast<std::uint64_t>(seed));
+  SpanNet net(static_cast<int>(train_s.inputs.cols()), spec.network, layout);
+  auto w_train = ToFloatTensor(train_s.targets).view({train_s.targets.rows(), m, 2});
+  auto w_val = ToFloatTensor(val_s.targets).view({val_s.targets.rows(), m, 2});
+  SpanTask task(net, layout, ToFloatTensor(norm.Apply(train_s.inputs)), w_train,
+                ToFloatTensor(norm.Apply(val_s.inputs)), w_val);
+  return Train(&task, train_config, RunPaths{run_dir}, static_cast<std::uint64_t>(seed), resume,
                hooks);
 }
 
-namespace {
-/// The engine's dense layers from the network's `names[i].weight` / `.bias` parameters (float).
+TrainingSummary TrainSpanOnWindows(const SpanModelSpec& spec, const WindowSet& train_w,
+                                   const WindowSet& val_w, const TrainConfig& train_config,
+                                   std::int64_t seed, const std::string& run_dir, bool resume,
+                                   const TrainHooks& hooks) {
+  FS_THROW_UNLESS(train_w.size() > 0, run_dir, ": no training windows");
+  FS_THROW_UNLESS(val_w.size() > 0, run_dir, ": no validation windows");
+  FS_THROW_UNLESS(train_w.observed == spec.observed && train_w.predicted == spec.predicted &&
+                      val_w.observed == spec.observed && val_w.predicted == spec.predicted,
+                  run_dir, ": windows of ", train_w.observed, " + ", train_w.predicted,
+                  " (train) / ", val_w.observed, " + ", val_w.predicted,
+                  " (val) points, the model expects ", spec.observed, " + ", spec.predicted);
+  return TrainSpanNet(spec, MakeSpanSamples(spec, train_w), MakeSpanSamples(spec, val_w),
+                      train_config, seed, run_dir, resume, hooks);
+}
+
 Mlp ToEngineMlp(torch::nn::Module& net, const std::vector<std::string>& names) {
   const auto params = net.named_parameters();
   std::vector<DenseLayer> layers;
@@ -163,22 +204,23 @@ Mlp ToEngineMlp(torch::nn::Module& net, const std::vector<std::string>& names) {
         {ToEigenMatrix(params[name + ".weight"]), ToEigenVector(params[name + ".bias"])});
   return Mlp(std::move(layers));
 }
-}  // namespace
 
-void WriteSpanArtifact(const SpanExperimentConfig& c, const std::string& checkpoint,
-                       const std::string& normalisation_file, const std::string& artifact_path) {
-  const HeadLayout layout = LayoutOf(c);
-  SpanNet net(2 * c.windows.observed, c.network, layout);
+SpanPredictorWeights SpanWeightsFromCheckpoint(const SpanModelSpec& spec, int input_dim,
+                                               const std::string& checkpoint,
+                                               const std::string& normalisation_file) {
+  const HeadLayout layout = LayoutOf(spec);
+  SpanNet net(input_dim, spec.network, layout);
   LoadCheckpointModel(checkpoint, net.ptr().get());
-  const Normalisation norm = ReadNormalisation(normalisation_file);
-  const double dt = SecondsPerStep(c.data);
-  const TimeBasis basis = MakeFutureBasis(c.basis, c.windows.predicted, dt);
+  const InputNormalisation norm = ReadInputNormalisation(normalisation_file);
+  FS_THROW_UNLESS(norm.mean.size() == input_dim, normalisation_file, ": normalisation of ",
+                  norm.mean.size(), " inputs, the net takes ", input_dim);
+  const TimeBasis basis = MakeFutureBasis(spec.basis, spec.predicted, spec.seconds_per_step);
   SpanPredictorWeights w;
-  w.observed = c.windows.observed;
-  w.predicted = c.windows.predicted;
-  w.seconds_per_step = dt;
-  w.rotate_to_heading = c.network.rotate_to_heading;
-  w.residual_to_constant_velocity = c.network.residual_to_constant_velocity;
+  w.observed = spec.observed;
+  w.predicted = spec.predicted;
+  w.seconds_per_step = spec.seconds_per_step;
+  w.rotate_to_heading = spec.network.rotate_to_heading;
+  w.residual_to_constant_velocity = spec.network.residual_to_constant_velocity;
   w.layout = layout;
   w.basis_centres = basis.centres();
   w.basis_gamma = basis.gamma();
@@ -186,6 +228,13 @@ void WriteSpanArtifact(const SpanExperimentConfig& c, const std::string& checkpo
   w.input_std = norm.std;
   w.layer_names = net->DenseLayerNames();
   w.mlp = ToEngineMlp(*net, w.layer_names);
+  return w;
+}
+
+void WriteSpanArtifact(const SpanExperimentConfig& c, const std::string& checkpoint,
+                       const std::string& normalisation_file, const std::string& artifact_path) {
+  const SpanPredictorWeights w = SpanWeightsFromCheckpoint(
+      SpanModelSpecOf(c), 2 * c.windows.observed, checkpoint, normalisation_file);
   SpanPredictor::Save(artifact_path, w, config::ToYaml(c), c.seed);
 }
 

@@ -1,0 +1,102 @@
+#pragma once
+/// The runtime projector of structurally constrained prediction (thesis ch 7, eq.
+/// formulationWhole): a predicted mixture of matrix normals (the SPAN predictor's
+/// TrajectoryDistribution) is made collision-compliant component by component, the mixture weights
+/// fixed as in the thesis:
+///   min_theta_r KL(p_theta_r || p_prior_r)  s.t.  C_r(p_theta_r) <= epsilon - margin,
+/// for every component with C_r > epsilon - margin (kl.h, collision_cost.h, projection.h). As
+/// C = sum_r alpha_r C_r with sum_r alpha_r = 1, the mixture then meets C <= epsilon; the returned
+/// C is recomputed on the result, never taken from the solver. The position mean of a prediction
+/// is origin + v t + M' phi(t) (span_predictor.h): the projector passes origin + v t_k to the cost
+/// as a constant offset. The optimiser's parametrisation needs a diagonal U (u_param: diagonal).
+///
+///   DistributionProjector projector(&map, model.basis(), times, ProjectorOptions{});
+///   auto ws = projector.MakeWorkspace();                     // one per caller
+///   TrajectoryDistribution out = prior;                       // sized once
+///   TrackProjection r = projector.Project(prior, &out, &ws);  // never throws on solver failure
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "core/rbf.h"
+#include "inference/constrained/collision_cost.h"
+#include "inference/constrained/component.h"
+#include "inference/constrained/projection.h"
+#include "inference/mapping/occupancy_map.h"
+#include "inference/prediction/span_predictor.h"
+
+namespace foresight::constrained {
+
+/// ComponentParams of component r of `d` (M, log_u_i = 2 log L_U(i,i), L_V). Error naming
+/// "u_param: diagonal" when L_U has a non-zero off-diagonal entry, and when r is out of range.
+ComponentParams ToComponentParams(const TrajectoryDistribution& d, int r);
+/// The inverse: writes M, L_U = diag(exp(log_u / 2)) and L_V into component r of *d. Error when a
+/// shape differs from d's.
+void SetFromComponentParams(const ComponentParams& p, int r, TrajectoryDistribution* d);
+
+struct ProjectorOptions {
+  double epsilon = 0.05;     ///< C <= epsilon is compliant (thesis 0.05), in (0, 1)
+  double margin = 2e-4;      ///< solve to epsilon - margin so the returned C is truly <= epsilon
+  int order = 6;             ///< Gauss-Hermite points per axis
+  ProjectionOptions solver;  ///< its epsilon is overwritten with epsilon - margin
+};
+
+/// Outcome of one track's projection (expected outcomes are values here, never exceptions).
+struct TrackProjection {
+  bool changed = false;   ///< false: the prior's mixture C already met epsilon (returned unchanged)
+  bool feasible = false;  ///< mixture C of the returned distribution <= epsilon
+  double prior_cost = 0, cost = 0;  ///< mixture C before / after
+  double kl = 0;                    ///< sum_r alpha_r KL_r
+  double seconds = 0;               ///< wall time of Project (steady_clock)
+  int evaluations = 0;              ///< objective evaluations over components
+  /// Per component: kAlreadyFeasible when C_r <= epsilon - margin or when the mixture already met
+  /// epsilon (nothing projected), else the solver's outcome.
+  std::vector<ProjectionSummary> components;
+  /// "compliant_prior" | "solved" | "infeasible" | "failed": the worst outcome over components,
+  /// and never "solved" or "compliant_prior" unless `feasible`.
+  std::string status;
+};
+
+/// Projects predicted mixtures onto {C <= epsilon} per component (see the file comment).
+/// Immutable after construction; one Workspace per caller.
+class DistributionProjector {
+ public:
+  struct Workspace {
+    CollisionCost::Workspace cost;  ///< its offset holds origin + v t_k of the current track
+    ComponentGradient gradient;     ///< sized scratch for callers of cost() with a gradient
+                                    ///< (Project's solver owns its own)
+    ComponentParams component;      ///< scratch: one component in the optimiser's parameters
+  };
+
+  /// @param map occupancy map (kept by pointer; must outlive this). @param basis the predictor's
+  /// trajectory basis phi(t). @param times the K points of the rectangle rule (s after the last
+  /// observation, e.g. dt, 2 dt, ..., f dt). Error naming a bad option (epsilon, margin, order,
+  /// solver limits).
+  DistributionProjector(const OccupancyMap* map, const TimeBasis& basis, Eigen::VectorXd times,
+                        const ProjectorOptions& options);
+
+  const ProjectorOptions& options() const { return options_; }
+  const CollisionCost& cost() const { return cost_; }
+  Workspace MakeWorkspace() const;
+
+  /// Mixture C of d (its origin/velocity offset applied). No allocation once `ws` holds a
+  /// component of d's basis (MakeWorkspace does not know it: the first call sizes it). Error when
+  /// d's basis size differs from the projector's or L_U is not diagonal; NaN when d holds NaN.
+  double Cost(const TrajectoryDistribution& d, Workspace* ws) const;
+
+  /// Projects `prior` into *out, which must have prior's shape (components and basis; a copy of
+  /// the prior is fine, `out` may be `&prior`). Never throws on solver or numeric failure (the
+  /// status says so); Error only for shape or u_param misuse.
+  TrackProjection Project(const TrajectoryDistribution& prior, TrajectoryDistribution* out,
+                          Workspace* ws) const;
+
+ private:
+  /// Writes origin + v t_k into ws->cost.offset.
+  void SetOffset(const TrajectoryDistribution& d, Workspace* ws) const;
+
+  ProjectorOptions options_;
+  CollisionCost cost_;
+};
+
+}  // namespace foresight::constrained

@@ -1,0 +1,389 @@
+#include "training/constrained/eval.h"
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <optional>
+#include <random>
+#include <sstream>
+
+#include "core/error.h"
+#include "core/file_io.h"
+#include "core/json.h"
+#include "core/log.h"
+#include "inference/constrained/distribution_projector.h"
+#include "inference/constrained/prediction_metrics.h"
+#include "inference/mapping/occupancy_map.h"
+#include "inference/prediction/naive_predictor.h"
+#include "inference/prediction/span_predictor.h"
+#include "models/occupancy/raster_map.h"
+#include "training/constrained/plots.h"
+
+namespace foresight::constrained {
+namespace fs = std::filesystem;
+
+RunArtifacts ArtifactsOf(const ConstrainedConfig& c, const std::string& run_dir) {
+  RunArtifacts a;
+  a.prior = run_dir + "/prior.h5";
+  if (c.ktm.enabled) a.ktm = run_dir + "/ktm.h5";
+  if (c.naive.enabled) a.naive = run_dir + "/naive.h5";
+  a.maps_dir = run_dir;
+  return a;
+}
+
+bool FitSceneMaps(const ConstrainedConfig& c, const std::vector<MapScene>& scenes,
+                  const std::string& run_dir, const std::atomic<bool>* interrupt) {
+  fs::create_directories(run_dir + "/maps");
+  for (const MapScene& s : scenes) {
+    if (interrupt && interrupt->load()) return false;
+    const std::string path = run_dir + "/" + SceneMapFile(s);
+    if (fs::exists(path)) continue;
+    const auto t0 = std::chrono::steady_clock::now();
+    WriteRasterMap(s.raster, c.map.Options(), path, config::ToYaml(c), c.seed);
+    log::Info("constrained: fitted the map of ", s.name, " (",
+              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+              " s) -> ", path);
+  }
+  return true;
+}
+
+namespace {
+
+/// Means of the scores of a set of windows.
+struct Block {
+  int n = 0, violating = 0;
+  double ade_n = 0, fde_n = 0, ade_m = 0, fde_m = 0, al = 0, anll = 0;
+  bool has_cost = false;
+
+  void Add(const PredictionScores& s) {
+    ++n;
+    ade_n += s.ade_nearest;
+    fde_n += s.fde_nearest;
+    ade_m += s.ade_mixture;
+    fde_m += s.fde_mixture;
+    al += s.al;
+    anll += s.anll;
+  }
+  void AddCost(double cost, double epsilon) {
+    has_cost = true;
+    violating += !(cost <= epsilon);  // a cost that could not be computed (NaN) is not compliant
+  }
+  JsonObject Json() const {
+    const double k = n > 0 ? 1.0 / n : NAN;
+    JsonObject o;
+    o.Set("windows", n);
+    o.Set("ade", ade_n * k).Set("fde", fde_n * k);
+    o.Set("ade_mixture_mean", ade_m * k).Set("fde_mixture_mean", fde_m * k);
+    o.Set("al", al * k).Set("anll", anll * k);
+    if (has_cost) o.Set("cvp", violating * k).Set("violating", violating);
+    return o;
+  }
+};
+
+JsonObject Percentiles(const std::vector<double>& v, double scale) {
+  JsonObject o;
+  o.Set("count", static_cast<int>(v.size()));
+  o.Set("median", Percentile(v, 50) * scale).Set("p90", Percentile(v, 90) * scale);
+  o.Set("p99", Percentile(v, 99) * scale).Set("max", Percentile(v, 100) * scale);
+  return o;
+}
+
+/// Monte Carlo estimate of the mixture's C on `map` (rectangle rule over `times`, as the cost):
+/// independent of the quadrature code (positions from TrajectoryDistribution::Position).
+std::pair<double, double> MonteCarloCost(const TrajectoryDistribution& d,
+                                         const Eigen::VectorXd& times, const OccupancyMap& map,
+                                         int samples, std::mt19937_64* rng) {
+  MapWorkspace ws = map.MakeWorkspace();
+  std::normal_distribution<double> normal;
+  const int per_time = std::max(50, samples / static_cast<int>(times.size()));
+  double c = 0, var = 0;
+  const double k = 1.0 / static_cast<double>(times.size());
+  for (int r = 0; r < d.components(); ++r)
+    for (Eigen::Index t = 0; t < times.size(); ++t) {
+      Eigen::Vector2d mu;
+      Eigen::Matrix2d cov;
+      d.Position(times[t], r, &mu, &cov);
+      const Eigen::Matrix2d l = Eigen::LLT<Eigen::Matrix2d>(cov).matrixL();
+      double sum = 0, sum2 = 0;
+      for (int s = 0; s < per_time; ++s) {
+        const Eigen::Vector2d x = mu + l * Eigen::Vector2d(normal(*rng), normal(*rng));
+        const double p = map.Probability(x.x(), x.y(), &ws);
+        sum += p;
+        sum2 += p * p;
+      }
+      const double mean = sum / per_time;
+      const double v = std::max(0.0, sum2 / per_time - mean * mean) / per_time;
+      c += d.alpha(r) * k * mean;
+      var += d.alpha(r) * d.alpha(r) * k * k * v;
+    }
+  return {c, std::sqrt(var)};
+}
+
+struct Accuracy {
+  std::vector<double> err_mc, se_mc, err_order, err_time;
+  void Add(double cost, const std::pair<double, double>& mc, double reference, double fine) {
+    err_mc.push_back(std::abs(cost - mc.first));
+    se_mc.push_back(mc.second);
+    err_order.push_back(std::abs(cost - reference));
+    err_time.push_back(std::abs(cost - fine));
+  }
+  JsonObject Json(int order, int reference_order) const {
+    // A non-finite entry (a cost that could not be computed) makes the maximum NaN (null).
+    auto max_of = [](const std::vector<double>& v) {
+      double m = v.empty() ? NAN : 0.0;
+      for (double x : v) m = std::isfinite(x) && std::isfinite(m) ? std::max(m, x) : NAN;
+      return m;
+    };
+    auto mean_of = [](const std::vector<double>& v) {
+      double s = 0;
+      for (double x : v) s += x;
+      return v.empty() ? NAN : s / static_cast<double>(v.size());
+    };
+    JsonObject o;
+    o.Set("windows", static_cast<int>(err_mc.size())).Set("order", order);
+    o.Set("max_abs_error_vs_monte_carlo", max_of(err_mc));
+    o.Set("mean_abs_error_vs_monte_carlo", mean_of(err_mc));
+    o.Set("max_monte_carlo_standard_error", max_of(se_mc));
+    o.Set("reference_order", reference_order);
+    o.Set("max_abs_error_vs_reference_order", max_of(err_order));
+    o.Set("max_abs_change_with_4x_time_points", max_of(err_time));
+    return o;
+  }
+};
+
+Eigen::MatrixX2d Rows(const Eigen::MatrixXd& rows, int k, int n) {
+  Eigen::MatrixX2d out(n, 2);
+  for (int i = 0; i < n; ++i) out.row(i) << rows(k, 2 * i), rows(k, 2 * i + 1);
+  return out;
+}
+
+}  // namespace
+
+std::string EvaluateConstrained(const ConstrainedConfig& c, const ConstrainedData& d,
+                                const std::string& run_dir) {
+  const RunArtifacts art = ArtifactsOf(c, run_dir);
+  for (const std::string& a : {art.prior, art.ktm, art.naive})
+    FS_THROW_UNLESS(a.empty() || fs::exists(a), a, " is missing; train (or export) the run first");
+  const SpanPredictor prior = SpanPredictor::Load(art.prior);
+  FS_THROW_UNLESS(prior.layout().u_param == UParam::kDiagonal, art.prior,
+                  ": the prior's U is not diagonal (network.u_param must be diagonal)");
+  std::optional<SpanPredictor> ktm;
+  if (!art.ktm.empty()) ktm = SpanPredictor::Load(art.ktm);
+  std::optional<NaivePredictor> naive;
+  if (!art.naive.empty()) naive = NaivePredictor::Load(art.naive);
+
+  const std::vector<MapScene>& scenes = d.split.test;
+  FitSceneMaps(c, scenes, run_dir);
+  const int p = c.windows.observed, f = c.windows.predicted;
+  const double dt = d.test.windows.seconds_per_step;
+  FS_THROW_UNLESS(prior.observed() == p && std::abs(prior.seconds_per_step() - dt) < 1e-9,
+                  art.prior, ": trained on ", prior.observed(), " observed points every ",
+                  prior.seconds_per_step(), " s; the config's windows have ", p, " every ", dt,
+                  " s");
+  // The rectangle rule of C over (0, f dt]: `substeps` points per prediction step; the check of
+  // its accuracy uses 4 times as many.
+  const int k = f * c.constraint.substeps;
+  const Eigen::VectorXd times = Eigen::VectorXd::LinSpaced(k, f * dt / k, f * dt);
+  const Eigen::VectorXd fine_times = Eigen::VectorXd::LinSpaced(4 * k, f * dt / (4 * k), f * dt);
+  const Eigen::VectorXd steps = Eigen::VectorXd::LinSpaced(f, dt, f * dt);  // for pictures
+  ProjectorOptions po;
+  po.epsilon = c.constraint.epsilon;
+  po.margin = c.constraint.margin;
+  po.order = c.constraint.order;
+  po.solver.max_evaluations = c.constraint.max_evaluations;
+  po.solver.max_seconds = c.constraint.max_seconds;
+  // The solver accepts C within its tolerance of its target; the target sits `margin` below
+  // epsilon, so a tolerance below the margin keeps accepted points compliant.
+  po.solver.tolerance = std::min(po.solver.tolerance, 0.5 * c.constraint.margin);
+  constexpr int kReferenceOrder = 20;
+  ProjectorOptions po_ref = po;
+  po_ref.order = kReferenceOrder;
+
+  struct SceneRuntime {
+    std::unique_ptr<OccupancyMap> map;
+    std::unique_ptr<DistributionProjector> projector, reference, fine;
+    // One workspace per operator: each is sized for its map, order and time points.
+    std::optional<DistributionProjector::Workspace> ws, ws_reference, ws_fine;
+  };
+  std::vector<SceneRuntime> rt(scenes.size());
+  auto runtime = [&](int s) -> SceneRuntime& {
+    SceneRuntime& r = rt[static_cast<std::size_t>(s)];
+    if (!r.map) {
+      r.map = LoadOccupancyMap(run_dir + "/" + SceneMapFile(scenes[static_cast<std::size_t>(s)]));
+      r.projector = std::make_unique<DistributionProjector>(r.map.get(), prior.basis(), times, po);
+      r.reference =
+          std::make_unique<DistributionProjector>(r.map.get(), prior.basis(), times, po_ref);
+      r.fine = std::make_unique<DistributionProjector>(r.map.get(), prior.basis(), fine_times, po);
+      r.ws = r.projector->MakeWorkspace();
+      r.ws_reference = r.reference->MakeWorkspace();
+      r.ws_fine = r.fine->MakeWorkspace();
+    }
+    return r;
+  };
+
+  const int n_all = d.test.windows.size();
+  const int n = c.eval.max_windows > 0 ? std::min(n_all, c.eval.max_windows) : n_all;
+  SpanPredictor::Workspace pws = prior.MakeWorkspace();
+  TrajectoryDistribution dist = prior.MakeDistribution(), opt = prior.MakeDistribution();
+  std::optional<SpanPredictor::Workspace> kws;
+  std::optional<TrajectoryDistribution> kdist;
+  if (ktm) {
+    kws = ktm->MakeWorkspace();
+    kdist = ktm->MakeDistribution();
+  }
+  std::optional<NaivePredictor::Workspace> nws;
+  if (naive) nws = naive->MakeWorkspace();
+  Eigen::Matrix<double, Eigen::Dynamic, 2> naive_out(f, 2);
+
+  Block b_prior, b_opt, b_prior_v, b_opt_v, b_ktm, b_cv, b_naive;
+  std::map<std::string, int> statuses;
+  std::vector<double> solve_s, check_s;
+  int failures = 0, kl_windows = 0;
+  double kl_sum = 0;
+  Accuracy acc, acc_opt;
+  // The optimised C of projected windows under a finer quadrature and a finer time grid: the
+  // solver drove the configured operator down, so compliance is also checked by the others.
+  int opt_violating_reference = 0, opt_violating_fine = 0;
+  std::mt19937_64 rng(static_cast<std::uint64_t>(c.eval.sample_seed));
+  std::vector<std::pair<int, WindowPicture>> pictures;
+  std::ostringstream csv;
+  csv << "window,scene,prior_cost,cost,status,seconds,evaluations,kl,prior_ade,optimised_ade,"
+         "prior_fde,optimised_fde\n";
+  for (int w = 0; w < n; ++w) {
+    const int s = d.test.scene[static_cast<std::size_t>(w)];
+    SceneRuntime& r = runtime(s);
+    DistributionProjector::Workspace* pw = &*r.ws;
+    const Eigen::MatrixX2d past = Rows(d.test.windows.past, w, p);
+    const Eigen::MatrixX2d truth = Rows(d.test.windows.future, w, f);
+    prior.Predict(past, &pws, &dist);
+    const TrackProjection tp = r.projector->Project(dist, &opt, pw);
+    const PredictionScores sp = ScorePrediction(dist, truth, dt);
+    const PredictionScores so = ScorePrediction(opt, truth, dt);
+    b_prior.Add(sp);
+    b_prior.AddCost(tp.prior_cost, c.constraint.epsilon);
+    b_opt.Add(so);
+    b_opt.AddCost(tp.cost, c.constraint.epsilon);
+    if (tp.prior_cost - c.constraint.epsilon > 0) {
+      b_prior_v.Add(sp);
+      b_prior_v.AddCost(tp.prior_cost, c.constraint.epsilon);
+      b_opt_v.Add(so);
+      b_opt_v.AddCost(tp.cost, c.constraint.epsilon);
+    }
+    ++statuses[tp.status];
+    if (!tp.feasible) ++failures;
+    (tp.changed ? solve_s : check_s).push_back(tp.seconds);
+    if (tp.changed) {
+      kl_sum += tp.kl;
+      ++kl_windows;
+    }
+    if (w < c.eval.accuracy_windows)
+      acc.Add(tp.prior_cost, MonteCarloCost(dist, times, *r.map, c.eval.accuracy_samples, &rng),
+              r.reference->Cost(dist, &*r.ws_reference), r.fine->Cost(dist, &*r.ws_fine));
+    if (tp.changed) {
+      const double reference = r.reference->Cost(opt, &*r.ws_reference);
+      const double fine = r.fine->Cost(opt, &*r.ws_fine);
+      opt_violating_reference += !(reference <= c.constraint.epsilon);
+      opt_violating_fine += !(fine <= c.constraint.epsilon);
+      if (static_cast<int>(acc_opt.err_mc.size()) < c.eval.accuracy_windows)
+        acc_opt.Add(tp.cost, MonteCarloCost(opt, times, *r.map, c.eval.accuracy_samples, &rng),
+                    reference, fine);
+    }
+    if (ktm) {
+      ktm->Predict(past, &*kws, &*kdist);
+      b_ktm.Add(ScorePrediction(*kdist, truth, dt));
+      b_ktm.AddCost(r.projector->Cost(*kdist, pw), c.constraint.epsilon);
+    }
+    b_cv.Add(ScorePoints(ConstantVelocity(past, f), truth));
+    if (naive) {
+      naive->Predict(past, &*nws, naive_out);
+      b_naive.Add(ScorePoints(naive_out, truth));
+    }
+    csv << w << ',' << scenes[static_cast<std::size_t>(s)].name << ',' << tp.prior_cost << ','
+        << tp.cost << ',' << tp.status << ',' << tp.seconds << ',' << tp.evaluations << ',' << tp.kl
+        << ',' << sp.ade_nearest << ',' << so.ade_nearest << ',' << sp.fde_nearest << ','
+        << so.fde_nearest << '\n';
+    if (tp.changed && static_cast<int>(pictures.size()) < c.eval.plot_windows)
+      pictures.push_back({s, WindowPicture{past, truth, dist, opt, tp.prior_cost, tp.cost}});
+  }
+  WriteFileAtomically(run_dir + "/tracks.csv", csv.str());
+
+  if (!pictures.empty()) {
+    fs::create_directories(run_dir + "/plots");
+    for (std::size_t i = 0; i < pictures.size(); ++i)
+      DrawWindowPicture(run_dir + "/plots/window_" + std::to_string(i) + ".png",
+                        scenes[static_cast<std::size_t>(pictures[i].first)].raster,
+                        pictures[i].second, steps, c.constraint.order, c.eval.plot_samples,
+                        static_cast<std::uint64_t>(c.eval.sample_seed) + i);
+  }
+
+  // Validation windows (prior and KTM only, no projection): what hyper-parameters are chosen by.
+  Block v_prior, v_ktm;
+  const int n_val = c.eval.max_windows > 0 ? std::min(d.val.windows.size(), c.eval.max_windows)
+                                           : d.val.windows.size();
+  for (int w = 0; w < n_val; ++w) {
+    const Eigen::MatrixX2d past = Rows(d.val.windows.past, w, p);
+    const Eigen::MatrixX2d truth = Rows(d.val.windows.future, w, f);
+    prior.Predict(past, &pws, &dist);
+    v_prior.Add(ScorePrediction(dist, truth, dt));
+    if (ktm) {
+      ktm->Predict(past, &*kws, &*kdist);
+      v_ktm.Add(ScorePrediction(*kdist, truth, dt));
+    }
+  }
+
+  JsonObject data;
+  data.Set("source", c.data.source).Set("scenes", d.report.scenes);
+  data.Set("map_kind", c.map.kind == RasterMapKind::kGrid ? "grid" : "fast_bhm");
+  data.Set("tracks_read", d.report.tracks_read).Set("tracks_kept", d.report.tracks_kept);
+  data.Set("tracks_too_short", d.report.too_short);
+  data.Set("tracks_outside_map_frame", d.report.outside_frame);
+  data.Set("samples_in_obstacles", d.report.points_in_obstacles);
+  data.Set("tracks_in_obstacles", d.report.tracks_in_obstacles);
+  data.Set("train_windows", d.train.windows.size()).Set("val_windows", d.val.windows.size());
+  data.Set("test_windows", n_all).Set("evaluated_windows", n);
+  data.Set("seconds_per_step", dt).Set("observed", p).Set("predicted", f);
+  JsonObject status;
+  for (const auto& [name, count] : statuses) status.Set(name, count);
+  JsonObject solve;
+  solve.Set("epsilon", c.constraint.epsilon).Set("order", c.constraint.order);
+  solve.Set("time_points", k).Set("statuses", status).Set("failures", failures);
+  solve.Set("projected", static_cast<int>(solve_s.size()));
+  solve.Set("optimised_violating_at_reference_order", opt_violating_reference);
+  solve.Set("optimised_violating_with_4x_time_points", opt_violating_fine);
+  solve.Set("mean_kl_of_projected", kl_windows > 0 ? kl_sum / kl_windows : NAN);
+  solve.Set("solve_ms", Percentiles(solve_s, 1e3));
+  solve.Set("check_ms", Percentiles(check_s, 1e3));
+  JsonObject o;
+  o.Set("kind", "constrained").Set("data", data);
+  o.Set("prior", b_prior.Json()).Set("optimised", b_opt.Json());
+  o.Set("prior_on_violating", b_prior_v.Json()).Set("optimised_on_violating", b_opt_v.Json());
+  if (ktm) o.Set("ktm", b_ktm.Json());
+  o.Set("cv", b_cv.Json());
+  if (naive) o.Set("naive", b_naive.Json());
+  JsonObject val;
+  val.Set("prior", v_prior.Json());
+  if (ktm) val.Set("ktm", v_ktm.Json());
+  o.Set("val", val);
+  o.Set("solve", solve);
+  o.Set("quadrature_accuracy", acc.Json(c.constraint.order, kReferenceOrder));
+  o.Set("quadrature_accuracy_optimised", acc_opt.Json(c.constraint.order, kReferenceOrder));
+  o.Set("notes",
+        "ade/fde: the mean of the component nearest to the truth (thesis); *_mixture_mean: of the "
+        "mixture mean; al: mean over steps of the mixture density of the truth (1/m^2); cvp: share "
+        "of windows with C - epsilon > 0; cv and naive are point predictions (no al); solve_ms: "
+        "windows whose prior violated the constraint (one core), check_ms: the others");
+  const std::string json = o.Dump() + "\n";
+  WriteFileAtomically(run_dir + "/eval.json", json);
+  log::Info("constrained eval: prior ADE ", b_prior.ade_n / std::max(1, b_prior.n), " CVP ",
+            b_prior.violating, "/", b_prior.n, " -> optimised ADE ",
+            b_opt.ade_n / std::max(1, b_opt.n), " CVP ", b_opt.violating, "/", b_opt.n,
+            ", failures ", failures);
+  return json;
+}
+
+}  // namespace foresight::constrained
