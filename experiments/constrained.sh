@@ -26,8 +26,11 @@ run() {  # run DIR CONFIG [key=value ...]
   fi
 }
 
+# Basis widths tried per dataset (1/s^2; Occ-Traj120 counts time in steps), fixed in advance.
+declare -A GAMMAS=([synthetic]="0.5 1.0 2.0" [occ_traj]="0.02 0.05 0.2" [thor]="0.5 1.0 2.0"
+                   [eth]="0.5 1.0 2.0")
 for ds in ${DATASETS:-synthetic occ_traj thor eth}; do
-  for gamma in ${GAMMAS:-0.25 1.0 4.0}; do
+  for gamma in ${GAMMAS[$ds]}; do
     run "runs/constrained_${ds}/g${gamma}" "configs/constrained/${ds}.yaml" \
       basis.gamma="$gamma" </dev/null
   done

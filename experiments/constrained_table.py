@@ -45,8 +45,8 @@ for ds, title in names.items():
     s = e["solve"]
     q = e["quadrature_accuracy"]
     solve_rows.append(
-        f"| {title} | {s['solve_ms']['count']} | {f(s['solve_ms']['median'], 1)} | "
-        f"{f(s['solve_ms']['p99'], 1)} | {f(s['solve_ms']['max'], 1)} | {s['failures']} | "
+        f"| {title} | {s['solve_time_ms']['count']} | {f(s['solve_time_ms']['median'], 1)} | "
+        f"{f(s['solve_time_ms']['p99'], 1)} | {f(s['solve_time_ms']['max'], 1)} | {s['failures']} | "
         f"{q['order']} | {f(q['max_abs_error_vs_monte_carlo'], 4)} "
         f"(MC s.e. {f(q['max_monte_carlo_standard_error'], 4)}) | "
         f"{f(q['max_abs_error_vs_reference_order'], 5)} | "

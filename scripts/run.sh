@@ -44,3 +44,8 @@ rm -rf runs/diffeo_quickstart
 rm -rf runs/otnet_quickstart
 ./build/bin/foresight train configs/otnet/synthetic.yaml --run-dir runs/otnet_quickstart
 ./build/bin/foresight bench otnet --artifact runs/otnet_quickstart/model.h5
+# Structurally constrained prediction (thesis ch 7): synthetic scenes with maps; the mixture prior,
+# KTM, constant velocity and the naive network, and the prior projected onto the collision chance
+# constraint (runs/constrained_quickstart/eval.json, tracks.csv, plots/window_*.png; about 15 s).
+rm -rf runs/constrained_quickstart
+./build/bin/foresight train configs/constrained/synthetic.yaml --run-dir runs/constrained_quickstart

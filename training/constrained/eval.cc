@@ -356,8 +356,8 @@ std::string EvaluateConstrained(const ConstrainedConfig& c, const ConstrainedDat
   solve.Set("optimised_violating_at_reference_order", opt_violating_reference);
   solve.Set("optimised_violating_with_4x_time_points", opt_violating_fine);
   solve.Set("mean_kl_of_projected", kl_windows > 0 ? kl_sum / kl_windows : NAN);
-  solve.Set("solve_ms", Percentiles(solve_s, 1e3));
-  solve.Set("check_ms", Percentiles(check_s, 1e3));
+  solve.Set("solve_time_ms", Percentiles(solve_s, 1e3));
+  solve.Set("check_time_ms", Percentiles(check_s, 1e3));
   JsonObject o;
   o.Set("kind", "constrained").Set("data", data);
   o.Set("prior", b_prior.Json()).Set("optimised", b_opt.Json());
@@ -372,11 +372,12 @@ std::string EvaluateConstrained(const ConstrainedConfig& c, const ConstrainedDat
   o.Set("solve", solve);
   o.Set("quadrature_accuracy", acc.Json(c.constraint.order, kReferenceOrder));
   o.Set("quadrature_accuracy_optimised", acc_opt.Json(c.constraint.order, kReferenceOrder));
-  o.Set("notes",
-        "ade/fde: the mean of the component nearest to the truth (thesis); *_mixture_mean: of the "
-        "mixture mean; al: mean over steps of the mixture density of the truth (1/m^2); cvp: share "
-        "of windows with C - epsilon > 0; cv and naive are point predictions (no al); solve_ms: "
-        "windows whose prior violated the constraint (one core), check_ms: the others");
+  o.Set(
+      "notes",
+      "ade/fde: the mean of the component nearest to the truth (thesis); *_mixture_mean: of the "
+      "mixture mean; al: mean over steps of the mixture density of the truth (1/m^2); cvp: share "
+      "of windows with C - epsilon > 0; cv and naive are point predictions (no al); solve_time_ms: "
+      "windows whose prior violated the constraint (one core), check_time_ms: the others");
   const std::string json = o.Dump() + "\n";
   WriteFileAtomically(run_dir + "/eval.json", json);
   log::Info("constrained eval: prior ADE ", b_prior.ade_n / std::max(1, b_prior.n), " CVP ",

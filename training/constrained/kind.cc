@@ -35,6 +35,7 @@ ExperimentKind ConstrainedKind() {
       std::cout << "wrote " << req.run_dir << "/eval.json\n";
     }
   };
+  k.export_run = constrained::ExportConstrainedRun;
   k.evaluate = [](const std::string& run_dir, const std::vector<std::string>& overrides) {
     // The split is the run's: another seed, data, split or windows section would score training
     // tracks as test (data.root only says where the same files are).

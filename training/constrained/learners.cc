@@ -179,11 +179,17 @@ bool TrainPrior(const LearnerSpec& spec, const WindowSet& train, const WindowSet
   const TrainingSummary summary =
       TrainSpanOnWindows(s, train, val, spec.train, spec.seed, dir, resume, hooks);
   if (Interrupted(summary, "prior", dir)) return false;
-  const SpanPredictorWeights w = SpanWeightsFromCheckpoint(
-      s, 2 * spec.observed, CheckpointToExport(dir, "prior"), dir + "/normalisation.h5");
+  ExportPrior(spec, dir, artifact, config_yaml);
+  return true;
+}
+
+void ExportPrior(const LearnerSpec& spec, const std::string& dir, const std::string& artifact,
+                 const std::string& config_yaml) {
+  const SpanPredictorWeights w =
+      SpanWeightsFromCheckpoint(SpanSpecOf(spec), 2 * spec.observed,
+                                CheckpointToExport(dir, "prior"), dir + "/normalisation.h5");
   SpanPredictor::Save(artifact, w, config_yaml, spec.seed);
   (void)SpanPredictor::Load(artifact);
-  return true;
 }
 
 bool TrainKtm(const LearnerSpec& spec, const KtmSpec& ktm, const WindowSet& train,
@@ -216,13 +222,21 @@ bool TrainKtm(const LearnerSpec& spec, const KtmSpec& ktm, const WindowSet& trai
   const TrainingSummary summary =
       TrainSpanNet(s, train_s, val_s, spec.train, spec.seed, dir, resume, hooks);
   if (Interrupted(summary, "ktm", dir)) return false;
+  ExportKtm(spec, ktm, dir, artifact, config_yaml);
+  return true;
+}
+
+void ExportKtm(const LearnerSpec& spec, const KtmSpec& ktm, const std::string& dir,
+               const std::string& artifact, const std::string& config_yaml) {
+  const std::string refs_path = dir + "/ktm_references.h5";
+  FS_THROW_UNLESS(fs::exists(refs_path), refs_path, ": missing, nothing to export");
   SpanPredictorWeights w = SpanWeightsFromCheckpoint(
-      s, ktm.references, CheckpointToExport(dir, "ktm"), dir + "/normalisation.h5");
-  w.ktm_references = refs;
+      SpanSpecOf(spec), ktm.references, CheckpointToExport(dir, "ktm"), dir + "/normalisation.h5");
+  w.ktm_references =
+      h5::File::Open(refs_path).ReadMatrixD("/references", ktm.references, 2 * spec.observed);
   w.ktm_lengthscale = ktm.lengthscale;
   SpanPredictor::Save(artifact, w, config_yaml, spec.seed);
   (void)SpanPredictor::Load(artifact);
-  return true;
 }
 
 bool TrainNaive(const LearnerSpec& spec, const NaiveSpec& naive, const WindowSet& train,
@@ -249,21 +263,27 @@ bool TrainNaive(const LearnerSpec& spec, const NaiveSpec& naive, const WindowSet
   const TrainingSummary summary =
       Train(&task, spec.train, RunPaths{dir}, static_cast<std::uint64_t>(spec.seed), resume, hooks);
   if (Interrupted(summary, "naive", dir)) return false;
+  ExportNaive(spec, naive, dir, artifact, config_yaml);
+  return true;
+}
 
+void ExportNaive(const LearnerSpec& spec, const NaiveSpec& naive, const std::string& dir,
+                 const std::string& artifact, const std::string& config_yaml) {
+  const int in = 2 * spec.observed, out = 2 * spec.predicted;
+  const InputNormalisation norm = ReadInputNormalisation(dir + "/normalisation.h5");
   NaiveNet best(in, naive.hidden, out);
   LoadCheckpointModel(CheckpointToExport(dir, "naive"), best.ptr().get());
   NaivePredictorWeights w;
   w.observed = spec.observed;
   w.predicted = spec.predicted;
   w.seconds_per_step = spec.seconds_per_step;
-  w.rotate_to_heading = rotate;
+  w.rotate_to_heading = spec.network.rotate_to_heading;
   w.input_mean = norm.mean;
   w.input_std = norm.std;
   w.layer_names = best->DenseLayerNames();
   w.mlp = ToEngineMlp(*best, w.layer_names);
   NaivePredictor::Save(artifact, w, config_yaml, spec.seed);
   (void)NaivePredictor::Load(artifact);
-  return true;
 }
 
 }  // namespace foresight::constrained

@@ -80,6 +80,15 @@ bool TrainNaive(const LearnerSpec& spec, const NaiveSpec& naive, const WindowSet
                 const WindowSet& val, const std::string& dir, bool resume, const TrainHooks& hooks,
                 const std::string& artifact, const std::string& config_yaml);
 
+/// Write `artifact` from the best checkpoint (else the last) in `dir` of a learner trained there
+/// with the same spec (the export step; training calls them at its end). Missing checkpoints,
+/// normalisation or KTM references are Errors naming the file.
+void ExportPrior(const LearnerSpec& spec, const std::string& dir, const std::string& artifact,
+                 const std::string& config_yaml);
+void ExportKtm(const LearnerSpec& spec, const KtmSpec& ktm, const std::string& dir,
+               const std::string& artifact, const std::string& config_yaml);
+void ExportNaive(const LearnerSpec& spec, const NaiveSpec& naive, const std::string& dir,
+                 const std::string& artifact, const std::string& config_yaml);
 /// KTM features [N x K] of ego-frame segments `ego_past` [N x 2p] (x_1, y_1, ...) against
 /// `references` [K x 2p]: exp(-d^2 / (2 l^2)), d^2 = (1/p) sum_j |q_j - r_j|^2.
 Eigen::MatrixXd KtmFeatures(const Eigen::MatrixXd& ego_past, const Eigen::MatrixXd& references,

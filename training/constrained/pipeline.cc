@@ -7,6 +7,7 @@
 #include "training/constrained/data.h"
 #include "training/constrained/eval.h"
 #include "training/constrained/learners.h"
+#include "training/kinds.h"
 #include "training/run_dir.h"
 #include "training/trainer.h"
 
@@ -70,6 +71,22 @@ bool TrainConstrainedRun(const ConstrainedConfig& c, const std::string& run_dir,
       }))
     return false;
   return FitSceneMaps(c, d.split.test, run_dir, interrupt);
+}
+
+std::string ExportConstrainedRun(const std::string& run_dir) {
+  const auto c = LoadRunConfig<ConstrainedConfig>(run_dir, {});
+  const ConstrainedData d = LoadConstrainedData(c);
+  const LearnerSpec spec = SpecOf(c, d.train.windows.seconds_per_step);
+  const RunArtifacts art = ArtifactsOf(c, run_dir);
+  const std::string yaml = config::ToYaml(c);
+  ExportPrior(spec, run_dir + "/prior", art.prior, yaml);
+  if (!art.ktm.empty())
+    ExportKtm(spec, KtmSpec{c.ktm.references, c.ktm.lengthscale}, run_dir + "/ktm", art.ktm, yaml);
+  if (!art.naive.empty())
+    ExportNaive(spec, NaiveSpec{c.naive.hidden}, run_dir + "/naive", art.naive, yaml);
+  log::Info("constrained: exported ", art.prior, art.ktm.empty() ? "" : ", " + art.ktm,
+            art.naive.empty() ? "" : ", " + art.naive);
+  return art.prior;
 }
 
 std::string EvaluateConstrainedRun(const ConstrainedConfig& c, const std::string& run_dir) {
