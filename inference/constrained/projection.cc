@@ -269,16 +269,15 @@ ProjectionSummary ProjectComponent(const ComponentParams& prior, const Constrain
   if (r > 0 && options.max_seconds > 0) r = nlopt_set_maxtime(opt.get(), options.max_seconds);
   double final_kl = 0;
   // SLSQP may stop without a feasible point (a line search that cannot make progress from where
-  // the linearisation led it); it then restarts from the lowest-cost point seen, within the
-  // remaining evaluation budget.
+  // the linearisation led it); it then restarts from the lowest-cost point seen, each attempt with
+  // max_evaluations, all within max_seconds.
   const bool set_up = r > 0;
   for (int attempt = 0; set_up && attempt <= options.restarts; ++attempt) {
     if (attempt > 0) {
-      const int remaining = options.max_evaluations - pb.evaluations;
-      if (pb.have_feasible || pb.failed || remaining <= 0) break;
+      if (pb.have_feasible || pb.failed) break;
       if (options.max_seconds > 0 && elapsed() >= options.max_seconds) break;
       theta = pb.fallback;
-      r = nlopt_set_maxeval(opt.get(), remaining);
+      r = nlopt_set_maxeval(opt.get(), options.max_evaluations);
       if (r > 0 && options.max_seconds > 0)
         r = nlopt_set_maxtime(opt.get(), options.max_seconds - elapsed());
       if (r <= 0) break;  // a setter failed: judged below like any other stop

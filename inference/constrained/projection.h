@@ -25,8 +25,8 @@ struct ProjectionOptions {
   double xtol_rel = 1e-6;     ///< NLopt relative parameter tolerance
   int max_evaluations = 300;  ///< objective evaluations at most
   double max_seconds = 1.0;   ///< wall-time limit per component (0: none)
-  int restarts =
-      2;  ///< restarts from the lowest-cost point when SLSQP stops without a feasible one
+  int restarts = 2;  ///< restarts from the lowest-cost point when SLSQP stops without a feasible
+                     ///< one (each with max_evaluations)
 };
 
 enum class ProjectionStatus {

@@ -304,8 +304,13 @@ TEST(ProjectComponent, EvaluationLimitKeepsTheBestPoint) {
     ProjectionOptions opt;
     opt.max_evaluations = limit;
     ComponentParams out;
+    // Each attempt (the first and every restart from the lowest-cost point) has the budget.
     const ProjectionSummary s = ProjectComponent(prior, AsFunction(h), opt, &out);
-    EXPECT_LE(s.evaluations, limit);
+    EXPECT_LE(s.evaluations, (opt.restarts + 1) * limit);
+    ProjectionOptions once = opt;
+    once.restarts = 0;
+    ComponentParams out_once;
+    EXPECT_LE(ProjectComponent(prior, AsFunction(h), once, &out_once).evaluations, limit);
     ASSERT_TRUE(s.status == ProjectionStatus::kSolved || s.status == ProjectionStatus::kInfeasible)
         << ToString(s.status) << " " << s.nlopt_result;
     EXPECT_NEAR(h(out, nullptr), s.cost, 1e-12);

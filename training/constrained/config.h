@@ -83,10 +83,11 @@ struct NaiveConfig {
 };
 
 struct ConstraintConfig {
-  double epsilon = 0.05;      ///< C <= epsilon is compliant (thesis 0.05)
-  double margin = 2e-4;       ///< solve to epsilon - margin so the returned C is truly <= epsilon
-  int order = 6;              ///< Gauss-Hermite points per axis
-  int substeps = 1;           ///< rectangle-rule time points per prediction step
+  double epsilon = 0.05;  ///< C <= epsilon is compliant (thesis 0.05)
+  double margin = 2e-4;   ///< solve to epsilon - margin so the returned C is truly <= epsilon
+  int order = 6;          ///< Gauss-Hermite points per axis
+  int substeps = 1;       ///< rectangle-rule time points per prediction step
+  int restarts = 2;  ///< SLSQP restarts from the lowest-cost point when no feasible one was found
   int max_evaluations = 300;  ///< SLSQP objective evaluations per component
   double max_seconds = 1.0;   ///< wall-time limit per component (s)
 
@@ -99,6 +100,8 @@ struct ConstraintConfig {
     a->Visit("order", &order, Range::Closed(1, 40), "Gauss-Hermite points per axis");
     a->Visit("substeps", &substeps, Range::Closed(1, 64),
              "time points of the rectangle rule per prediction step (1: at the predicted steps)");
+    a->Visit("restarts", &restarts, Range::Closed(0, 100),
+             "SLSQP restarts from the lowest-cost point seen when it stops infeasible");
     a->Visit("max_evaluations", &max_evaluations, Range::Closed(1, 100000),
              "SLSQP evaluations per component at most");
     a->Visit("max_seconds", &max_seconds, Range::Closed(0, 3600),

@@ -197,6 +197,7 @@ std::string EvaluateConstrained(const ConstrainedConfig& c, const ConstrainedDat
   po.order = c.constraint.order;
   po.solver.max_evaluations = c.constraint.max_evaluations;
   po.solver.max_seconds = c.constraint.max_seconds;
+  po.solver.restarts = c.constraint.restarts;
   // The solver accepts C within its tolerance of its target; the target sits `margin` below
   // epsilon, so a tolerance below the margin keeps accepted points compliant.
   po.solver.tolerance = std::min(po.solver.tolerance, 0.5 * c.constraint.margin);
