@@ -35,6 +35,31 @@ Mlp Mlp::Load(const h5::File& file, const std::string& prefix,
   }
 }
 
+Mlp Mlp::LoadListed(const h5::File& file, const std::string& group, const std::string& names_attr,
+                    const std::string& prefix) {
+  const std::string joined = file.GetStringAttr(group, names_attr);
+  std::vector<std::string> names;
+  for (std::size_t start = 0;;) {
+    const auto comma = joined.find(',', start);
+    names.push_back(joined.substr(start, comma == std::string::npos ? comma : comma - start));
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  Mlp mlp = Load(file, prefix, names);
+  for (const auto& l : mlp.layers())
+    FS_THROW_UNLESS(l.weight.allFinite() && l.bias.allFinite(), file.path(),
+                    ": non-finite weights");
+  return mlp;
+}
+
+void Mlp::SaveListed(h5::File* file, const std::string& group, const std::string& names_attr,
+                     const std::string& prefix, const std::vector<std::string>& names) const {
+  std::string joined;
+  for (const auto& name : names) joined += (joined.empty() ? "" : ",") + name;
+  file->SetAttr(group, names_attr, joined);
+  Save(file, prefix, names);
+}
+
 void Mlp::Save(h5::File* file, const std::string& prefix,
                const std::vector<std::string>& names) const {
   FS_THROW_UNLESS(names.size() == layers_.size(), file->path(), ": ", names.size(),

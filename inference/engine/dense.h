@@ -28,6 +28,14 @@ class Mlp {
                   const std::vector<std::string>& names);
   /// Writes what Load reads: `<prefix><names[i]>/weight` [out x in] and `/bias` [out] (float).
   void Save(h5::File* file, const std::string& prefix, const std::vector<std::string>& names) const;
+  /// The network of an artifact whose layer names (evaluation order) are the comma-separated string
+  /// attribute `names_attr` of `group` (e.g. /model dense_layers); weights under `prefix`. A
+  /// non-finite weight is an Error naming the file.
+  static Mlp LoadListed(const h5::File& file, const std::string& group,
+                        const std::string& names_attr, const std::string& prefix);
+  /// Writes what LoadListed reads.
+  void SaveListed(h5::File* file, const std::string& group, const std::string& names_attr,
+                  const std::string& prefix, const std::vector<std::string>& names) const;
 
   int input_size() const { return static_cast<int>(layers_.front().weight.cols()); }
   int output_size() const { return static_cast<int>(layers_.back().weight.rows()); }

@@ -19,21 +19,11 @@ NaivePredictor NaivePredictor::Load(const std::string& path) {
   p.input_std_ = f.ReadMatrixD("/normalisation/input_std", in, 1).col(0);
   FS_THROW_UNLESS((p.input_std_.array() > 0).all() && p.input_mean_.allFinite(), path,
                   ": /normalisation has non-positive or non-finite entries");
-  std::vector<std::string> names;
-  const std::string joined = f.GetStringAttr("/model", "dense_layers");
-  for (std::size_t start = 0;;) {
-    const auto comma = joined.find(',', start);
-    names.push_back(joined.substr(start, comma == std::string::npos ? comma : comma - start));
-    if (comma == std::string::npos) break;
-    start = comma + 1;
-  }
-  p.mlp_ = Mlp::Load(f, "/weights/", names);
+  p.mlp_ = Mlp::LoadListed(f, "/model", "dense_layers", "/weights/");
   FS_THROW_UNLESS(p.mlp_.input_size() == in, path, ": network takes ", p.mlp_.input_size(),
                   " inputs, expected 2 x observed = ", in);
   FS_THROW_UNLESS(p.mlp_.output_size() == 2 * p.predicted_, path, ": network gives ",
                   p.mlp_.output_size(), " outputs, expected 2 x predicted = ", 2 * p.predicted_);
-  for (const auto& l : p.mlp_.layers())
-    FS_THROW_UNLESS(l.weight.allFinite() && l.bias.allFinite(), path, ": non-finite weights");
   return p;
 }
 
@@ -50,10 +40,7 @@ void NaivePredictor::Save(const std::string& path, const NaivePredictorWeights& 
     f->SetAttr("/model", "rotate_to_heading", static_cast<std::int64_t>(w.rotate_to_heading));
     f->WriteMatrix("/normalisation/input_mean", w.input_mean);
     f->WriteMatrix("/normalisation/input_std", w.input_std);
-    std::string names;
-    for (const auto& name : w.layer_names) names += (names.empty() ? "" : ",") + name;
-    f->SetAttr("/model", "dense_layers", names);
-    w.mlp.Save(f, "/weights/", w.layer_names);
+    w.mlp.SaveListed(f, "/model", "dense_layers", "/weights/", w.layer_names);
   });
 }
 

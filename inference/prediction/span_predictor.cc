@@ -177,26 +177,12 @@ SpanPredictor SpanPredictor::Load(const std::string& path) {
   p.input_std_ = f.ReadMatrixD("/normalisation/input_std", in, 1).col(0);
   FS_THROW_UNLESS((p.input_std_.array() > 0).all() && p.input_mean_.allFinite(), path,
                   ": /normalisation has non-positive or non-finite entries");
-  std::vector<std::string> names;
-  {
-    const std::string joined = f.GetStringAttr("/model", "dense_layers");
-    std::size_t start = 0;
-    while (start <= joined.size()) {
-      const auto comma = joined.find(',', start);
-      names.push_back(
-          joined.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
-      if (comma == std::string::npos) break;
-      start = comma + 1;
-    }
-  }
-  p.mlp_ = Mlp::Load(f, "/weights/", names);
+  p.mlp_ = Mlp::LoadListed(f, "/model", "dense_layers", "/weights/");
   FS_THROW_UNLESS(p.mlp_.input_size() == in, path, ": network takes ", p.mlp_.input_size(),
                   " inputs, expected ",
                   p.ktm_references_.size() > 0 ? "K (KTM references) = " : "2 x observed = ", in);
   FS_THROW_UNLESS(p.mlp_.output_size() == p.layout_.Total(), path, ": network gives ",
                   p.mlp_.output_size(), " outputs, the head layout needs ", p.layout_.Total());
-  for (const auto& l : p.mlp_.layers())
-    FS_THROW_UNLESS(l.weight.allFinite() && l.bias.allFinite(), path, ": non-finite weights");
   return p;
 }
 
@@ -217,10 +203,7 @@ void SpanPredictor::Save(const std::string& path, const SpanPredictorWeights& w,
     f->WriteMatrix("/model/basis_centres", w.basis_centres);
     f->WriteMatrix("/normalisation/input_mean", w.input_mean);
     f->WriteMatrix("/normalisation/input_std", w.input_std);
-    std::string names;
-    for (const auto& name : w.layer_names) names += (names.empty() ? "" : ",") + name;
-    f->SetAttr("/model", "dense_layers", names);
-    w.mlp.Save(f, "/weights/", w.layer_names);
+    w.mlp.SaveListed(f, "/model", "dense_layers", "/weights/", w.layer_names);
     if (w.ktm_references.size() > 0) {
       f->WriteMatrix("/model/ktm_references", w.ktm_references);
       f->SetAttr("/model", "ktm_lengthscale", w.ktm_lengthscale);
