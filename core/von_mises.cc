@@ -247,7 +247,14 @@ double AverageLikelihood(const VonMisesMixtureBatch& mixtures,
 
 double MinimumRotationError(const VonMisesMixtureBatch& mixtures,
                             const Eigen::Ref<const Eigen::VectorXd>& theta) {
+  return MinimumRotationError(mixtures, theta, 0.0);
+}
+
+double MinimumRotationError(const VonMisesMixtureBatch& mixtures,
+                            const Eigen::Ref<const Eigen::VectorXd>& theta, double min_weight) {
   CheckBatch(mixtures, theta, "MinimumRotationError");
+  FS_THROW_UNLESS(min_weight >= 0 && min_weight <= 1, "MinimumRotationError: min_weight ",
+                  min_weight, " must be in [0, 1]");
   // Thesis ch 4 "Minimum Rotation Error" (thesis.tex near line 1285) prints
   //   MRE = 1/N' sum_n min_r |theta_n - mu_r|,
   // which is wrong on the circle (theta = pi - 0.01 and mu = -pi + 0.01 are 0.02 rad apart, not
@@ -256,8 +263,12 @@ double MinimumRotationError(const VonMisesMixtureBatch& mixtures,
   double sum = 0;
   for (Eigen::Index n = 0; n < theta.size(); ++n) {
     double best = std::numeric_limits<double>::infinity();
+    Eigen::Index heaviest = 0;  // the first of the largest alphas always counts
+    for (Eigen::Index r = 1; r < mixtures.alpha.cols(); ++r)
+      if (mixtures.alpha(n, r) > mixtures.alpha(n, heaviest)) heaviest = r;
     for (Eigen::Index r = 0; r < mixtures.mu.cols(); ++r) {
       if (mixtures.alpha(n, r) <= 0) continue;
+      if (mixtures.alpha(n, r) < min_weight && r != heaviest) continue;
       best = std::min(best, std::abs(WrapAngle(theta[n] - mixtures.mu(n, r))));
     }
     FS_THROW_UNLESS(std::isfinite(best), "MinimumRotationError: mixture ", n,
@@ -265,6 +276,15 @@ double MinimumRotationError(const VonMisesMixtureBatch& mixtures,
     sum += best;
   }
   return sum / static_cast<double>(theta.size());
+}
+
+void CapConcentration(VonMisesMixtureBatch* mixtures, double cap) {
+  FS_THROW_UNLESS(mixtures != nullptr, "CapConcentration: no mixtures");
+  FS_THROW_UNLESS(cap > 0, "CapConcentration: cap ", cap, " must be > 0");
+  Eigen::MatrixXd& kappa = mixtures->kappa;
+  for (Eigen::Index j = 0; j < kappa.cols(); ++j)
+    for (Eigen::Index i = 0; i < kappa.rows(); ++i)
+      if (kappa(i, j) > cap) kappa(i, j) = cap;
 }
 
 }  // namespace foresight

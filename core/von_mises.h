@@ -58,5 +58,17 @@ double AverageLikelihood(const VonMisesMixtureBatch& mixtures,
                          const Eigen::Ref<const Eigen::VectorXd>& theta);
 double MinimumRotationError(const VonMisesMixtureBatch& mixtures,
                             const Eigen::Ref<const Eigen::VectorXd>& theta);
+/// MRE over the components that carry weight: components with alpha_r < min_weight are ignored,
+/// except that the heaviest component of each row (the first on ties) always counts, so every
+/// row has one. Components with alpha_r <= 0 never count. min_weight = 0 is the overload above.
+/// min_weight must be in [0, 1] (else an Error naming it). Issue 11: a mixture that parks a tiny
+/// component on every heading should not score as well as one that predicts the heading.
+double MinimumRotationError(const VonMisesMixtureBatch& mixtures,
+                            const Eigen::Ref<const Eigen::VectorXd>& theta, double min_weight);
+
+/// kappa = min(kappa, cap) for every component, in place: reports AL and MRE at several caps (the
+/// cap sets the scale of AL: a spike of concentration kappa peaks at ~sqrt(kappa / (2 pi))).
+/// cap must be > 0 (else an Error naming it); NaN kappas stay NaN.
+void CapConcentration(VonMisesMixtureBatch* mixtures, double cap);
 
 }  // namespace foresight

@@ -22,11 +22,13 @@ namespace {
 /// Growable columns, turned into DirectionalSamples at the end.
 struct SampleColumns {
   std::vector<double> x, y, t, theta;
-  void Add(double xi, double yi, double ti, double thetai) {
+  std::vector<std::int64_t> path;
+  void Add(double xi, double yi, double ti, double thetai, std::int64_t path_id) {
     x.push_back(xi);
     y.push_back(yi);
     t.push_back(ti);
     theta.push_back(thetai);
+    path.push_back(path_id);
   }
   DirectionalSamples Finish() const {
     DirectionalSamples s;
@@ -35,6 +37,7 @@ struct SampleColumns {
     s.y = Eigen::Map<const Eigen::VectorXd>(y.data(), n);
     s.t = Eigen::Map<const Eigen::VectorXd>(t.data(), n);
     s.theta = Eigen::Map<const Eigen::VectorXd>(theta.data(), n);
+    s.path = path;
     return s;
   }
 };
@@ -124,6 +127,8 @@ DirectionalSamples DirectionalSamples::Select(const std::vector<Eigen::Index>& i
   s.y.resize(n);
   s.t.resize(n);
   s.theta.resize(n);
+  const bool has_path = !path.empty();
+  if (has_path) s.path.resize(index.size());
   for (Eigen::Index i = 0; i < n; ++i) {
     const Eigen::Index j = index[static_cast<std::size_t>(i)];
     FS_THROW_UNLESS(j >= 0 && j < size(), "DirectionalSamples::Select: row ", j, " is outside [0, ",
@@ -132,6 +137,11 @@ DirectionalSamples DirectionalSamples::Select(const std::vector<Eigen::Index>& i
     s.y[i] = y[j];
     s.t[i] = t[j];
     s.theta[i] = theta[j];
+    if (has_path) {
+      FS_THROW_UNLESS(static_cast<std::size_t>(j) < path.size(), "DirectionalSamples::Select: row ",
+                      j, " has no path id (path [", path.size(), "], x [", size(), "])");
+      s.path[static_cast<std::size_t>(i)] = path[static_cast<std::size_t>(j)];
+    }
   }
   return s;
 }
@@ -141,6 +151,8 @@ void DirectionalSamples::Validate(const std::string& where) const {
                   ": direction samples have x [", x.size(), "], y [", y.size(), "], t [", t.size(),
                   "], theta [", theta.size(), "] (sizes must match)");
   FS_THROW_UNLESS(size() > 0, where, ": no direction samples");
+  FS_THROW_UNLESS(path.empty() || static_cast<Eigen::Index>(path.size()) == size(), where,
+                  ": path ids [", path.size(), "] must be empty or one per sample [", size(), "]");
   for (Eigen::Index i = 0; i < size(); ++i) {
     FS_THROW_UNLESS(std::isfinite(x[i]) && std::isfinite(y[i]) && std::isfinite(t[i]) &&
                         std::isfinite(theta[i]),
@@ -165,7 +177,8 @@ DirectionalSamples ReadDirectionalGridCsv(const std::string& path,
   SampleColumns out;
   std::set<long long> finished_paths;
   long long path_id = -1, row_in_path = 0;
-  double px = 0, py = 0;  // previous row of the same path
+  std::int64_t segment = -1;  // output path id: one per drawn path, a new one after a jump
+  double px = 0, py = 0;      // previous row of the same path
   while (std::getline(in, text)) {
     ++line;
     if (Trim(text).empty()) continue;
@@ -194,6 +207,7 @@ DirectionalSamples ReadDirectionalGridCsv(const std::string& path,
       if (path_id >= 0) finished_paths.insert(path_id);
       path_id = pid;
       row_in_path = 0;
+      ++segment;
       ++stats.tracks;
       // The first row of a path has a placeholder (0) or a heading computed across the previous
       // path's last point: no heading.
@@ -206,6 +220,7 @@ DirectionalSamples ReadDirectionalGridCsv(const std::string& path,
         ++stats.dropped_standing;
       } else if (step > kDirectionalGridMaxStep) {
         ++stats.dropped_jump;
+        ++segment;  // the rows after the jump are another walk
       } else {
         // README convention: orientation_raw = pi/2 + atan2(y_prev - y, x_prev - x), so the heading
         // of motion is orientation_raw + pi/2 (mod 2 pi). Checked against the step direction.
@@ -218,7 +233,7 @@ DirectionalSamples ReadDirectionalGridCsv(const std::string& path,
                         std::atan2(dy, dx), " (", mismatch,
                         " rad apart): not the README convention");
         out.Add(v[0], v[1], static_cast<double>(row_in_path) * kDirectionalGridSecondsPerRow,
-                heading);
+                heading, segment);
         ++stats.kept;
       }
     }
@@ -299,6 +314,7 @@ DirectionalSamples ReadEdinburghTracks(const std::string& path, const HeadingFil
   DirectionalReadStats stats;
   SampleColumns out;
   const double s = kEdinburghMetresPerPixel;
+  std::int64_t segment = -1;  // output path id: one per kept track, a new one after each gap
   for (const Track& tr : tracks) {
     const auto n = static_cast<std::int64_t>(tr.points.size());
     stats.points += n;
@@ -308,6 +324,7 @@ DirectionalSamples ReadEdinburghTracks(const std::string& path, const HeadingFil
       continue;
     }
     ++stats.first_points;
+    ++segment;
     for (std::size_t i = 1; i < tr.points.size(); ++i) {
       const PixelPoint& a = tr.points[i - 1];
       const PixelPoint& b = tr.points[i];
@@ -317,6 +334,7 @@ DirectionalSamples ReadEdinburghTracks(const std::string& path, const HeadingFil
       const double dt = static_cast<double>(b.frame - a.frame) / kEdinburghFramesPerSecond;
       if (dt > filter.max_gap) {
         ++stats.dropped_gap;  // starts a new segment: the step across the gap is not a heading
+        ++segment;
         continue;
       }
       if (dt <= 0) {
@@ -331,7 +349,7 @@ DirectionalSamples ReadEdinburghTracks(const std::string& path, const HeadingFil
       } else {
         out.Add(b.x * s, (kEdinburghImageHeight - 1 - b.y) * s,
                 static_cast<double>(b.frame - frame0) / kEdinburghFramesPerSecond,
-                WrapAngle(std::atan2(dy, dx)));
+                WrapAngle(std::atan2(dy, dx)), segment);
         ++stats.kept;
       }
     }
@@ -377,7 +395,7 @@ DirectionalSamples GenerateCrossingFlow(const CrossingFlowConfig& c) {
       y += step * std::sin(heading);
       t += c.sample_period;
       if (x < 0 || x > c.size || y < 0 || y > c.size || t > c.duration) break;
-      out.Add(x, y, t, WrapAngle(heading));
+      out.Add(x, y, t, WrapAngle(heading), k);
     }
   }
   DirectionalSamples s = out.Finish();
@@ -399,6 +417,34 @@ std::vector<std::vector<Eigen::Index>> KFoldTestIndices(Eigen::Index n, int k, s
     folds[static_cast<std::size_t>(f)].assign(perm.begin() + begin, perm.begin() + end);
     std::sort(folds[static_cast<std::size_t>(f)].begin(), folds[static_cast<std::size_t>(f)].end());
   }
+  return folds;
+}
+
+std::vector<std::vector<Eigen::Index>> GroupedKFoldTestIndices(
+    const std::vector<std::int64_t>& groups, int k, std::uint64_t seed) {
+  // Rows of each distinct id, ids in increasing order (independent of the row order).
+  std::map<std::int64_t, std::vector<Eigen::Index>> rows_of;
+  for (std::size_t i = 0; i < groups.size(); ++i)
+    rows_of[groups[i]].push_back(static_cast<Eigen::Index>(i));
+  FS_THROW_UNLESS(k >= 2 && rows_of.size() >= static_cast<std::size_t>(k),
+                  "grouped k-fold split: need k >= 2 folds and at least k groups (k ", k,
+                  ", groups ", rows_of.size(), ", rows ", groups.size(), ")");
+  std::vector<const std::vector<Eigen::Index>*> order;
+  order.reserve(rows_of.size());
+  for (const auto& [id, rows] : rows_of) order.push_back(&rows);
+  // Shuffle (same draws as KFoldTestIndices), then largest first; equal sizes keep the shuffle.
+  std::mt19937_64 rng(seed);
+  for (std::size_t i = order.size() - 1; i > 0; --i) std::swap(order[i], order[rng() % (i + 1)]);
+  std::stable_sort(order.begin(), order.end(),
+                   [](const auto* a, const auto* b) { return a->size() > b->size(); });
+  std::vector<std::vector<Eigen::Index>> folds(static_cast<std::size_t>(k));
+  for (const std::vector<Eigen::Index>* rows : order) {
+    std::size_t smallest = 0;
+    for (std::size_t f = 1; f < folds.size(); ++f)
+      if (folds[f].size() < folds[smallest].size()) smallest = f;
+    folds[smallest].insert(folds[smallest].end(), rows->begin(), rows->end());
+  }
+  for (auto& fold : folds) std::sort(fold.begin(), fold.end());
   return folds;
 }
 

@@ -13,11 +13,15 @@ namespace foresight {
 
 struct DirectionalSamples {
   Eigen::VectorXd x, y, t, theta;  ///< [n] each
+  /// [n] or empty: id of the path (track) each sample came from, for path-grouped folds
+  /// (GroupedKFoldTestIndices). Ids are unique per path within one reader call; not necessarily
+  /// contiguous. Empty when unknown.
+  std::vector<std::int64_t> path;
   Eigen::Index size() const { return x.size(); }
-  /// Rows `index` (for splits).
+  /// Rows `index` (for splits); carries `path` when it is set.
   DirectionalSamples Select(const std::vector<Eigen::Index>& index) const;
-  /// Throws an Error naming `where` if empty, any value is non-finite or theta is outside [-pi,
-  /// pi).
+  /// Throws an Error naming `where` if empty, any value is non-finite, theta is outside [-pi,
+  /// pi) or `path` is neither empty nor of size n.
   void Validate(const std::string& where) const;
 };
 
@@ -60,6 +64,8 @@ inline constexpr double kEdinburghFramesPerSecond = 9.0;
 /// t = (row index within its path) * kDirectionalGridSecondsPerRow. The first row of a path has no
 /// heading (first_points); a repeated way-point is dropped_standing; a step longer than
 /// kDirectionalGridMaxStep is dropped_jump. Positions are kept as they are (m, right-handed).
+/// `path`: 0, 1, 2, ... in file order, one per drawn path (file path_id); a jump splits the drawn
+/// path, and the rows after it get the next id (the two pieces are different walks).
 DirectionalSamples ReadDirectionalGridCsv(const std::string& path,
                                           DirectionalReadStats* stats = nullptr);
 
@@ -74,6 +80,7 @@ DirectionalSamples ReadDirectionalGridCsv(const std::string& path,
 /// than min_track_points points -> dropped_short_track. Malformed lines, non-finite or
 /// non-integer values, frames going back and a TRACK that disagrees with its Properties line
 /// (n_points, first and last frame) are Errors naming file:line.
+/// `path`: 0, 1, 2, ... in file order, one per kept TRACK, and a new id where a gap restarts it.
 DirectionalSamples ReadEdinburghTracks(const std::string& path, const HeadingFilter& filter,
                                        DirectionalReadStats* stats = nullptr);
 
@@ -85,6 +92,7 @@ DirectionalSamples ReadEdinburghTracks(const std::string& path, const HeadingFil
 /// track's middle time is in the first half it goes +x with probability dominant_fraction, else
 /// -x; in the second half the other way round. Samples (position after each step, its time and
 /// heading) stop at the square's border. Same config, same samples (own draws on mt19937_64).
+/// `path` = the track index k (tracks that leave no sample leave a gap in the ids).
 struct CrossingFlowConfig {
   int num_tracks = 400;
   double duration = 100.0;          ///< s (time axis of the map)
@@ -99,6 +107,17 @@ DirectionalSamples GenerateCrossingFlow(const CrossingFlowConfig& config);
 
 /// K folds of a shuffled index (seeded): fold k's test rows (sorted); the rest train. Every row
 /// is in exactly one test fold; fold sizes differ by at most one. K >= 2 and n >= K, else an Error.
+/// The thesis's point-wise protocol: neighbouring way-points of one path land in different folds.
 std::vector<std::vector<Eigen::Index>> KFoldTestIndices(Eigen::Index n, int k, std::uint64_t seed);
+
+/// K folds that keep groups whole (path-grouped folds): `groups` [n] holds the group (path) id of
+/// each row; every row of a group is in the same test fold. The distinct ids are sorted, shuffled
+/// with `seed` (Fisher-Yates on mt19937_64), then stably sorted by size, largest first, and each
+/// group goes to the fold with the fewest rows so far (the lowest fold index on ties): fold sizes
+/// are as balanced as the groups allow (greedy longest-processing-time; max - min <= the largest
+/// group). Returns each fold's test rows, sorted. Same groups and seed, same folds. K >= 2 and at
+/// least K distinct groups, else an Error naming k and the number of groups.
+std::vector<std::vector<Eigen::Index>> GroupedKFoldTestIndices(
+    const std::vector<std::int64_t>& groups, int k, std::uint64_t seed);
 
 }  // namespace foresight

@@ -58,9 +58,13 @@ expect_error "not a run directory" eval "$TMP"
 
 FUS="$TMP/fusion"
 "$BIN" train configs/occupancy/synthetic_fusion.yaml --run-dir "$FUS" >/dev/null 2>"$TMP/fus.log" || { cat "$TMP/fus.log"; fail "fusion train"; }
-for k in auc_single auc_fuse_once auc_repeated; do
-  grep -q "\"$k\"" "$FUS/eval.json" || fail "fusion eval.json lacks $k"
+for k in auc_single auc_fuse_once auc_fuse_once_conflation information_bytes; do
+  grep -q "\"$k\"" "$FUS/eval.json" "$FUS/training_summary.json" || fail "fusion run lacks $k"
 done
+"$BIN" train configs/occupancy/synthetic_fusion.yaml fast_bhm.update=published --run-dir "$TMP/fus_pub" >/dev/null 2>&1 || fail "published fusion train"
+grep -q '"auc_repeated"' "$TMP/fus_pub/eval.json" || fail "published fusion eval.json lacks auc_repeated"
+expect_error "fast_bhm.bound_updates" train configs/occupancy/synthetic.yaml fast_bhm.bound_updates=-1 --run-dir "$TMP/occ_bad"
+expect_error "fast_bhm.prior_variance" train configs/occupancy/synthetic.yaml fast_bhm.prior_variance=-1 --run-dir "$TMP/occ_bad"
 check_json "$FUS/eval.json"
 "$BIN" map fuse "$FUS/single.h5" "$FUS/fuse_once.h5" -o "$TMP/fused.h5" | grep -q "fused 2 maps" || fail "map fuse"
 "$BIN" map fuse "$OCC/model.h5" "$FUS/single.h5" --base "$FUS/model.h5" -o "$TMP/fused_base.h5" >/dev/null || fail "map fuse --base"

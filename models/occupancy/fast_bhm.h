@@ -31,8 +31,17 @@ enum class BoundInit {
   kPrior,  ///< z from the prior of the scan (an M-step on the previous posterior)
 };
 enum class MStepForm { kExact, kPrinted };
+/// Which Fast-BHM update trains the map.
+enum class FastBhmUpdate {
+  kPublished,  ///< as published: decoupled mean update, scan by scan (FastBhmLearner)
+  kCoupled,    ///< the coupled weights and a learned bound (CoupledBhmLearner, coupled_bhm.h)
+};
 
 struct FastBhmConfig {
+  /// The published update stays the default of code-built configs (navigation and constrained
+  /// maps fitted to rasters); configs/occupancy/*.yaml choose the coupled one.
+  FastBhmUpdate update = FastBhmUpdate::kPublished;
+  int bound_updates = 5;  ///< kCoupled: M-steps of the bound after the first E-step
   double prior_mean = 0.0;
   double prior_variance = 1e4;
   int em_iterations = 1;  ///< E-steps per scan (an M-step between consecutive ones)
@@ -41,19 +50,26 @@ struct FastBhmConfig {
 
   template <class A>
   void Serialize(A* a) {
+    a->VisitEnum("update", &update,
+                 config::EnumNames<FastBhmUpdate>{{FastBhmUpdate::kPublished, "published"},
+                                                  {FastBhmUpdate::kCoupled, "coupled"}},
+                 "published: decoupled mean update scan by scan, z from em_iterations / "
+                 "bound_init (thesis); coupled: sparse coupled weights and a learned bound");
+    a->Visit("bound_updates", &bound_updates, config::Range::Closed(0, 100),
+             "update: coupled: bound (z) updates after the first E-step (0: z = 1)");
     a->Visit("prior_mean", &prior_mean, config::Range::Any(), "mean of the weight prior");
     a->Visit("prior_variance", &prior_variance, config::Range::Positive(),
              "variance of the weight prior");
     a->Visit("em_iterations", &em_iterations, config::Range::Closed(1, 100),
-             "EM iterations per scan");
+             "update: published: EM iterations per scan");
     a->VisitEnum(
         "bound_init", &bound_init,
         config::EnumNames<BoundInit>{{BoundInit::kPrior, "prior"}, {BoundInit::kOne, "one"}},
-        "starting variational parameter z of each scan");
+        "update: published: starting variational parameter z of each scan");
     a->VisitEnum("m_step", &m_step,
                  config::EnumNames<MStepForm>{{MStepForm::kExact, "exact"},
                                               {MStepForm::kPrinted, "printed"}},
-                 "M-step form (exact expectation, or as printed in the thesis)");
+                 "update: published: M-step form (exact expectation, or as printed in the thesis)");
   }
 };
 

@@ -261,5 +261,73 @@ TEST(VonMises, AverageLikelihoodAndMinimumRotationErrorByHand) {
                                {"mixture 2", "positive alpha"});
 }
 
+TEST(VonMises, MinimumRotationErrorWithMinWeightByHand) {
+  VonMisesMixtureBatch m;
+  m.Resize(4, 3);
+  m.kappa.setConstant(5.0);
+  // Row 0: a light component (0.05) sits on the heading; the heavy ones are 0.5 and 1.0 away.
+  m.alpha.row(0) << 0.05, 0.55, 0.40;
+  m.mu.row(0) << 1.0, 1.5, 2.0;
+  // Row 1: every component is light (0.2 < 0.25): only the heaviest (the second) counts.
+  m.alpha.row(1) << 0.20, 0.20, 0.20;  // ties: the first of the largest, column 0
+  m.mu.row(1) << -3.0, 0.3, 0.1;
+  // Row 2: a component exactly at the threshold counts (alpha < min_weight is dropped).
+  m.alpha.row(2) << 0.25, 0.75, 0.0;
+  m.mu.row(2) << 0.0, 2.0, 0.0;
+  // Row 3: heading across the wrap from the heavy component; alpha 0 never counts.
+  m.alpha.row(3) << 0.9, 0.1, 0.0;
+  m.mu.row(3) << -M_PI + 0.1, M_PI - 0.2, M_PI - 0.3;
+  Eigen::VectorXd theta(4);
+  theta << 1.0, 0.0, 0.1, M_PI - 0.3;
+
+  // min_weight 0: the plain MRE. Row 0: 0; row 1: min(3, 0.3, 0.1) = 0.1; row 2: 0.1 (mu 0);
+  // row 3: |wrap(pi - 0.3 - (-pi + 0.1))| = 0.4, |pi - 0.3 - (pi - 0.2)| = 0.1 -> 0.1.
+  const double plain = (0.0 + 0.1 + 0.1 + 0.1) / 4;
+  EXPECT_NEAR(MinimumRotationError(m, theta, 0.0), plain, 1e-12);
+  EXPECT_NEAR(MinimumRotationError(m, theta), plain, 1e-12);
+  // min_weight 0.25. Row 0: the 0.05 component drops -> min(0.5, 1.0) = 0.5; row 1: only column 0
+  // (the first heaviest) -> |0 - (-3)| = 3; row 2: 0.25 is not below 0.25 -> 0.1; row 3: the 0.1
+  // component drops -> 0.4.
+  EXPECT_NEAR(MinimumRotationError(m, theta, 0.25), (0.5 + 3.0 + 0.1 + 0.4) / 4, 1e-12);
+  // min_weight 1: only the heaviest component of each row: 0.5, 3, |0.1 - 2| = 1.9, 0.4.
+  EXPECT_NEAR(MinimumRotationError(m, theta, 1.0), (0.5 + 3.0 + 1.9 + 0.4) / 4, 1e-12);
+  testing::ExpectErrorContains([&] { MinimumRotationError(m, theta, -0.1); },
+                               {"min_weight -0.1", "[0, 1]"});
+  testing::ExpectErrorContains([&] { MinimumRotationError(m, theta, 1.5); }, {"min_weight 1.5"});
+  m.alpha.row(2).setZero();
+  testing::ExpectErrorContains([&] { MinimumRotationError(m, theta, 0.5); },
+                               {"mixture 2", "positive alpha"});
+}
+
+TEST(VonMises, CapConcentrationClampsKappaAndSetsTheAverageLikelihoodScale) {
+  VonMisesMixtureBatch m;
+  m.Resize(2, 2);
+  m.alpha << 0.5, 0.5, 1.0, 0.0;
+  m.mu << 0.0, 1.0, -0.5, 2.0;
+  m.kappa << 500.0, 3.0, 100.0, 1e9;
+  const VonMisesMixtureBatch before = m;
+  CapConcentration(&m, 100.0);
+  Eigen::MatrixXd expect(2, 2);
+  expect << 100.0, 3.0, 100.0, 100.0;
+  EXPECT_EQ(m.kappa, expect);
+  EXPECT_EQ(m.alpha, before.alpha);
+  EXPECT_EQ(m.mu, before.mu);
+  CapConcentration(&m, 10.0);
+  expect << 10.0, 3.0, 10.0, 10.0;
+  EXPECT_EQ(m.kappa, expect);
+  // AL at the cap against the closed form: each row's heading on its first component's mean.
+  Eigen::VectorXd theta(2);
+  theta << 0.0, -0.5;
+  auto vm = [](double t, double mu, double k) {
+    return std::exp(k * std::cos(t - mu)) / (2 * M_PI * std::cyl_bessel_i(0.0, k));
+  };
+  const double p0 = 0.5 * vm(0.0, 0.0, 10.0) + 0.5 * vm(0.0, 1.0, 3.0);
+  const double p1 = vm(-0.5, -0.5, 10.0);
+  EXPECT_NEAR(AverageLikelihood(m, theta), (p0 + p1) / 2, 1e-12);
+  testing::ExpectErrorContains([&] { CapConcentration(&m, 0.0); }, {"cap 0", "> 0"});
+  testing::ExpectErrorContains([&] { CapConcentration(&m, std::nan("")); }, {"cap nan"});
+  testing::ExpectErrorContains([&] { CapConcentration(nullptr, 1.0); }, {"CapConcentration"});
+}
+
 }  // namespace
 }  // namespace foresight

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <map>
+#include <random>
 #include <set>
 #include <sstream>
 
@@ -302,6 +304,175 @@ TEST(KFold, PartitionsEveryRowOnceAndIsSeeded) {
   EXPECT_NE(KFoldTestIndices(103, 10, 5), folds);
   testing::ExpectErrorContains([] { KFoldTestIndices(5, 1, 0); }, {"k 1", "rows 5"});
   testing::ExpectErrorContains([] { KFoldTestIndices(3, 4, 0); }, {"k 4", "rows 3"});
+}
+
+TEST(DirectionalGridCsv, PathIdsFollowDrawnPathsAndSplitAtJumps) {
+  testing::TempDir dir;
+  const std::string path = dir.File("paths.csv");
+  std::string text = "x_m,y_m,orientation_raw_rad,path_id\n";
+  text += CsvRow(0, 0, 0, 0);                   // path start
+  text += CsvRow(1, 0, Raw(0, 0, 1, 0), 0);     // id 0
+  text += CsvRow(1, 1, Raw(1, 0, 1, 1), 0);     // id 0
+  text += CsvRow(3, 3, 0, 1);                   // path start
+  text += CsvRow(3, 4, Raw(3, 3, 3, 4), 1);     // id 1
+  text += CsvRow(3, 14, Raw(3, 4, 3, 14), 1);   // jump: dropped, the rest is another walk
+  text += CsvRow(2, 14, Raw(3, 14, 2, 14), 1);  // id 2
+  text += CsvRow(2, 14, Raw(2, 14, 2, 14), 1);  // standing: dropped, same walk
+  text += CsvRow(2, 15, Raw(2, 14, 2, 15), 1);  // id 2
+  text += CsvRow(0, 0, 0, 7);                   // path start (ids need not be contiguous)
+  text += CsvRow(1, 0, Raw(0, 0, 1, 0), 7);     // id 3
+  testing::WriteText(path, text);
+  const DirectionalSamples s = ReadDirectionalGridCsv(path);
+  ASSERT_EQ(s.size(), 6);
+  EXPECT_EQ(s.path, (std::vector<std::int64_t>{0, 0, 1, 2, 2, 3}));
+  EXPECT_DOUBLE_EQ(s.y[3], 14);  // the first sample after the jump
+}
+
+TEST(EdinburghTracks, PathIdsFollowTracksAndRestartAfterGaps) {
+  testing::TempDir dir;
+  const std::string path = dir.File("tracks.paths.txt");
+  const std::string text =
+      EdinburghTrack(1, {{100, 200, 10},
+                         {105, 200, 11},     // id 0
+                         {110, 195, 12},     // id 0
+                         {115, 195, 13},     // id 0
+                         {120, 195, 40},     // 27 frames = 3 s: gap, the track restarts
+                         {125, 195, 41},     // id 1
+                         {130, 195, 42}}) +  // id 1
+      EdinburghTrack(2, {{10, 10, 5}, {12, 10, 6}, {14, 10, 7}}) +  // short: no id
+      EdinburghTrack(3,
+                     {{300, 300, 3}, {300, 290, 4}, {300, 280, 5}, {300, 270, 6}, {300, 260, 7}});
+  testing::WriteText(path, text);
+  DirectionalReadStats st;
+  const DirectionalSamples s = ReadEdinburghTracks(path, HeadingFilter{}, &st);
+  EXPECT_EQ(st.dropped_gap, 1);
+  ASSERT_EQ(s.size(), 9);
+  EXPECT_EQ(s.path, (std::vector<std::int64_t>{0, 0, 0, 1, 1, 2, 2, 2, 2}));
+  s.Validate("edinburgh");
+}
+
+TEST(CrossingFlow, PathIsTheTrackIndex) {
+  CrossingFlowConfig c;
+  c.num_tracks = 40;
+  c.seed = 3;
+  const DirectionalSamples s = GenerateCrossingFlow(c);
+  ASSERT_EQ(s.path.size(), static_cast<std::size_t>(s.size()));
+  EXPECT_TRUE(std::is_sorted(s.path.begin(), s.path.end()));
+  EXPECT_GE(s.path.front(), 0);
+  EXPECT_LT(s.path.back(), c.num_tracks);
+  // Consecutive samples of one track are one step (speed * period) and one period apart; a new
+  // track starts at an edge (x within one step of 0 or size).
+  const double step = c.speed * c.sample_period;
+  for (Eigen::Index i = 0; i < s.size(); ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    if (i > 0 && s.path[k] == s.path[k - 1]) {
+      EXPECT_NEAR(std::hypot(s.x[i] - s.x[i - 1], s.y[i] - s.y[i - 1]), step, 1e-9) << i;
+      EXPECT_NEAR(s.t[i] - s.t[i - 1], c.sample_period, 1e-9) << i;
+    } else {
+      EXPECT_TRUE(s.x[i] <= step + 1e-9 || s.x[i] >= c.size - step - 1e-9) << i;
+    }
+  }
+}
+
+TEST(DirectionalSamples, SelectCarriesPathsAndValidateChecksTheirSize) {
+  DirectionalSamples s;
+  s.x = Eigen::VectorXd::LinSpaced(4, 0, 3);
+  s.y = s.x;
+  s.t = s.x;
+  s.theta = Eigen::VectorXd::Zero(4);
+  s.Validate("no paths");  // empty: allowed
+  EXPECT_TRUE(s.Select({2, 0}).path.empty());
+  s.path = {10, 11, 12, 13};
+  s.Validate("paths");
+  EXPECT_EQ(s.Select({3, 1, 1}).path, (std::vector<std::int64_t>{13, 11, 11}));
+  s.path = {10, 11};
+  testing::ExpectErrorContains([&] { s.Validate("here"); },
+                               {"here", "path ids [2]", "empty or one per sample [4]"});
+}
+
+/// Checks that `folds` partition rows 0..n-1, are sorted and keep every group in one fold.
+void ExpectGroupedPartition(const std::vector<std::vector<Eigen::Index>>& folds,
+                            const std::vector<std::int64_t>& groups) {
+  std::vector<int> fold_of(groups.size(), -1);
+  for (std::size_t f = 0; f < folds.size(); ++f) {
+    EXPECT_TRUE(std::is_sorted(folds[f].begin(), folds[f].end())) << f;
+    for (Eigen::Index i : folds[f]) {
+      ASSERT_GE(i, 0);
+      ASSERT_LT(static_cast<std::size_t>(i), groups.size());
+      EXPECT_EQ(fold_of[static_cast<std::size_t>(i)], -1) << "row " << i << " in two folds";
+      fold_of[static_cast<std::size_t>(i)] = static_cast<int>(f);
+    }
+  }
+  std::map<std::int64_t, int> fold_of_group;
+  for (std::size_t i = 0; i < groups.size(); ++i) {
+    EXPECT_NE(fold_of[i], -1) << "row " << i << " in no fold";
+    const auto [it, fresh] = fold_of_group.emplace(groups[i], fold_of[i]);
+    if (!fresh) {
+      EXPECT_EQ(it->second, fold_of[i]) << "group " << groups[i] << " split";
+    }
+  }
+}
+
+TEST(GroupedKFold, KeepsGroupsWholeCoversEveryRowOnceAndBalances) {
+  // 60 groups of 1..12 rows, rows of a group interleaved with other groups.
+  std::mt19937_64 rng(7);
+  std::vector<std::int64_t> groups;
+  std::map<std::int64_t, std::size_t> size_of;
+  for (std::int64_t g = 0; g < 60; ++g) {
+    const std::size_t m = 1 + rng() % 12;
+    size_of[g * 3 + 100] = m;
+    for (std::size_t j = 0; j < m; ++j) groups.push_back(g * 3 + 100);
+  }
+  for (std::size_t i = groups.size() - 1; i > 0; --i) std::swap(groups[i], groups[rng() % (i + 1)]);
+  const auto folds = GroupedKFoldTestIndices(groups, 10, 4);
+  ASSERT_EQ(folds.size(), 10u);
+  ExpectGroupedPartition(folds, groups);
+  std::size_t lo = groups.size(), hi = 0, largest = 0;
+  for (const auto& f : folds) {
+    lo = std::min(lo, f.size());
+    hi = std::max(hi, f.size());
+  }
+  for (const auto& [g, m] : size_of) largest = std::max(largest, m);
+  EXPECT_LE(hi - lo, largest);  // greedy largest-first bound
+  EXPECT_EQ(GroupedKFoldTestIndices(groups, 10, 4), folds);
+  EXPECT_NE(GroupedKFoldTestIndices(groups, 10, 5), folds);
+  // Equal groups: k divides their number -> equal folds.
+  std::vector<std::int64_t> equal;
+  for (int g = 0; g < 12; ++g)
+    for (int j = 0; j < 5; ++j) equal.push_back(g);
+  for (const auto& f : GroupedKFoldTestIndices(equal, 4, 1)) EXPECT_EQ(f.size(), 15u);
+}
+
+TEST(GroupedKFold, LargestFirstToTheSmallestFoldByHand) {
+  // Sizes 5, 4, 3, 3, 2, 1 into 2 folds: 5 -> A; 4 -> B; 3 -> B (7); 3 -> A (8); 2 -> B (9);
+  // 1 -> A (9). The groups of each size are unique here except the two 3s, so the fold contents
+  // are fixed up to which 3-group goes where: {5, 3, 1} and {4, 3, 2}, sizes 9 and 9.
+  std::vector<std::int64_t> groups;
+  const int sizes[] = {5, 4, 3, 3, 2, 1};
+  for (int g = 0; g < 6; ++g)
+    for (int j = 0; j < sizes[g]; ++j) groups.push_back(g);
+  for (std::uint64_t seed = 0; seed < 5; ++seed) {
+    const auto folds = GroupedKFoldTestIndices(groups, 2, seed);
+    ExpectGroupedPartition(folds, groups);
+    ASSERT_EQ(folds.size(), 2u);
+    EXPECT_EQ(folds[0].size(), 9u);
+    EXPECT_EQ(folds[1].size(), 9u);
+    // Fold 0 holds the largest group (rows 0..4) and the single row (17); fold 1 the 4-group.
+    EXPECT_EQ(folds[0].front(), 0);
+    EXPECT_EQ(folds[0].back(), 17);
+    EXPECT_EQ(folds[1].front(), 5);
+  }
+  testing::ExpectErrorContains(
+      [] {
+        GroupedKFoldTestIndices({1, 1, 2, 2}, 3, 0);
+      },
+      {"k 3", "groups 2"});
+  testing::ExpectErrorContains(
+      [] {
+        GroupedKFoldTestIndices({1, 2, 3}, 1, 0);
+      },
+      {"k 1", "groups 3"});
+  testing::ExpectErrorContains([] { GroupedKFoldTestIndices({}, 2, 0); }, {"k 2", "groups 0"});
 }
 
 /// A real data file under $FORESIGHT_DATA or ../shared/data, or "" when absent.

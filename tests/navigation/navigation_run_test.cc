@@ -43,7 +43,7 @@ TEST(NavigationRun, EveryMethodRunsAnEpisodeAndTheSummaryHasItsKeys) {
   testing::TempDir dir;
   const NavigationExperimentConfig c = SmallConfig(dir);
   const std::vector<MethodSummary> s = RunNavigation(c, dir.path(), 1);
-  ASSERT_EQ(s.size(), 3u);
+  ASSERT_EQ(s.size(), 3u) << "a methods list without orca is unchanged";
   for (const MethodSummary& m : s) {
     EXPECT_EQ(m.episodes, 1);
     EXPECT_GE(m.cycle_ms_median, 0.0);
@@ -53,13 +53,103 @@ TEST(NavigationRun, EveryMethodRunsAnEpisodeAndTheSummaryHasItsKeys) {
   std::ifstream in(dir.File("summary.json"));
   std::stringstream text;
   text << in.rdbuf();
-  for (const char* key :
-       {"\"span\"", "\"reactive\"", "\"cl_rrt_star\"", "success_rate", "collision_free_rate",
-        "ttg_mean", "doc_mean", "min_clearance", "cycle_ms_median", "cycle_ms_p99"})
+  for (const char* key : {"\"span\"",
+                          "\"reactive\"",
+                          "\"cl_rrt_star\"",
+                          "success_rate",
+                          "collision_free_rate",
+                          "ttg_mean",
+                          "doc_mean",
+                          "min_clearance",
+                          "cycle_ms_median",
+                          "cycle_ms_p99",
+                          "successes",
+                          "success_and_collision_free_rate",
+                          "success_and_collision_free",
+                          "ttg_censored_mean",
+                          "robot_caused_doc_mean",
+                          "robot_caused_collision_free_rate",
+                          "success_rate_ci",
+                          "collision_free_rate_ci",
+                          "success_and_collision_free_rate_ci",
+                          "robot_caused_collision_free_rate_ci"})
     EXPECT_NE(text.str().find(key), std::string::npos) << key;
   for (const char* f : {"episodes.csv", "paths.png", "episode.avi", "map.h5"})
     EXPECT_TRUE(std::filesystem::exists(dir.File(f))) << f;
   EXPECT_GT(std::filesystem::file_size(dir.File("episode.avi")), 1000u);
+  // episodes.csv: the robot-caused DOC is the last column (readers by position keep working).
+  std::ifstream csv(dir.File("episodes.csv"));
+  std::string header;
+  std::getline(csv, header);
+  EXPECT_EQ(header.substr(header.rfind(',') + 1), "robot_caused_doc");
+  EXPECT_EQ(header.rfind("method,episode,seed,reached,ttg,doc,doc_static,min_clearance,", 0), 0u);
+}
+
+TEST(NavigationRun, OrcaIsTheFourthMethod) {
+  testing::TempDir dir;
+  NavigationExperimentConfig c = SmallConfig(dir);
+  c.methods = {"orca", "reactive"};
+  c.video.method = "orca";
+  c.video.enabled = false;
+  c.map.kind = NavigationMapKind::kGrid;  // the map is not what this test is about
+  EXPECT_EQ(ParseNavigationMethod("orca", "test"), NavigationMethod::kOrca);
+  EXPECT_STREQ(MethodName(NavigationMethod::kOrca), "orca");
+  const std::vector<MethodSummary> s = RunNavigation(c, dir.path(), 1);
+  ASSERT_EQ(s.size(), 2u);
+  EXPECT_EQ(s[0].method, "orca");
+  EXPECT_EQ(s[0].success_rate, 1.0) << "ORCA crosses a nearly empty square";
+  EXPECT_EQ(s[0].robot_caused_doc_mean, 0.0);
+  EXPECT_LE(s[0].robot_caused_doc_mean, s[0].doc_mean);
+  // Its options are checked like the others', naming the key.
+  c.orca.heading_gain = -1;
+  testing::ExpectErrorContains([&] { c.Validate("cfg.yaml"); },
+                               {"cfg.yaml", "orca", "heading_gain"});
+}
+
+TEST(NavigationRun, RobotCausedContactFollowsItsDefinition) {
+  const Eigen::Vector2d robot(0, 0), ped(0.7, 0);  // overlapping: radius sum 0.8
+  const double r = 0.8;
+  // Driving into the pedestrian: the robot's fault.
+  EXPECT_TRUE(RobotCausedContact(robot, {0.5, 0}, ped, r, false));
+  // Driving at 60 degrees off the normal: closing at 0.5 cos 60 = 0.25 m/s > 0.05: still.
+  EXPECT_TRUE(RobotCausedContact(robot, {0.25, 0.433}, ped, r, false));
+  // Moving almost tangentially (closing at 0.04 m/s) or away: not.
+  EXPECT_FALSE(RobotCausedContact(robot, {0.04, 0.8}, ped, r, false));
+  EXPECT_FALSE(RobotCausedContact(robot, {-0.5, 0}, ped, r, false));
+  // Standing still (|v| < 0.05) while run into: not, even with a tiny velocity toward it.
+  EXPECT_FALSE(RobotCausedContact(robot, {0.049, 0}, ped, r, false));
+  // A pedestrian that just appeared inside the robot's disc: never.
+  EXPECT_FALSE(RobotCausedContact(robot, {0.5, 0}, ped, r, true));
+  // No overlap: no contact at all.
+  EXPECT_FALSE(RobotCausedContact(robot, {0.5, 0}, {0.81, 0}, r, false));
+  // Only the robot's own velocity counts (the pedestrian's is not an argument): the rule holds in
+  // any frame orientation.
+  const double a = 2.1;
+  const Eigen::Vector2d turned(0.7 * std::cos(a), 0.7 * std::sin(a));
+  EXPECT_TRUE(RobotCausedContact(robot, 0.5 * turned.normalized(), turned, r, false));
+  EXPECT_FALSE(RobotCausedContact(robot, -0.5 * turned.normalized(), turned, r, false));
+}
+
+TEST(NavigationRun, WilsonIntervalMatchesHandComputedValues) {
+  // (p + z^2/2n -+ z sqrt(p(1-p)/n + z^2/4n^2)) / (1 + z^2/n) with z = 1.96, n = 20.
+  RateInterval i = WilsonInterval(0, 20);
+  EXPECT_EQ(i.lo, 0.0);
+  EXPECT_NEAR(i.hi, 0.161, 5e-4);
+  i = WilsonInterval(20, 20);
+  EXPECT_NEAR(i.lo, 0.839, 5e-4);
+  EXPECT_EQ(i.hi, 1.0);
+  i = WilsonInterval(10, 20);
+  EXPECT_NEAR(i.lo, 0.299, 5e-4);
+  EXPECT_NEAR(i.hi, 0.701, 5e-4);
+  // k = 3, n = 40 by hand: centre (0.075 + 0.048020) / 1.096040 = 0.112241, half-width
+  // 1.96 sqrt(0.0017344 + 0.00060025) / 1.096040 = 0.086405.
+  i = WilsonInterval(3, 40);
+  EXPECT_NEAR(i.lo, 0.025836, 1e-5);
+  EXPECT_NEAR(i.hi, 0.198646, 1e-5);
+  // No episodes: no information.
+  i = WilsonInterval(0, 0);
+  EXPECT_EQ(i.lo, 0.0);
+  EXPECT_EQ(i.hi, 1.0);
 }
 
 TEST(NavigationRun, EpisodesAreDeterministicForReplayFreeMethods) {
@@ -121,18 +211,20 @@ TEST(NavigationRun, BadScenesAndArtifactsAreClearErrors) {
 }
 
 TEST(NavigationRun, SummaryMetricsFollowTheirDefinitions) {
-  auto episode = [](bool reached, double ttg, double doc, double clear, std::vector<double> ms) {
+  auto episode = [](bool reached, double ttg, double doc, double clear, std::vector<double> ms,
+                    double robot_doc = 0) {
     EpisodeResult r;
     r.method = "span";
     r.reached = reached;
     r.ttg = ttg;
     r.doc = doc;
+    r.robot_caused_doc = robot_doc;
     r.min_clearance = clear;
     r.cycle_ms = std::move(ms);
     return r;
   };
   std::vector<EpisodeResult> results = {episode(true, 20, 0.0, 0.2, {1, 2, 3}),
-                                        episode(false, 90, 0.5, -0.1, {4, 5}),
+                                        episode(false, 90, 0.5, -0.1, {4, 5}, 0.3),
                                         episode(true, 30, 0.2, 0.05, {6})};
   results.push_back(results[0]);
   results.back().method = "reactive";  // other methods are not mixed in
@@ -147,6 +239,18 @@ TEST(NavigationRun, SummaryMetricsFollowTheirDefinitions) {
   EXPECT_DOUBLE_EQ(m.cycle_ms_median, 3.5);  // of {1, ..., 6}
   EXPECT_NEAR(m.cycle_ms_p99, 5.95, 1e-12);  // linear interpolation at 0.99 * 5
   EXPECT_DOUBLE_EQ(m.cycle_ms_max, 6.0);
+  // Success counts only with DOC = 0; TTG censored: the failure counts as its max_time (90 s).
+  EXPECT_EQ(m.successes, 2);
+  EXPECT_EQ(m.collision_free, 1);
+  EXPECT_EQ(m.success_and_collision_free, 1);
+  EXPECT_DOUBLE_EQ(m.success_and_collision_free_rate, 1.0 / 3);
+  EXPECT_DOUBLE_EQ(m.ttg_censored_mean, (20.0 + 90.0 + 30.0) / 3);
+  EXPECT_DOUBLE_EQ(m.robot_caused_doc_mean, 0.1);
+  EXPECT_EQ(m.robot_caused_collision_free, 2);  // the 0.2 s of DOC in episode 3 were not caused
+  EXPECT_DOUBLE_EQ(m.robot_caused_collision_free_rate, 2.0 / 3);
+  EXPECT_EQ(m.success_rate_ci.lo, WilsonInterval(2, 3).lo);
+  EXPECT_EQ(m.success_and_collision_free_rate_ci.hi, WilsonInterval(1, 3).hi);
+  EXPECT_EQ(m.robot_caused_collision_free_rate_ci.hi, WilsonInterval(2, 3).hi);
   // None reached: TTG is null in the JSON, never NaN.
   NavigationExperimentConfig c;
   c.scenario.name = "a\"b";
@@ -156,6 +260,8 @@ TEST(NavigationRun, SummaryMetricsFollowTheirDefinitions) {
   EXPECT_EQ(json.find("nan"), std::string::npos);
   EXPECT_EQ(json.find("inf"), std::string::npos);
   EXPECT_NE(json.find("\"a\\\"b\""), std::string::npos) << json;
+  EXPECT_NE(json.find("\"success_rate_ci\": [0, 0.793"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"ttg_censored_mean\": 90"), std::string::npos) << json;
 }
 
 }  // namespace

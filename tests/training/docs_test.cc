@@ -33,7 +33,8 @@ TEST(Docs, ShippedNavigationConfigsLoad) {
     const NavigationExperimentConfig c = config::LoadExperimentConfig<NavigationExperimentConfig>(
         src + "/configs/navigation/" + name + ".yaml");
     EXPECT_EQ(c.scenario.name, name);
-    EXPECT_EQ(c.methods.size(), 3u);
+    EXPECT_EQ(c.methods.size(), 4u);
+    EXPECT_TRUE(c.Uses(NavigationMethod::kOrca)) << name;
     EXPECT_GE(c.episodes, 20);
   }
   for (const char* name : {"predictor", "predictor_thor"})

@@ -15,6 +15,9 @@
 namespace foresight {
 
 enum class DirectionalSource { kCrossing, kGridCsv, kEdinburgh };
+/// How K-fold cross-validation splits the samples: whole paths (every way-point of a path in one
+/// fold; neighbours on a path are near-copies of each other) or single points (the thesis).
+enum class DirectionalFoldsBy { kPath, kPoint };
 
 struct DirectionalCrossingSection {
   CrossingFlowConfig flow;
@@ -116,8 +119,12 @@ struct DirectionalNetworkConfig {
 };
 
 struct DirectionalEvalConfig {
-  int folds = 10;              ///< K of K-fold cross-validation
-  int max_folds = 0;           ///< evaluate only the first k folds (0: all K)
+  int folds = 10;  ///< K of K-fold cross-validation
+  DirectionalFoldsBy folds_by = DirectionalFoldsBy::kPath;
+  int knn_k = 10;                ///< k of the k-nearest-neighbour baseline (1-NN always runs)
+  double mre_min_weight = 0.05;  ///< mre_w: components lighter than this are ignored
+  std::vector<double> metric_caps{10, 30, 100};  ///< AL also reported with kappa capped at each
+  int max_folds = 0;                             ///< evaluate only the first k folds (0: all K)
   double val_fraction = 0.1;   ///< of each training split, held out for early stopping / best epoch
   bool spatiotemporal = true;  ///< train the spatiotemporal model (model.h5)
   bool spatial = true;         ///< also train the spatial-only model
@@ -133,6 +140,16 @@ struct DirectionalEvalConfig {
   void Serialize(A* a) {
     using config::Range;
     a->Visit("folds", &folds, Range::Closed(2, 100), "K of K-fold cross-validation (thesis: 10)");
+    a->VisitEnum("folds_by", &folds_by,
+                 config::EnumNames<DirectionalFoldsBy>{{DirectionalFoldsBy::kPath, "path"},
+                                                       {DirectionalFoldsBy::kPoint, "point"}},
+                 "fold unit: whole paths (default) or single points (the thesis's protocol)");
+    a->Visit("knn_k", &knn_k, Range::Closed(1, 100),
+             "k of the k-nearest-neighbour baseline (knn; nn1 always runs); both use max_kappa");
+    a->Visit("mre_min_weight", &mre_min_weight, Range::Closed(0, 1),
+             "mre_w ignores components lighter than this (the heaviest always counts)");
+    a->Visit("metric_caps", &metric_caps, Range::Positive(),
+             "AL is also reported with every concentration capped at each of these (al_cap<c>)");
     a->Visit("max_folds", &max_folds, Range::AtLeast(0),
              "evaluate only the first k folds (0: all)");
     a->Visit("val_fraction", &val_fraction, Range::Open(0, 1),

@@ -16,6 +16,7 @@
 #include "datasets/data_root.h"
 #include "inference/engine/artifact.h"
 #include "models/directional/directional_grid_map.h"
+#include "models/directional/knn_directional.h"
 #include "training/directional/plots.h"
 #include "training/run_dir.h"
 #include "training/tensor_eigen.h"
@@ -202,8 +203,25 @@ DirectionalGridConfig GridConfig(const DirectionalExperimentConfig& c,
   return g;
 }
 
-std::pair<double, double> Score(const VonMisesMixtureBatch& b, const Eigen::VectorXd& theta) {
-  return {AverageLikelihood(b, theta), MinimumRotationError(b, theta)};
+DirectionalScore Score(const DirectionalEvalConfig& e, const VonMisesMixtureBatch& b,
+                       const Eigen::VectorXd& theta) {
+  DirectionalScore s;
+  s.al = AverageLikelihood(b, theta);
+  s.mre = MinimumRotationError(b, theta);
+  s.mre_w = MinimumRotationError(b, theta, e.mre_min_weight);
+  for (const double cap : e.metric_caps) {
+    VonMisesMixtureBatch capped = b;
+    CapConcentration(&capped, cap);
+    s.al_caps.push_back(AverageLikelihood(capped, theta));
+  }
+  return s;
+}
+
+/// "10" for 10, "2.5" for 2.5: the suffix of al_cap<c>.
+std::string CapName(double cap) {
+  std::ostringstream os;
+  os << cap;
+  return os.str();
 }
 
 }  // namespace
@@ -328,11 +346,11 @@ TrainingSummary TrainDirectionalNet(const DirectionalExperimentConfig& c,
   return s;
 }
 
-std::vector<std::pair<std::string, std::pair<double, double>>> EvaluateDirectionalSplit(
+std::vector<std::pair<std::string, DirectionalScore>> EvaluateDirectionalSplit(
     const DirectionalExperimentConfig& c, const DirectionalFeatureConfig& f,
     const DirectionalSamples& train_all, const DirectionalSamples& test,
     const std::string& work_dir, const TrainHooks& hooks, bool* interrupted) {
-  std::vector<std::pair<std::string, std::pair<double, double>>> out;
+  std::vector<std::pair<std::string, DirectionalScore>> out;
   if (interrupted) *interrupted = false;
   VonMisesMixtureBatch batch;
   const auto [train, val] =
@@ -348,7 +366,7 @@ std::vector<std::pair<std::string, std::pair<double, double>>> EvaluateDirection
     const DirectionalMap map = DirectionalMap::Load(dir + "/model.h5");
     auto ws = map.MakeWorkspace();
     map.Query(test.x, test.y, test.t, &ws, &batch);
-    out.push_back({VariantName(v), Score(batch, test.theta)});
+    out.push_back({VariantName(v), Score(c.eval, batch, test.theta)});
   }
   std::vector<std::pair<std::string, DirectionalGridConfig>> grids{
       {"grid_um", GridConfig(c, f, GridDirectionalKind::kUnimodal, false)},
@@ -360,7 +378,24 @@ std::vector<std::pair<std::string, std::pair<double, double>>> EvaluateDirection
   for (const auto& [name, g] : grids) {
     const DirectionalGridMap grid = DirectionalGridMap::Fit(train_all, g);
     grid.Query(test.x, test.y, &batch);
-    out.push_back({name, Score(batch, test.theta)});
+    out.push_back({name, Score(c.eval, batch, test.theta)});
+  }
+  // Nearest training headings at the same cap: the trivial baseline every table carries. With
+  // more than one time point, time is a coordinate scaled so that one temporal length scale
+  // weighs as one spatial length scale.
+  const bool timed = f.time_points > 1;
+  for (const int k : {1, c.eval.knn_k}) {
+    if (k == c.eval.knn_k && k == 1) continue;  // knn with k = 1 is nn1
+    FS_THROW_UNLESS(k <= train_all.size(), "eval.knn_k = ", k, " exceeds the ", train_all.size(),
+                    " training samples of a fold");
+    KnnDirectionalConfig kc;
+    kc.k = k;
+    kc.kappa = c.network.max_kappa;
+    kc.use_time = timed;
+    kc.time_scale = timed ? f.length_scale / f.time_length_scale : 1.0;
+    const KnnDirectionalMap knn = KnnDirectionalMap::Fit(train_all, kc);
+    knn.Query(test.x, test.y, test.t, &batch);
+    out.push_back({k == 1 ? "nn1" : "knn", Score(c.eval, batch, test.theta)});
   }
   return out;
 }
@@ -386,12 +421,17 @@ std::string DirectionalEvalReport::ToJson() const {
     for (std::size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + Num(v[i]);
     return s + "]";
   };
-  for (const auto& m : methods)
+  for (const auto& m : methods) {
     os << "  \"" << m.method << "\": {\"al\": " << Num(m.MeanAl())
        << ", \"mre\": " << Num(m.MeanMre()) << ", \"al_std\": " << Num(m.StdAl())
        << ", \"mre_std\": " << Num(m.StdMre()) << ", \"al_folds\": " << list(m.al)
-       << ", \"mre_folds\": " << list(m.mre) << "},\n";
-  os << "  \"samples\": " << samples << ",\n  \"folds\": " << folds
+       << ", \"mre_folds\": " << list(m.mre) << ", \"mre_w\": " << Num(Mean(m.mre_w));
+    for (std::size_t i = 0; i < m.al_caps.size() && i < metric_caps.size(); ++i)
+      os << ", \"al_cap" << CapName(metric_caps[i]) << "\": " << Num(Mean(m.al_caps[i]));
+    os << "},\n";
+  }
+  os << "  \"samples\": " << samples << ",\n  \"folds\": " << folds << ",\n  \"folds_by\": \""
+     << folds_by << "\""
      << ",\n  \"folds_evaluated\": " << folds_evaluated
      << ",\n  \"resolution\": {\"cells_x\": " << features.cells_x
      << ", \"cells_y\": " << features.cells_y
@@ -407,10 +447,17 @@ std::string DirectionalEvalReport::ToJson() const {
 
 std::string DirectionalEvalReport::ToCsv() const {
   std::ostringstream os;
-  os << "method,fold,al,mre\n";
+  os << "method,fold,al,mre,mre_w";
+  for (const double cap : metric_caps) os << ",al_cap" << CapName(cap);
+  os << "\n";
   for (const auto& m : methods)
-    for (std::size_t k = 0; k < m.al.size(); ++k)
-      os << m.method << "," << k << "," << Num(m.al[k]) << "," << Num(m.mre[k]) << "\n";
+    for (std::size_t k = 0; k < m.al.size(); ++k) {
+      os << m.method << "," << k << "," << Num(m.al[k]) << "," << Num(m.mre[k]) << ","
+         << Num(k < m.mre_w.size() ? m.mre_w[k] : NAN);
+      for (std::size_t i = 0; i < metric_caps.size(); ++i)
+        os << "," << Num(i < m.al_caps.size() && k < m.al_caps[i].size() ? m.al_caps[i][k] : NAN);
+      os << "\n";
+    }
   return os.str();
 }
 
@@ -495,6 +542,35 @@ DirectionalEvalReport EvaluateDirectionalRun(const DirectionalExperimentConfig& 
 }
 
 namespace {
+/// Guards a fold directory against being evaluated on rows other than those it was trained for:
+/// the first use writes WORK/test_rows.hash (count and FNV-1a of the test rows); later uses must
+/// match. A fold trained before the hash existed (point folds, the old default) is accepted only
+/// with eval.folds_by: point.
+void CheckFoldRows(const std::string& work, const std::vector<Eigen::Index>& rows, bool by_path) {
+  std::uint64_t h = 1469598103934665603ULL;
+  for (const Eigen::Index r : rows) {
+    h ^= static_cast<std::uint64_t>(r);
+    h *= 1099511628211ULL;
+  }
+  std::ostringstream want;
+  want << rows.size() << " " << h;
+  const std::string path = work + "/test_rows.hash";
+  if (fs::exists(path)) {
+    std::ifstream in(path);
+    std::string have;
+    std::getline(in, have);
+    FS_THROW_UNLESS(have == want.str(), path, ": this fold was trained with other test rows (",
+                    have, " vs ", want.str(),
+                    "); eval.folds, eval.folds_by, the data or the seed differ from the run's");
+    return;
+  }
+  FS_THROW_UNLESS(!by_path || !fs::exists(work), work,
+                  " holds a fold trained before path folds existed (point folds): evaluate it "
+                  "with eval.folds_by=point");
+  fs::create_directories(work);
+  std::ofstream(path) << want.str() << "\n";
+}
+
 DirectionalRunResult RunFolds(const DirectionalExperimentConfig& c, const std::string& run_dir,
                               const TrainHooks& hooks) {
   const DirectionalSamples data = LoadDirectionalSamples(c);
@@ -503,14 +579,27 @@ DirectionalRunResult RunFolds(const DirectionalExperimentConfig& c, const std::s
   log::Info(data.size(), " samples; ", f.cells_x, " x ", f.cells_y,
             " spatial inducing points over x [", f.x_min, ", ", f.x_max, "], y [", f.y_min, ", ",
             f.y_max, "], ", f.time_points, " temporal over [", f.t_min, ", ", f.t_max, "] s");
-  const auto folds =
-      KFoldTestIndices(data.size(), c.eval.folds, static_cast<std::uint64_t>(c.seed));
+  const bool by_path = c.eval.folds_by == DirectionalFoldsBy::kPath;
+  FS_THROW_UNLESS(!by_path || static_cast<Eigen::Index>(data.path.size()) == data.size(),
+                  "eval.folds_by: path, but the samples carry no path ids (use point)");
+  std::vector<std::vector<Eigen::Index>> folds;
+  try {
+    folds =
+        by_path
+            ? GroupedKFoldTestIndices(data.path, c.eval.folds, static_cast<std::uint64_t>(c.seed))
+            : KFoldTestIndices(data.size(), c.eval.folds, static_cast<std::uint64_t>(c.seed));
+  } catch (const Error& e) {
+    Fail("eval.folds = ", c.eval.folds, " with eval.folds_by = ", by_path ? "path" : "point", ": ",
+         e.what());
+  }
   const int evaluate = EvaluatedFolds(c);
 
   DirectionalRunResult result;
   DirectionalEvalReport& report = result.report;
   report.samples = data.size();
   report.folds = c.eval.folds;
+  report.folds_by = by_path ? "path" : "point";
+  report.metric_caps = c.eval.metric_caps;
   report.features = f;
   for (int k = 0; k < evaluate; ++k) {
     const auto& test_idx = folds[static_cast<std::size_t>(k)];
@@ -522,6 +611,7 @@ DirectionalRunResult RunFolds(const DirectionalExperimentConfig& c, const std::s
     log::Info("fold ", k + 1, "/", evaluate, ": ", train.size(), " training, ", test.size(),
               " test samples");
     const std::string work = run_dir + "/folds/" + std::to_string(k);
+    CheckFoldRows(work, test_idx, by_path);
     bool interrupted = false;
     const auto scores = EvaluateDirectionalSplit(c, f, train, test, work, hooks, &interrupted);
     if (interrupted) {
@@ -533,12 +623,17 @@ DirectionalRunResult RunFolds(const DirectionalExperimentConfig& c, const std::s
       for (auto& existing : report.methods)
         if (existing.method == name) m = &existing;
       if (!m) {
-        report.methods.push_back({name, {}, {}});
+        report.methods.push_back({name, {}, {}, {}, {}});
         m = &report.methods.back();
+        m->al_caps.resize(score.al_caps.size());
       }
-      m->al.push_back(score.first);
-      m->mre.push_back(score.second);
-      log::Info("  fold ", k + 1, " ", name, ": AL ", score.first, " MRE ", score.second);
+      m->al.push_back(score.al);
+      m->mre.push_back(score.mre);
+      m->mre_w.push_back(score.mre_w);
+      for (std::size_t i = 0; i < score.al_caps.size(); ++i)
+        m->al_caps[i].push_back(score.al_caps[i]);
+      log::Info("  fold ", k + 1, " ", name, ": AL ", score.al, " MRE ", score.mre, " MRE_w ",
+                score.mre_w);
     }
     ++report.folds_evaluated;
   }

@@ -49,9 +49,20 @@ struct LoadedDirectionalNet {
 };
 LoadedDirectionalNet LoadDirectionalNetFromArtifact(const std::string& path);
 
+/// One method's scores on one test split: AL and MRE as the thesis defines them (every
+/// concentration as the method predicts it, capped at network.max_kappa), AL again with the
+/// concentrations capped at each eval.metric_caps value, and mre_w, the MRE over the components
+/// weighing at least eval.mre_min_weight (so a spike of negligible weight cannot score).
+struct DirectionalScore {
+  double al = 0, mre = 0, mre_w = 0;
+  std::vector<double> al_caps;  ///< [metric_caps]
+};
+
 struct DirectionalMethodMetrics {
   std::string method;
-  std::vector<double> al, mre;  ///< per fold
+  std::vector<double> al, mre;               ///< per fold
+  std::vector<double> mre_w;                 ///< per fold
+  std::vector<std::vector<double>> al_caps;  ///< [cap][fold]
   double MeanAl() const;
   double MeanMre() const;
   double StdAl() const;
@@ -61,11 +72,14 @@ struct DirectionalMethodMetrics {
 struct DirectionalEvalReport {
   Eigen::Index samples = 0;
   int folds = 0, folds_evaluated = 0;
+  std::string folds_by;               ///< "path" or "point"
+  std::vector<double> metric_caps;    ///< of al_caps
   DirectionalFeatureConfig features;  ///< resolved
   std::vector<DirectionalMethodMetrics> methods;
   const DirectionalMethodMetrics* Find(const std::string& method) const;
   /// `{ "spatiotemporal": {"al": .., "mre": .., "al_std": .., "mre_std": .., "al_folds": [..],
-  /// "mre_folds": [..]}, ..., "samples": n, "folds": K, "folds_evaluated": k, "resolution": {..} }`
+  /// "mre_folds": [..], "mre_w": .., "al_cap10": .., ...}, ..., "samples": n, "folds": K,
+  /// "folds_by": "path", "folds_evaluated": k, "resolution": {..} }`
   std::string ToJson() const;
   std::string ToCsv() const;
   std::string BriefReport() const;
@@ -96,10 +110,11 @@ DirectionalEvalReport EvaluateDirectionalRun(const DirectionalExperimentConfig& 
 /// A fold without a checkpoint is an Error naming it. @return the run's artifact path.
 std::string ExportDirectionalRun(const std::string& run_dir);
 
-/// Evaluates the methods on one split (used by the experiment binary with its own folds):
-/// returns {method, AL, MRE} for spatiotemporal, spatial (optional), grid_um, grid_mm (+ dense).
-/// Networks are trained into `work_dir`/<variant>.
-std::vector<std::pair<std::string, std::pair<double, double>>> EvaluateDirectionalSplit(
+/// Evaluates the methods on one split: returns the scores of spatiotemporal, spatial (optional),
+/// grid_um, grid_mm (+ dense), nn1 and knn (nearest training headings at max_kappa; with time as
+/// a coordinate when the features have more than one time point). Networks are trained into
+/// `work_dir`/<variant>.
+std::vector<std::pair<std::string, DirectionalScore>> EvaluateDirectionalSplit(
     const DirectionalExperimentConfig& config, const DirectionalFeatureConfig& features,
     const DirectionalSamples& train, const DirectionalSamples& test, const std::string& work_dir,
     const TrainHooks& hooks = {}, bool* interrupted = nullptr);

@@ -8,7 +8,7 @@ namespace foresight {
 
 namespace {
 constexpr NavigationMethod kAllMethods[] = {NavigationMethod::kSpan, NavigationMethod::kReactive,
-                                            NavigationMethod::kClRrtStar};
+                                            NavigationMethod::kClRrtStar, NavigationMethod::kOrca};
 }  // namespace
 
 const char* MethodName(NavigationMethod method) {
@@ -19,6 +19,8 @@ const char* MethodName(NavigationMethod method) {
       return "reactive";
     case NavigationMethod::kClRrtStar:
       return "cl_rrt_star";
+    case NavigationMethod::kOrca:
+      return "orca";
   }
   return "";
 }
@@ -26,13 +28,27 @@ const char* MethodName(NavigationMethod method) {
 NavigationMethod ParseNavigationMethod(const std::string& name, const std::string& where) {
   for (const NavigationMethod m : kAllMethods)
     if (name == MethodName(m)) return m;
-  Fail(where, ": unknown method '", name, "' (expected span, reactive or cl_rrt_star)");
+  Fail(where, ": unknown method '", name, "' (expected span, reactive, cl_rrt_star or orca)");
 }
 
 std::vector<NavigationMethod> NavigationExperimentConfig::Methods() const {
   std::vector<NavigationMethod> out;
   for (const std::string& m : methods) out.push_back(ParseNavigationMethod(m, "methods"));
   return out;
+}
+
+nav::OrcaControllerOptions MakeOrcaControllerOptions(const NavigationExperimentConfig& c) {
+  nav::OrcaControllerOptions o;
+  o.time_horizon = c.orca.time_horizon;
+  o.responsibility = c.orca.responsibility;
+  o.heading_gain = c.orca.heading_gain;
+  o.safety_margin = c.orca.safety_margin;
+  o.dt = c.dt;
+  o.robot_radius = c.scenario.robot_radius;
+  o.pedestrian_radius = c.scenario.pedestrian_radius;
+  o.epsilon = c.span.options.epsilon;
+  o.limits = {-c.v_max, c.v_max, c.omega_max};
+  return o;
 }
 
 bool NavigationExperimentConfig::Uses(NavigationMethod method) const {
@@ -56,6 +72,8 @@ void NavigationExperimentConfig::Validate(const std::string& path) const {
   FS_THROW_UNLESS(span_problems.empty(), path, ": span: ", span_problems);
   const std::string rrt_problems = c.cl_rrt_star.options.Problems();
   FS_THROW_UNLESS(rrt_problems.empty(), path, ": cl_rrt_star: ", rrt_problems);
+  const std::string orca_problems = MakeOrcaControllerOptions(c).Problems();
+  FS_THROW_UNLESS(orca_problems.empty(), path, ": orca: ", orca_problems);
   FS_THROW_UNLESS(c.predictor.tracks == "scenario" || c.predictor.tracks == "replay", path,
                   ": predictor.tracks: '", c.predictor.tracks, "', expected scenario or replay");
   (void)ParseNavigationMethod(c.video.method, path + ": video.method");

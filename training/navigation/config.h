@@ -1,7 +1,7 @@
 #pragma once
 /// The config of a navigation experiment (configs/navigation/*.yaml, `model: navigation`): the
 /// crowd scenario, where the pedestrian predictor and the static map come from, the controllers
-/// (SPAN and the reactive and CL-RRT* baselines) and the episodes. Torch-free.
+/// (SPAN and the reactive, CL-RRT* and ORCA baselines) and the episodes. Torch-free.
 
 #include <cstdint>
 #include <string>
@@ -10,6 +10,7 @@
 #include "core/config.h"
 #include "datasets/crowd_scenario.h"
 #include "inference/navigation/cl_rrt_star.h"
+#include "inference/navigation/orca.h"
 #include "inference/navigation/span_controller.h"
 
 namespace foresight {
@@ -127,9 +128,30 @@ struct ClRrtStarConfig {
   }
 };
 
+/// The ORCA baseline (inference/navigation/orca.h; van den Berg et al. 2011). The robot's radius,
+/// dt, the control limits and the static threshold come from the experiment (epsilon: span's).
+struct OrcaConfig {
+  double time_horizon = 2.0;    ///< tau (s)
+  double responsibility = 1.0;  ///< share of the avoidance the robot takes (0.5: reciprocal)
+  double heading_gain = 2.0;    ///< 1/s
+  double safety_margin = 0.1;   ///< m added to each pedestrian's radius
+  template <class A>
+  void Serialize(A* a) {
+    a->Visit("time_horizon", &time_horizon, config::Range::Closed(0.1, 30),
+             "ORCA time horizon tau: collisions later than this are ignored (s)");
+    a->Visit("responsibility", &responsibility, config::Range::OpenClosed(0, 1),
+             "share of the avoidance the robot takes per pedestrian (1: pedestrians do not react; "
+             "0.5: reciprocal, as between ORCA agents)");
+    a->Visit("heading_gain", &heading_gain, config::Range::Positive(),
+             "turn rate per rad of heading error to the ORCA velocity (1/s), then clamped");
+    a->Visit("safety_margin", &safety_margin, config::Range::Closed(0, 2),
+             "added to each pedestrian's radius in ORCA (m)");
+  }
+};
+
 /// The controllers a navigation experiment compares. Configs name them (`methods: [span, ...]`);
 /// ParseNavigationMethod is the one place a name becomes a method.
-enum class NavigationMethod { kSpan, kReactive, kClRrtStar };
+enum class NavigationMethod { kSpan, kReactive, kClRrtStar, kOrca };
 const char* MethodName(NavigationMethod method);
 /// The method called `name`; an unknown name is an Error naming `where` and the known names.
 NavigationMethod ParseNavigationMethod(const std::string& name, const std::string& where);
@@ -167,6 +189,7 @@ struct NavigationExperimentConfig {
   SpanControllerConfig span;
   ReactiveControllerConfig reactive;
   ClRrtStarConfig cl_rrt_star;
+  OrcaConfig orca;
   NavigationVideoConfig video;
 
   template <class A>
@@ -177,7 +200,7 @@ struct NavigationExperimentConfig {
     a->Visit("predictor", &predictor, config::Range::Any(), "SPAN pedestrian predictor");
     a->Visit("map", &map, config::Range::Any(), "static occupancy map");
     a->Visit("methods", &methods, config::Range::Any(),
-             "controllers compared: span | reactive | cl_rrt_star");
+             "controllers compared: span | reactive | cl_rrt_star | orca");
     a->Visit("episodes", &episodes, config::Range::Closed(1, 100000), "episodes per method");
     // At most a day: the cycle count max_time / dt must stay far inside an int.
     a->Visit("max_time", &max_time, config::Range::OpenClosed(0, 86400),
@@ -192,6 +215,7 @@ struct NavigationExperimentConfig {
     a->Visit("span", &span, config::Range::Any(), "SPAN controller");
     a->Visit("reactive", &reactive, config::Range::Any(), "reactive baseline");
     a->Visit("cl_rrt_star", &cl_rrt_star, config::Range::Any(), "CL-RRT* baseline");
+    a->Visit("orca", &orca, config::Range::Any(), "ORCA baseline");
     a->Visit("video", &video, config::Range::Any(), "video of one episode");
   }
   /// Scenario and method checks; errors name `path` and the key.
@@ -200,5 +224,9 @@ struct NavigationExperimentConfig {
   std::vector<NavigationMethod> Methods() const;
   bool Uses(NavigationMethod method) const;
 };
+
+/// The ORCA controller's options of an experiment: the `orca` block with dt, the scenario's radii,
+/// span.epsilon (static threshold) and the control limits.
+nav::OrcaControllerOptions MakeOrcaControllerOptions(const NavigationExperimentConfig& config);
 
 }  // namespace foresight

@@ -16,6 +16,7 @@ const cv::Scalar kRobot(40, 40, 220), kGoal(60, 170, 60), kPedestrian(110, 110, 
 cv::Scalar MethodColour(const std::string& m) {
   if (m == "span") return {40, 40, 220};
   if (m == "reactive") return {200, 120, 30};
+  if (m == "orca") return {170, 60, 170};  // purple (BGR)
   return {40, 160, 40};
 }
 }  // namespace

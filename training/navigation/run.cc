@@ -19,6 +19,7 @@
 #include "inference/mapping/grid_map.h"
 #include "inference/navigation/cl_rrt_star.h"
 #include "inference/navigation/goal_distance.h"
+#include "inference/navigation/orca.h"
 #include "inference/navigation/span_controller.h"
 #include "models/occupancy/raster_map.h"
 #include "training/navigation/render.h"
@@ -129,6 +130,8 @@ std::unique_ptr<nav::NavigationController> MakeController(const NavigationExperi
       return std::make_unique<nav::ClRrtStarController>(res.field.get(), res.raster.extent, r,
                                                         seed);
     }
+    case NavigationMethod::kOrca:
+      return std::make_unique<nav::OrcaController>(res.field.get(), MakeOrcaControllerOptions(c));
   }
   Fail("navigation: method ", static_cast<int>(method), " has no controller");
 }
@@ -140,7 +143,29 @@ std::string Json(double v) {
   return s.str();
 }
 
+std::string Json(const RateInterval& i) { return "[" + Json(i.lo) + ", " + Json(i.hi) + "]"; }
+
 }  // namespace
+
+bool RobotCausedContact(const Eigen::Vector2d& robot_position,
+                        const Eigen::Vector2d& robot_velocity,
+                        const Eigen::Vector2d& pedestrian_position, double radius_sum,
+                        bool just_spawned) {
+  const Eigen::Vector2d d = pedestrian_position - robot_position;
+  const double distance = d.norm();
+  if (!(distance < radius_sum) || just_spawned) return false;
+  if (robot_velocity.norm() < kRobotCausedSpeed) return false;  // standing still: run into
+  if (distance <= 0) return true;
+  return robot_velocity.dot(d / distance) > kRobotCausedSpeed;
+}
+
+RateInterval WilsonInterval(int k, int n, double z) {
+  if (n <= 0) return {0.0, 1.0};
+  const double nn = n, p = static_cast<double>(k) / nn, z2 = z * z;
+  const double centre = (p + z2 / (2 * nn)) / (1 + z2 / nn);
+  const double half = z * std::sqrt(p * (1 - p) / nn + z2 / (4 * nn * nn)) / (1 + z2 / nn);
+  return {std::max(0.0, centre - half), std::min(1.0, centre + half)};
+}
 
 double NavigationResources::StaticDistance(double x, double y) const {
   int r, c;
@@ -208,6 +233,20 @@ EpisodeResult RunEpisode(const NavigationExperimentConfig& c, const NavigationRe
   nav::UnicycleState s{ends.start[0], ends.start[1], ends.start[2]};
   const Eigen::Vector2d goal = ends.goal;
   const double r_robot = c.scenario.robot_radius;
+  // When each active pedestrian appeared (step) and whether it appeared inside the robot's disc:
+  // a contact with it within a step of that is never robot-caused.
+  std::unordered_map<std::int64_t, std::pair<int, bool>> appeared;
+  auto track = [&](int step) {
+    for (const CrowdAgent& a : crowd->agents()) {
+      if (!a.active) {
+        appeared.erase(a.id);
+        continue;
+      }
+      if (appeared.count(a.id) == 0)
+        appeared[a.id] = {step, (a.position - s.position()).norm() < r_robot + a.radius};
+    }
+  };
+  track(0);
   controller->Prepare(goal);  // per-goal set-up (distance field) outside the timed cycles
   const int max_cycles = static_cast<int>(std::ceil(c.max_time / c.dt));
   std::vector<Eigen::Vector2d> path{s.position()};
@@ -261,6 +300,7 @@ EpisodeResult RunEpisode(const NavigationExperimentConfig& c, const NavigationRe
     }
     const nav::Control cmd = limits.Clamp(u.command);
     const nav::UnicycleState next = nav::EulerStep(s, cmd, c.dt);
+    const Eigen::Vector2d robot_velocity = (next.position() - s.position()) / c.dt;
     RobotAgent robot;
     robot.position = next.position();
     robot.velocity = (next.position() - s.position()) / c.dt;
@@ -272,13 +312,21 @@ EpisodeResult RunEpisode(const NavigationExperimentConfig& c, const NavigationRe
     observe();
     path.push_back(s.position());
     ++out.cycles;
+    track(cycle + 1);
     // Metrics at the new state.
     double clear = res.StaticDistance(s.x, s.y) - r_robot;
+    bool robot_caused = clear < 0;  // the robot is the only mover near walls
     if (clear < 0) out.doc_static += c.dt;
     for (const CrowdAgent& a : crowd->agents())
-      if (a.active)
+      if (a.active) {
         clear = std::min(clear, (a.position - s.position()).norm() - r_robot - a.radius);
+        const auto& [step, inside] = appeared.at(a.id);
+        robot_caused =
+            robot_caused || RobotCausedContact(s.position(), robot_velocity, a.position,
+                                               r_robot + a.radius, inside && step >= cycle);
+      }
     if (clear < 0) out.doc += c.dt;
+    if (robot_caused) out.robot_caused_doc += c.dt;
     min_clear = std::min(min_clear, clear);
     if (recorder) try {
         Eigen::Matrix2Xd so_far(2, static_cast<Eigen::Index>(path.size()));
@@ -304,23 +352,35 @@ MethodSummary Summarise(const std::string& method, const std::vector<EpisodeResu
   MethodSummary m;
   m.method = method;
   std::vector<double> cycles, ttg;
-  double doc = 0, clear = 0, worst = kInf;
-  int reached = 0, free = 0;
+  double doc = 0, robot_doc = 0, clear = 0, worst = kInf, ttg_censored = 0;
   for (const EpisodeResult& r : results) {
     if (r.method != method) continue;
     ++m.episodes;
-    reached += r.reached;
-    free += r.doc == 0.0;
+    m.successes += r.reached;
+    m.collision_free += r.doc == 0.0;
+    m.success_and_collision_free += r.reached && r.doc == 0.0;
+    m.robot_caused_collision_free += r.robot_caused_doc == 0.0;
     if (r.reached) ttg.push_back(r.ttg);
+    ttg_censored += r.ttg;  // max_time for an episode that did not reach the goal
     doc += r.doc;
+    robot_doc += r.robot_caused_doc;
     clear += r.min_clearance;
     worst = std::min(worst, r.min_clearance);
     m.solve_failures += r.solve_failures;
     cycles.insert(cycles.end(), r.cycle_ms.begin(), r.cycle_ms.end());
   }
+  m.success_rate_ci = WilsonInterval(m.successes, m.episodes);
+  m.collision_free_rate_ci = WilsonInterval(m.collision_free, m.episodes);
+  m.success_and_collision_free_rate_ci = WilsonInterval(m.success_and_collision_free, m.episodes);
+  m.robot_caused_collision_free_rate_ci = WilsonInterval(m.robot_caused_collision_free, m.episodes);
   if (m.episodes == 0) return m;
-  m.success_rate = static_cast<double>(reached) / m.episodes;
-  m.collision_free_rate = static_cast<double>(free) / m.episodes;
+  const double n = m.episodes;
+  m.success_rate = m.successes / n;
+  m.collision_free_rate = m.collision_free / n;
+  m.success_and_collision_free_rate = m.success_and_collision_free / n;
+  m.robot_caused_collision_free_rate = m.robot_caused_collision_free / n;
+  m.ttg_censored_mean = ttg_censored / n;
+  m.robot_caused_doc_mean = robot_doc / n;
   m.ttg_mean = ttg.empty()
                    ? std::nan("")
                    : std::accumulate(ttg.begin(), ttg.end(), 0.0) / static_cast<double>(ttg.size());
@@ -352,7 +412,19 @@ std::string SummaryJson(const NavigationExperimentConfig& c, int episodes,
       << ", \"cycle_ms_median\": " << Json(m.cycle_ms_median)
       << ", \"cycle_ms_p99\": " << Json(m.cycle_ms_p99)
       << ", \"cycle_ms_max\": " << Json(m.cycle_ms_max)
-      << ", \"solve_failures\": " << m.solve_failures << ", \"episodes\": " << m.episodes << "}";
+      << ", \"solve_failures\": " << m.solve_failures << ", \"episodes\": " << m.episodes
+      << ", \"successes\": " << m.successes << ", \"collision_free\": " << m.collision_free
+      << ", \"success_and_collision_free\": " << m.success_and_collision_free
+      << ", \"success_and_collision_free_rate\": " << Json(m.success_and_collision_free_rate)
+      << ", \"robot_caused_collision_free\": " << m.robot_caused_collision_free
+      << ", \"robot_caused_collision_free_rate\": " << Json(m.robot_caused_collision_free_rate)
+      << ", \"ttg_censored_mean\": " << Json(m.ttg_censored_mean)
+      << ", \"robot_caused_doc_mean\": " << Json(m.robot_caused_doc_mean)
+      << ", \"success_rate_ci\": " << Json(m.success_rate_ci)
+      << ", \"collision_free_rate_ci\": " << Json(m.collision_free_rate_ci)
+      << ", \"success_and_collision_free_rate_ci\": " << Json(m.success_and_collision_free_rate_ci)
+      << ", \"robot_caused_collision_free_rate_ci\": "
+      << Json(m.robot_caused_collision_free_rate_ci) << "}";
   }
   j << "\n}\n";
   return j.str();
@@ -396,7 +468,7 @@ std::vector<MethodSummary> RunNavigation(const NavigationExperimentConfig& c,
   std::vector<EpisodeResult> results;
   std::ofstream csv(out_dir + "/episodes.csv");
   csv << "method,episode,seed,reached,ttg,doc,doc_static,min_clearance,path_length,cycles,solve_"
-         "failures,cycle_ms_median,cycle_ms_p99\n";
+         "failures,cycle_ms_median,cycle_ms_p99,robot_caused_doc\n";
   for (const NavigationMethod method : c.Methods()) {
     for (int e = 0; e < n; ++e) {
       std::unique_ptr<VideoRecorder> video;
@@ -407,7 +479,7 @@ std::vector<MethodSummary> RunNavigation(const NavigationExperimentConfig& c,
       csv << r.method << ',' << r.episode << ',' << r.seed << ',' << r.reached << ',' << r.ttg
           << ',' << r.doc << ',' << r.doc_static << ',' << r.min_clearance << ',' << r.path_length
           << ',' << r.cycles << ',' << r.solve_failures << ',' << Percentile(r.cycle_ms, 0.5) << ','
-          << Percentile(r.cycle_ms, 0.99) << '\n';
+          << Percentile(r.cycle_ms, 0.99) << ',' << r.robot_caused_doc << '\n';
       csv.flush();
       log::Info(r.method, " episode ", e, ": ", r.reached ? "reached" : "not reached", " ttg ",
                 r.ttg, " s, doc ", r.doc, " s, min clearance ", r.min_clearance,

@@ -1,9 +1,11 @@
 #pragma once
 /// Navigation episodes in one harness (thesis ch 5, "Experimental Evaluation"): the crowd of the
 /// scenario (simulated or replayed), a unicycle robot stepped at dt, and a controller per method
-/// (SPAN, reactive, CL-RRT*) fed each cycle with the last observed pedestrian positions. Metrics:
-/// success, time-to-goal (TTG), duration of collision (DOC), minimum clearance and control-cycle
-/// compute time. Writes DIR/episodes.csv, DIR/summary.json, DIR/paths.png and DIR/episode.avi.
+/// (SPAN, reactive, CL-RRT*, ORCA) fed each cycle with the last observed pedestrian positions.
+/// Metrics (docs/navigation.md): success, time-to-goal (TTG, also censored at max_time), duration
+/// of collision (DOC) and the part of it the robot causes, minimum clearance, control-cycle compute
+/// time, and Wilson 95 % intervals on the rates. Writes DIR/episodes.csv, DIR/summary.json,
+/// DIR/paths.png and DIR/episode.avi.
 
 #include <Eigen/Core>
 #include <memory>
@@ -42,15 +44,39 @@ struct EpisodeResult {
   int episode = 0;
   std::uint64_t seed = 0;
   bool reached = false;
-  double ttg = 0;            ///< s (time of arrival; max_time when not reached)
-  double doc = 0;            ///< s in collision with a pedestrian or a static obstacle
-  double doc_static = 0;     ///< s of `doc` in contact with a static obstacle
+  double ttg = 0;         ///< s (time of arrival; max_time when not reached)
+  double doc = 0;         ///< s in collision with a pedestrian or a static obstacle
+  double doc_static = 0;  ///< s of `doc` in contact with a static obstacle
+  /// s of `doc` with a robot-caused contact (RobotCausedContact; static contacts always are)
+  double robot_caused_doc = 0;
   double min_clearance = 0;  ///< m, smallest gap to a pedestrian or obstacle (negative: overlap)
   double path_length = 0;    ///< m
   int cycles = 0, solve_failures = 0;
   std::vector<double> cycle_ms;  ///< compute time of each control cycle
   Eigen::Matrix2Xd path;         ///< robot positions, one per cycle
 };
+
+/// Speed (m/s) above which the robot counts as moving, and as closing in on a pedestrian.
+constexpr double kRobotCausedSpeed = 0.05;
+
+/// Whether a robot-pedestrian contact at one step is the robot's fault (docs/navigation.md):
+/// the discs overlap (distance < `radius_sum`), the pedestrian did not just appear inside the
+/// robot's disc (`just_spawned`: it became active this step or the previous one while
+/// overlapping), the robot moves (|robot_velocity| >= kRobotCausedSpeed) and its own velocity
+/// toward the pedestrian, robot_velocity . n with n the unit vector robot -> pedestrian, exceeds
+/// kRobotCausedSpeed. Coincident centres (no n) count as robot-caused when the robot moves.
+/// @param robot_velocity [2] the robot's velocity over the step that ended at this contact (m/s)
+bool RobotCausedContact(const Eigen::Vector2d& robot_position,
+                        const Eigen::Vector2d& robot_velocity,
+                        const Eigen::Vector2d& pedestrian_position, double radius_sum,
+                        bool just_spawned);
+
+/// Wilson score interval [lo, hi] of a binomial proportion k / n at normal quantile z (1.96:
+/// 95 %): (p + z^2/2n -+ z sqrt(p(1-p)/n + z^2/4n^2)) / (1 + z^2/n), p = k / n. n = 0: [0, 1].
+struct RateInterval {
+  double lo = 0, hi = 1;
+};
+RateInterval WilsonInterval(int k, int n, double z = 1.96);
 
 /// Draws frames of one episode (the video); null in RunEpisode for none.
 class EpisodeRecorder {
@@ -63,8 +89,8 @@ class EpisodeRecorder {
                      const Eigen::Matrix2Xd& path_so_far) = 0;
 };
 
-/// Runs one episode of `method` (span | reactive | cl_rrt_star). Never throws from the control
-/// loop.
+/// Runs one episode of `method` (span | reactive | cl_rrt_star | orca). Never throws from the
+/// control loop.
 EpisodeResult RunEpisode(const NavigationExperimentConfig& config,
                          const NavigationResources& resources, NavigationMethod method, int episode,
                          EpisodeRecorder* recorder = nullptr);
@@ -72,9 +98,19 @@ EpisodeResult RunEpisode(const NavigationExperimentConfig& config,
 struct MethodSummary {
   std::string method;
   int episodes = 0;
+  int successes = 0;                    ///< episodes that reached the goal
+  int collision_free = 0;               ///< episodes with DOC = 0
+  int success_and_collision_free = 0;   ///< reached and DOC = 0
+  int robot_caused_collision_free = 0;  ///< episodes with robot-caused DOC = 0
   double success_rate = 0, collision_free_rate = 0;
-  double ttg_mean = 0;  ///< over reached episodes (NaN -> null when none)
+  double success_and_collision_free_rate = 0, robot_caused_collision_free_rate = 0;
+  /// Wilson 95 % intervals of the four rates above
+  RateInterval success_rate_ci, collision_free_rate_ci, success_and_collision_free_rate_ci,
+      robot_caused_collision_free_rate_ci;
+  double ttg_mean = 0;           ///< over reached episodes (NaN -> null when none)
+  double ttg_censored_mean = 0;  ///< over all episodes, a failure counting as its ttg (max_time)
   double doc_mean = 0;
+  double robot_caused_doc_mean = 0;
   double min_clearance = 0;       ///< m, smallest gap over all episodes (negative: overlap)
   double min_clearance_mean = 0;  ///< m, mean over episodes of each episode's smallest gap
   double cycle_ms_median = 0, cycle_ms_p99 = 0, cycle_ms_max = 0;

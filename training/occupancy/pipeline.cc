@@ -1,5 +1,6 @@
 #include "training/occupancy/pipeline.h"
 
+#include <Eigen/Cholesky>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -14,6 +15,7 @@
 #include "inference/mapping/grid_map.h"
 #include "inference/mapping/hinge_map.h"
 #include "models/occupancy/bhm.h"
+#include "models/occupancy/coupled_bhm.h"
 #include "models/occupancy/fast_bhm.h"
 #include "models/occupancy/grid_builder.h"
 #include "models/occupancy/hilbert_map.h"
@@ -104,15 +106,73 @@ OccupancyData LoadOccupancyData(const OccupancyExperimentConfig& c) {
   return data;
 }
 
+namespace {
+
+/// The coupled learner on `scans` of `points`, fitted (bound updates logged, and returned).
+std::unique_ptr<CoupledBhmLearner> FitCoupledBhm(const HingeGrid& grid, const FastBhmConfig& f,
+                                                 const LabelledPoints& points,
+                                                 const std::vector<int>& scans,
+                                                 std::vector<BoundUpdateReport>* reports) {
+  auto learner =
+      std::make_unique<CoupledBhmLearner>(grid, CoupledBhmOptions{f.prior_mean, f.prior_variance});
+  for (const int s : scans) {
+    const auto b = points.scan_begin[s], e = points.scan_begin[s + 1];
+    learner->Add(points.xy.middleCols(b, e - b), points.occupied.data() + b);
+  }
+  const std::vector<BoundUpdateReport> r = learner->Fit(f.bound_updates);
+  for (const BoundUpdateReport& u : r)
+    log::Info("coupled Fast-BHM: bound update ", u.update, ": ELBO ", u.elbo, ", mean |dz| ",
+              u.mean_abs_dz, ", ", u.seconds, " s");
+  if (reports) *reports = r;
+  return learner;
+}
+
+std::string BoundReportsJson(const std::vector<BoundUpdateReport>& reports) {
+  std::ostringstream os;
+  os << "[";
+  for (std::size_t i = 0; i < reports.size(); ++i)
+    os << (i ? ", " : "") << "{\"update\": " << reports[i].update
+       << ", \"elbo\": " << Json(reports[i].elbo)
+       << ", \"mean_abs_dz\": " << Json(reports[i].mean_abs_dz)
+       << ", \"seconds\": " << Json(reports[i].seconds) << "}";
+  return os.str() + "]";
+}
+
+}  // namespace
+
 std::unique_ptr<OccupancyMap> TrainOccupancyMap(const std::string& model,
                                                 const OccupancyExperimentConfig& c,
-                                                const OccupancyData& data, double* seconds) {
+                                                const OccupancyData& data, double* seconds,
+                                                std::vector<BoundUpdateReport>* bound_reports) {
   const auto start = std::chrono::steady_clock::now();
   std::unique_ptr<OccupancyMap> map;
-  if (model == kFastBhmType) {
+  const bool coupled = c.fast_bhm.update == FastBhmUpdate::kCoupled;
+  if (model == kFastBhmType && coupled) {
+    const auto learner = FitCoupledBhm(HingeGrid(c.features), c.fast_bhm, data.train,
+                                       FirstScans(data.train), bound_reports);
+    map = std::make_unique<HingeMap>(learner->ToMap());
+  } else if (model == kFastBhmType) {
     FastBhmLearner learner(HingeGrid(c.features), c.fast_bhm);
     UpdateOnScans(&learner, data.train, FirstScans(data.train));
     map = std::make_unique<HingeMap>(learner.ToMap());
+  } else if (model == kBhmType && coupled) {
+    // The full BHM with the coupled learner's bound: the same posterior, kept with its full
+    // covariance (dense inverse of the sparse precision; small grids only).
+    const HingeGrid grid(c.features);
+    FS_THROW_UNLESS(grid.size() <= 4096, "model: ", kBhmType, " keeps a dense covariance of ",
+                    grid.size(), " features; use at most 4096 (features.spacing)");
+    const auto learner =
+        FitCoupledBhm(grid, c.fast_bhm, data.train, FirstScans(data.train), bound_reports);
+    const SparseInformation info = learner->DataInformation();
+    Eigen::MatrixXd precision = Eigen::MatrixXd(info.precision_data);
+    precision = precision.selfadjointView<Eigen::Lower>();
+    precision.diagonal().array() += 1.0 / c.fast_bhm.prior_variance;
+    HingeWeights w;
+    w.mean = learner->mean();
+    w.covariance = precision.llt().solve(Eigen::MatrixXd::Identity(grid.size(), grid.size()));
+    w.variance = w.covariance.diagonal();
+    map = std::make_unique<HingeMap>(HingeMapKind::kBhm, grid, std::move(w), c.fast_bhm.prior_mean,
+                                     c.fast_bhm.prior_variance);
   } else if (model == kBhmType) {
     BhmLearner learner(HingeGrid(c.features), c.fast_bhm);
     UpdateOnScans(&learner, data.train, FirstScans(data.train));
@@ -184,6 +244,28 @@ FusionResult RunFusion(const OccupancyExperimentConfig& c, const OccupancyData& 
                   " robot(s); need at least two (check fusion.robots / centre)");
   for (const auto& l : robots) r.robot_scans.push_back(static_cast<int>(l.size()));
 
+  std::vector<std::string> names;
+  for (std::size_t i = 0; i < robots.size(); ++i) names.push_back("robot " + std::to_string(i));
+  if (c.fast_bhm.update == FastBhmUpdate::kCoupled) {
+    // The learning map: single map; fuse once exactly (sum of the robots' sparse information,
+    // each at its own learned bounds) and approximately (conflation of their diagonal maps).
+    r.single = std::make_unique<HingeMap>(
+        FitCoupledBhm(grid, c.fast_bhm, data.train, FirstScans(data.train), nullptr)->ToMap());
+    std::vector<SparseInformation> parts;
+    std::vector<HingeMap> locals;
+    for (const auto& scans : robots) {
+      const auto l = FitCoupledBhm(grid, c.fast_bhm, data.train, scans, nullptr);
+      parts.push_back(l->DataInformation());
+      locals.push_back(l->ToMap());
+      r.information_bytes.push_back(static_cast<std::int64_t>(parts.back().Bytes()));
+    }
+    r.fuse_once = std::make_unique<HingeMap>(CoupledBhmLearner::FuseInformation(
+        grid, CoupledBhmOptions{c.fast_bhm.prior_mean, c.fast_bhm.prior_variance}, parts));
+    std::vector<const HingeMap*> ptrs;
+    for (const auto& l : locals) ptrs.push_back(&l);
+    r.conflated = std::make_unique<HingeMap>(FuseMaps(ptrs, names, c.fusion.options));
+    return r;
+  }
   FastBhmLearner single(grid, c.fast_bhm);
   UpdateOnScans(&single, data.train, FirstScans(data.train));
   r.single = std::make_unique<HingeMap>(single.ToMap());
@@ -196,11 +278,7 @@ FusionResult RunFusion(const OccupancyExperimentConfig& c, const OccupancyData& 
     locals.push_back(l.ToMap());
   }
   std::vector<const HingeMap*> ptrs;
-  std::vector<std::string> names;
-  for (std::size_t i = 0; i < locals.size(); ++i) {
-    ptrs.push_back(&locals[i]);
-    names.push_back("robot " + std::to_string(i));
-  }
+  for (const auto& l : locals) ptrs.push_back(&l);
   r.fuse_once = std::make_unique<HingeMap>(FuseMaps(ptrs, names, c.fusion.options));
 
   // Repeated fusion (thesis Algorithm "Fast-BHM Sequential Fusion"): after each 1/merges of every
@@ -234,18 +312,26 @@ void TrainOccupancyRun(const OccupancyExperimentConfig& c, const std::string& ru
     const FusionResult r = RunFusion(c, data);
     SaveOccupancyMap(*r.single, run_dir + "/single.h5", c);
     SaveOccupancyMap(*r.fuse_once, run_dir + "/fuse_once.h5", c);
-    SaveOccupancyMap(*r.repeated, artifact, c);
+    if (r.conflated) SaveOccupancyMap(*r.conflated, run_dir + "/conflated.h5", c);
+    // The run's map: the exactly fused learning map (coupled), else the repeated fusion.
+    SaveOccupancyMap(r.repeated ? *r.repeated : *r.fuse_once, artifact, c);
     std::ofstream out(run_dir + "/training_summary.json");
     out << "{\"seconds\": " << Json(Seconds(start)) << ", \"robots\": " << r.robot_scans.size()
         << ", \"robot_scans\": [";
     for (std::size_t i = 0; i < r.robot_scans.size(); ++i)
       out << (i ? ", " : "") << r.robot_scans[i];
+    out << "], \"information_bytes\": [";
+    for (std::size_t i = 0; i < r.information_bytes.size(); ++i)
+      out << (i ? ", " : "") << r.information_bytes[i];
     out << "], \"merges\": " << c.fusion.merges << "}\n";
   } else {
     double secs = 0;
-    const std::unique_ptr<OccupancyMap> map = TrainOccupancyMap(c.model, c, data, &secs);
+    std::vector<BoundUpdateReport> bounds;
+    const std::unique_ptr<OccupancyMap> map = TrainOccupancyMap(c.model, c, data, &secs, &bounds);
     SaveOccupancyMap(*map, artifact, c);
-    std::ofstream(run_dir + "/training_summary.json") << "{\"seconds\": " << Json(secs) << "}\n";
+    std::ofstream(run_dir + "/training_summary.json")
+        << "{\"seconds\": " << Json(secs) << ", \"bound_updates\": " << BoundReportsJson(bounds)
+        << "}\n";
     log::Info(c.model, ": trained in ", secs, " s");
   }
 }
@@ -262,27 +348,37 @@ std::string EvaluateOccupancyRun(const OccupancyExperimentConfig& c, const std::
        << ",\n  \"test_points\": " << data.test.size() << ",\n";
   if (c.model == "occupancy.fusion") {
     // Evaluates what ships: the maps as loaded from their artifacts.
-    const auto single_map = LoadOccupancyMap(run_dir + "/single.h5");
-    const auto once_map = LoadOccupancyMap(run_dir + "/fuse_once.h5");
-    const auto repeated_map = LoadOccupancyMap(artifact);
-    const BinaryMetrics single = EvaluateMap(*single_map, data.test);
-    const BinaryMetrics once = EvaluateMap(*once_map, data.test);
-    const BinaryMetrics repeated = EvaluateMap(*repeated_map, data.test);
-    json << "  \"merges\": " << c.fusion.merges << ",\n  \"auc_single\": " << Json(single.auc)
-         << ",\n  \"auc_fuse_once\": " << Json(once.auc)
-         << ",\n  \"auc_repeated\": " << Json(repeated.auc)
-         << ",\n  \"single\": " << MetricsJson(single)
-         << ",\n  \"fuse_once\": " << MetricsJson(once)
-         << ",\n  \"repeated\": " << MetricsJson(repeated) << ",\n  \"auc\": " << Json(repeated.auc)
-         << ",\n  \"precision\": " << Json(repeated.precision)
-         << ",\n  \"recall\": " << Json(repeated.recall)
+    // coupled: single, fuse_once (sparse information, exact), fuse_once_conflation (diagonal
+    // maps, approximate); published: single, fuse_once and repeated (conflation both).
+    const bool coupled = c.fast_bhm.update == FastBhmUpdate::kCoupled;
+    const std::vector<std::pair<std::string, std::string>> files =
+        coupled
+            ? std::vector<std::pair<std::string, std::string>>{{"single", "single.h5"},
+                                                               {"fuse_once", "fuse_once.h5"},
+                                                               {"fuse_once_conflation",
+                                                                "conflated.h5"}}
+            : std::vector<std::pair<std::string, std::string>>{
+                  {"single", "single.h5"}, {"fuse_once", "fuse_once.h5"}, {"repeated", "model.h5"}};
+    std::vector<std::unique_ptr<OccupancyMap>> maps;
+    std::vector<MapPanel> panels;
+    json << "  \"update\": \"" << (coupled ? "coupled" : "published")
+         << "\",\n  \"merges\": " << c.fusion.merges;
+    BinaryMetrics last;
+    for (const auto& [name, file] : files) {
+      maps.push_back(LoadOccupancyMap(run_dir + "/" + file));
+      last = EvaluateMap(*maps.back(), data.test);
+      json << ",\n  \"auc_" << name << "\": " << Json(last.auc) << ",\n  \"" << name
+           << "\": " << MetricsJson(last) << ",\n  \"" << name
+           << "_bytes\": " << fs::file_size(run_dir + "/" + file);
+      panels.push_back({name, maps.back().get()});
+      log::Info("fusion: ", name, " AUC ", last.auc);
+    }
+    const BinaryMetrics shipped = EvaluateMap(*LoadOccupancyMap(artifact), data.test);
+    json << ",\n  \"auc\": " << Json(shipped.auc)
+         << ",\n  \"precision\": " << Json(shipped.precision)
+         << ",\n  \"recall\": " << Json(shipped.recall)
          << ",\n  \"artifact_bytes\": " << fs::file_size(artifact) << "\n}\n";
-    WriteMapPanels({{"single map", single_map.get()},
-                    {"fused once", once_map.get()},
-                    {"repeatedly fused", repeated_map.get()}},
-                   c.eval.plot_resolution, run_dir + "/plots/map.png");
-    log::Info("fusion AUC: single ", single.auc, ", fuse once ", once.auc, ", repeated ",
-              repeated.auc);
+    WriteMapPanels(panels, c.eval.plot_resolution, run_dir + "/plots/map.png");
   } else {
     const std::unique_ptr<OccupancyMap> loaded = LoadOccupancyMap(artifact);  // evaluate what ships
     const BinaryMetrics m = EvaluateMap(*loaded, data.test);

@@ -17,6 +17,8 @@
 
 namespace foresight {
 
+struct BoundUpdateReport;  // models/occupancy/coupled_bhm.h
+
 /// Scans and labelled points of an experiment, split by scan.
 struct OccupancyData {
   std::vector<LaserScan> scans;  ///< all scans, in recording order
@@ -31,11 +33,12 @@ struct OccupancyData {
 OccupancyData LoadOccupancyData(const OccupancyExperimentConfig& config);
 
 /// Trains one map of kind `model` (occupancy.fast_bhm | bhm | hilbert | grid) on the training
-/// scans, in recording order. `seconds` receives the wall-clock training time.
-std::unique_ptr<OccupancyMap> TrainOccupancyMap(const std::string& model,
-                                                const OccupancyExperimentConfig& config,
-                                                const OccupancyData& data,
-                                                double* seconds = nullptr);
+/// scans, in recording order. `seconds` receives the wall-clock training time; `bound_reports`
+/// the ELBO of every bound update (fast_bhm.update: coupled; also for bhm, whose coupled variant
+/// keeps the learned posterior with its dense covariance).
+std::unique_ptr<OccupancyMap> TrainOccupancyMap(
+    const std::string& model, const OccupancyExperimentConfig& config, const OccupancyData& data,
+    double* seconds = nullptr, std::vector<BoundUpdateReport>* bound_reports = nullptr);
 /// Writes the map's artifact (hinge maps with config.precision).
 void SaveOccupancyMap(const OccupancyMap& map, const std::string& path,
                       const OccupancyExperimentConfig& config);
@@ -45,9 +48,13 @@ std::int64_t ArtifactBytes(const OccupancyMap& map, const OccupancyExperimentCon
 BinaryMetrics EvaluateMap(const OccupancyMap& map, const LabelledPoints& points);
 
 /// Multi-robot fusion (thesis ch 3 "Fusion of Fast-BHM"): single map, fuse once, repeated fusion.
+/// fast_bhm.update: coupled -> single, fuse_once (the robots' sparse information summed: exact
+/// for their bounds) and conflated (their diagonal maps conflated: approximate); published ->
+/// single, fuse_once and repeated (conflation, the thesis's algorithms).
 struct FusionResult {
-  std::unique_ptr<OccupancyMap> single, fuse_once, repeated;
-  std::vector<int> robot_scans;  ///< training scans per robot
+  std::unique_ptr<OccupancyMap> single, fuse_once, repeated, conflated;
+  std::vector<int> robot_scans;                 ///< training scans per robot
+  std::vector<std::int64_t> information_bytes;  ///< coupled: per robot, of its sparse information
 };
 FusionResult RunFusion(const OccupancyExperimentConfig& config, const OccupancyData& data);
 

@@ -1,0 +1,1 @@
+target_sources(foresight_navigation PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/orca.cc)

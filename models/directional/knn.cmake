@@ -1,0 +1,1 @@
+target_sources(foresight_models_directional_grid PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/directional/knn_directional.cc)

@@ -1,0 +1,1 @@
+foresight_add_test(directional_knn_tests SOURCES models/knn_directional_test.cc DEPS foresight_models_directional_grid foresight_test_util PREFIX directional.)
