@@ -53,7 +53,7 @@ void CoupledBhmLearner::Add(const Eigen::Ref<const Eigen::Matrix2Xd>& xy,
                             const std::uint8_t* occupied) {
   const auto n = static_cast<std::size_t>(xy.cols());
   for (std::size_t i = 0; i < n; ++i) {
-    FS_THROW_UNLESS(std::isfinite(xy(0, i)) && std::isfinite(xy(1, i)), "coupled BHM: scan ",
+    FS_THROW_UNLESS(std::isfinite(xy(0, i)) && std::isfinite(xy(1, i)), "coupled BHM: added scan ",
                     scans_, " point ", i, " has a non-finite coordinate (", xy(0, i), ", ",
                     xy(1, i), ")");
   }

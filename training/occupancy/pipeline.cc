@@ -117,7 +117,11 @@ std::unique_ptr<CoupledBhmLearner> FitCoupledBhm(const HingeGrid& grid, const Fa
       std::make_unique<CoupledBhmLearner>(grid, CoupledBhmOptions{f.prior_mean, f.prior_variance});
   for (const int s : scans) {
     const auto b = points.scan_begin[s], e = points.scan_begin[s + 1];
-    learner->Add(points.xy.middleCols(b, e - b), points.occupied.data() + b);
+    try {
+      learner->Add(points.xy.middleCols(b, e - b), points.occupied.data() + b);
+    } catch (const Error& err) {  // the learner counts its own scans; name the data's
+      Fail("training scan ", s, ": ", err.what());
+    }
   }
   const std::vector<BoundUpdateReport> r = learner->Fit(f.bound_updates);
   for (const BoundUpdateReport& u : r)
@@ -323,7 +327,9 @@ void TrainOccupancyRun(const OccupancyExperimentConfig& c, const std::string& ru
     out << "], \"information_bytes\": [";
     for (std::size_t i = 0; i < r.information_bytes.size(); ++i)
       out << (i ? ", " : "") << r.information_bytes[i];
-    out << "], \"merges\": " << c.fusion.merges << "}\n";
+    out << "]";
+    if (r.repeated) out << ", \"merges\": " << c.fusion.merges;  // coupled fuses once
+    out << "}\n";
   } else {
     double secs = 0;
     std::vector<BoundUpdateReport> bounds;
@@ -361,8 +367,8 @@ std::string EvaluateOccupancyRun(const OccupancyExperimentConfig& c, const std::
                   {"single", "single.h5"}, {"fuse_once", "fuse_once.h5"}, {"repeated", "model.h5"}};
     std::vector<std::unique_ptr<OccupancyMap>> maps;
     std::vector<MapPanel> panels;
-    json << "  \"update\": \"" << (coupled ? "coupled" : "published")
-         << "\",\n  \"merges\": " << c.fusion.merges;
+    json << "  \"update\": \"" << (coupled ? "coupled" : "published") << "\"";
+    if (!coupled) json << ",\n  \"merges\": " << c.fusion.merges;  // coupled fuses once
     BinaryMetrics last;
     for (const auto& [name, file] : files) {
       maps.push_back(LoadOccupancyMap(run_dir + "/" + file));
