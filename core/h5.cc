@@ -62,6 +62,14 @@ hid_t MemType<std::uint8_t>() {
 
 std::string ObjectName(const std::string& object) { return object.empty() ? "/" : object; }
 
+/// A creation property list of class `cls` (groups, datasets) without modification times, so
+/// the same content makes the same file, bit for bit (a resumed run's artifact is compared so).
+Handle UntimedCreation(hid_t cls) {
+  Handle list(H5Pcreate(cls), H5Pclose);
+  if (list.ok()) H5Pset_obj_track_times(list.get(), 0);
+  return list;
+}
+
 }  // namespace
 
 File File::Create(const std::string& path) {
@@ -182,7 +190,9 @@ void EnsureGroup(hid_t file, const std::string& path, const std::string& group) 
     pos = group.find('/', pos + 1);
     const std::string prefix = group.substr(0, pos);
     if (!prefix.empty() && prefix != "/" && H5Lexists(file, prefix.c_str(), H5P_DEFAULT) <= 0) {
-      Handle g(H5Gcreate2(file, prefix.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
+      Handle g(H5Gcreate2(file, prefix.c_str(), H5P_DEFAULT,
+                          UntimedCreation(H5P_GROUP_CREATE).get(), H5P_DEFAULT),
+               H5Gclose);
       FS_THROW_UNLESS(g.ok(), path, ": cannot create group '", prefix, "'");
     }
     if (pos == std::string::npos) return;
@@ -285,7 +295,9 @@ void File::EnsureParentGroups(const std::string& name) {
     const std::string group = name.substr(0, pos);
     if (group.empty() || group == "/") continue;
     if (H5Lexists(id_, group.c_str(), H5P_DEFAULT) > 0) continue;
-    Handle g(H5Gcreate2(id_, group.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
+    Handle g(H5Gcreate2(id_, group.c_str(), H5P_DEFAULT, UntimedCreation(H5P_GROUP_CREATE).get(),
+                        H5P_DEFAULT),
+             H5Gclose);
     FS_THROW_UNLESS(g.ok(), path_, ": cannot create group '", group, "'");
   }
 }
@@ -299,8 +311,8 @@ void WriteRaw(hid_t file, const std::string& path, const std::string& name, cons
                             : H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr),
                H5Sclose);
   if (H5Lexists(file, name.c_str(), H5P_DEFAULT) > 0) H5Ldelete(file, name.c_str(), H5P_DEFAULT);
-  Handle ds(H5Dcreate2(file, name.c_str(), MemType<T>(), space.get(), H5P_DEFAULT, H5P_DEFAULT,
-                       H5P_DEFAULT),
+  Handle ds(H5Dcreate2(file, name.c_str(), MemType<T>(), space.get(), H5P_DEFAULT,
+                       UntimedCreation(H5P_DATASET_CREATE).get(), H5P_DEFAULT),
             H5Dclose);
   FS_THROW_UNLESS(ds.ok(), path, ": cannot create dataset '", name, "'");
   std::size_t count = 1;
@@ -385,9 +397,9 @@ void File::WriteString(const std::string& name, const std::string& text) {
   H5Tset_strpad(type.get(), H5T_STR_NULLPAD);
   Handle space(H5Screate(H5S_SCALAR), H5Sclose);
   if (H5Lexists(id_, name.c_str(), H5P_DEFAULT) > 0) H5Ldelete(id_, name.c_str(), H5P_DEFAULT);
-  Handle ds(
-      H5Dcreate2(id_, name.c_str(), type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
-      H5Dclose);
+  Handle ds(H5Dcreate2(id_, name.c_str(), type.get(), space.get(), H5P_DEFAULT,
+                       UntimedCreation(H5P_DATASET_CREATE).get(), H5P_DEFAULT),
+            H5Dclose);
   std::string padded = text.empty() ? std::string(1, '\0') : text;
   FS_THROW_UNLESS(
       ds.ok() && H5Dwrite(ds.get(), type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, padded.data()) >= 0,

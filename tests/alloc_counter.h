@@ -29,7 +29,8 @@ void* operator new[](std::size_t n) { return operator new(n); }
 void operator delete[](void* p) noexcept { std::free(p); }
 void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
 
-#if defined(FORESIGHT_ALLOC_COUNTER_MALLOC) && defined(__GLIBC__) && !defined(__SANITIZE_ADDRESS__)
+#if defined(FORESIGHT_ALLOC_COUNTER_MALLOC) && defined(__GLIBC__) && \
+    !defined(__SANITIZE_ADDRESS__) && !defined(FORESIGHT_SANITIZE)
 #define FORESIGHT_COUNTS_MALLOC 1
 extern "C" {
 void* __libc_malloc(std::size_t);
