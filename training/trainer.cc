@@ -155,9 +155,10 @@ std::string WithoutChecksum(const std::string& path, const std::string& bytes) {
   const bool has_trailer = n >= 16 && bytes.compare(n - 16, 8, kChecksumMagic, 8) == 0;
   // Required: without it a corrupted file would reach LibTorch's archive reader, which is not
   // hardened against damaged input (it can crash the process; docs/robustness.md).
-  FS_THROW_UNLESS(has_trailer, path,
-                  ": checkpoint has no checksum trailer (truncated, corrupted, or written by a build "
-                  "older than the checksum); delete it to start again, or restore a copy");
+  FS_THROW_UNLESS(
+      has_trailer, path,
+      ": checkpoint has no checksum trailer (truncated, corrupted, or written by a build "
+      "older than the checksum); delete it to start again, or restore a copy");
   std::uint64_t stored = 0;
   for (int i = 0; i < 8; ++i)
     stored |= static_cast<std::uint64_t>(static_cast<unsigned char>(bytes[n - 8 + i])) << (8 * i);
