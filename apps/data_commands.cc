@@ -1,5 +1,6 @@
 // `foresight data convert | generate | info`
 
+#include <cmath>
 #include <iostream>
 
 #include "apps/commands.h"
@@ -31,6 +32,10 @@ void AddDataCommands(CLI::App* app) {
       ->add_option("--seconds-per-step", convert_args->seconds_per_step, "seconds per frame step")
       ->check(CLI::PositiveNumber);
   convert->callback([convert_args] {
+    // CLI::PositiveNumber lets nan through (nan <= 0 is false).
+    FS_THROW_UNLESS(std::isfinite(convert_args->seconds_per_step),
+                    "--seconds-per-step: ", convert_args->seconds_per_step,
+                    " is not a finite number > 0");
     TrackSet all;
     all.seconds_per_step = convert_args->seconds_per_step;
     for (const auto& in : convert_args->inputs) {

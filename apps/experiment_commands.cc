@@ -3,11 +3,11 @@
 // config.yaml) and calls its step; no command here names a method.
 
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 
 #include "apps/commands.h"
 #include "core/error.h"
+#include "core/file_io.h"
 #include "training/kinds.h"
 
 namespace foresight::app {
@@ -87,10 +87,7 @@ void AddExperimentCommands(CLI::App* app, std::shared_ptr<const ExperimentRegist
       std::cout << text;
       return;
     }
-    std::ofstream out(*docs_out);
-    out << text;
-    out.close();
-    FS_THROW_UNLESS(out.good(), *docs_out, ": cannot write the config reference");
+    WriteFileAtomically(*docs_out, text);
   });
 
   auto* kinds =

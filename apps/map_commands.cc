@@ -2,9 +2,12 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
+#include <iterator>
 #include <memory>
 
 #include "apps/commands.h"
@@ -25,6 +28,14 @@ struct FuseArgs {
   std::string output, base;
   double threshold = FusionOptions{}.variance_threshold;
 };
+
+/// Whether two files hold the same bytes (a copied artifact under another name).
+bool SameBytes(const std::string& a, const std::string& b) {
+  if (fs::file_size(a) != fs::file_size(b)) return false;
+  std::ifstream fa(a, std::ios::binary), fb(b, std::ios::binary);
+  return std::equal(std::istreambuf_iterator<char>(fa), std::istreambuf_iterator<char>(),
+                    std::istreambuf_iterator<char>(fb));
+}
 }  // namespace
 
 void AddMapCommands(CLI::App* app) {
@@ -53,6 +64,17 @@ void AddMapCommands(CLI::App* app) {
         FS_THROW_UNLESS(!fs::equivalent(args->inputs[i], args->inputs[j]), args->inputs[i],
                         ": the same map is given twice (as input ", j + 1, " and ", i + 1,
                         "); fusing a map with itself counts its evidence twice");
+    for (std::size_t i = 0; i < args->inputs.size(); ++i)
+      for (std::size_t j = 0; j < i; ++j)
+        FS_THROW_UNLESS(!SameBytes(args->inputs[i], args->inputs[j]), args->inputs[i],
+                        ": holds the same bytes as input ", j + 1, " (", args->inputs[j],
+                        "), a copy of one map; fusing a map with itself counts its evidence twice");
+    std::vector<std::string> read = args->inputs;
+    if (!args->base.empty()) read.push_back(args->base);
+    for (const std::string& in : read)
+      FS_THROW_UNLESS(!fs::exists(args->output) || !fs::equivalent(args->output, in), args->output,
+                      ": the output is also an input (", in,
+                      "); write the fused map to a new file");
     std::vector<HingeMap> maps;
     for (const auto& p : args->inputs) maps.push_back(HingeMap::Load(p));
     std::vector<const HingeMap*> ptrs;

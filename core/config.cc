@@ -1,10 +1,13 @@
 #include "core/config.h"
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <map>
+
+#include "core/one_line.h"
 
 namespace foresight::config {
 
@@ -147,9 +150,23 @@ void ApplyOverride(YAML::Node root, const std::string& assignment) {
 }
 
 namespace {
+/// A config scalar (key or value) is one line of text: a line break or another control character
+/// (tab aside) is refused here, so that no later message quoting the value spans lines.
+void RefuseControlCharacters(const YAML::Node& scalar, const std::string& source) {
+  const std::string& text = scalar.Scalar();
+  const bool bad = std::any_of(text.begin(), text.end(), [](char ch) {
+    const auto u = static_cast<unsigned char>(ch);
+    return (u < 0x20 && ch != '\t') || u == 0x7f;
+  });
+  FS_THROW_UNLESS(!bad, source, ":", scalar.Mark().line + 1, ": '", OneLine(text),
+                  "' holds a line break or control character; config keys and values are one line");
+}
+
 /// yaml-cpp keeps both entries of a duplicated key and answers lookups with the first, so a
-/// repeated key would be silently ignored: refuse it, naming both lines.
+/// repeated key would be silently ignored: refuse it, naming both lines. Keys must be scalars
+/// (names), and every scalar one line (RefuseControlCharacters).
 void RefuseDuplicateKeys(const YAML::Node& node, const std::string& source) {
+  if (node.IsScalar()) RefuseControlCharacters(node, source);
   if (node.IsSequence()) {
     for (const auto& item : node) RefuseDuplicateKeys(item, source);
     return;
@@ -157,9 +174,12 @@ void RefuseDuplicateKeys(const YAML::Node& node, const std::string& source) {
   if (!node.IsMap()) return;
   std::map<std::string, int> seen;  // key -> 1-based line
   for (const auto& item : node) {
+    const int line = item.first.Mark().line + 1;
+    FS_THROW_UNLESS(item.first.IsScalar() || item.first.IsNull(), source, ":", line, ": a key is ",
+                    item.first.IsSequence() ? "a list" : "a mapping", "; config keys are names");
     if (item.first.IsScalar()) {
+      RefuseControlCharacters(item.first, source);
       const std::string key = item.first.Scalar();
-      const int line = item.first.Mark().line + 1;
       const auto [it, inserted] = seen.emplace(key, line);
       FS_THROW_UNLESS(inserted, source, ":", line, ": key '", key, "' is repeated (first at line ",
                       it->second, "); give each key once");
@@ -174,7 +194,7 @@ YAML::Node ParseYaml(const std::string& text, const std::string& source) {
   try {
     node = YAML::Load(text);
   } catch (const YAML::Exception& e) {
-    Fail(source, ":", e.mark.line + 1, ": invalid YAML: ", e.msg);
+    Fail(source, ":", e.mark.line + 1, ": invalid YAML: ", OneLine(e.msg));
   }
   RefuseDuplicateKeys(node, source);
   return node;

@@ -45,8 +45,31 @@ void SyncParentDirectory(const std::string& path) {
 }
 }  // namespace
 
-void WriteThroughTemporary(const std::string& path,
+namespace {
+/// The file an atomic write replaces: `path`, or the file a symbolic link at `path` points to (the
+/// link stays). Refuses an existing target that is not a regular file (a device such as
+/// /dev/full, a directory, a socket): renaming over it would replace it.
+std::string ReplacedFile(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::path target = path;
+  for (int hops = 0; fs::is_symlink(fs::symlink_status(target, ec)); ++hops) {
+    FS_THROW_UNLESS(hops < 40, path, ": too many levels of symbolic links");
+    const fs::path next = fs::read_symlink(target, ec);
+    FS_THROW_UNLESS(!ec, path, ": cannot read the symbolic link (", ec.message(), ")");
+    target = next.is_absolute() ? next : target.parent_path() / next;
+  }
+  const fs::file_status st = fs::status(target, ec);
+  FS_THROW_UNLESS(!fs::exists(st) || fs::is_regular_file(st), path,
+                  ": exists and is not a regular file (a device, directory or socket); "
+                  "refusing to replace it, give a file path");
+  return target.string();
+}
+}  // namespace
+
+void WriteThroughTemporary(const std::string& path_given,
                            const std::function<void(const std::string& tmp)>& write) {
+  const std::string path = ReplacedFile(path_given);
   const std::string tmp = path + ".tmp";
   try {
     write(tmp);

@@ -13,7 +13,9 @@ void WriteFileBytes(const std::string& path, const char* data, std::size_t size)
 
 /// `write` fills the temporary file it is given (path.tmp), which is then renamed to `path` and
 /// the directory entry flushed; on any failure the temporary file is removed, `path` is left as
-/// it was and the Error propagates. Every atomic writer goes through this.
+/// it was and the Error propagates. A symbolic link at `path` is written through (the file it
+/// points to is replaced, the link stays); an existing `path` that is not a regular file (e.g.
+/// /dev/full, a directory) is refused. Every atomic writer goes through this.
 void WriteThroughTemporary(const std::string& path,
                            const std::function<void(const std::string& tmp)>& write);
 

@@ -96,6 +96,10 @@ cv::Mat ReadGrey(const std::string& path) {
   return img;
 }
 
+/// Ids and frames are integers; beyond 2^53 a double no longer holds every integer (and the
+/// conversions to integer types would overflow).
+constexpr double kMaxInteger = 9007199254740992.0;  // 2^53
+
 }  // namespace
 
 TrackSet ReadThorTracks(const std::string& path) {
@@ -114,8 +118,8 @@ TrackSet ReadThorTracks(const std::string& path) {
         f.size());
     const double t = Field(f[0], path, number, "time");
     const double id = Field(f[1], path, number, "person_id");
-    FS_THROW_UNLESS(id == std::floor(id), path, ":", number, ": person_id '", f[1],
-                    "' is not an integer");
+    FS_THROW_UNLESS(id == std::floor(id) && std::abs(id) <= kMaxInteger, path, ":", number,
+                    ": person_id '", f[1], "' is not an integer in [-2^53, 2^53]");
     by_id[static_cast<std::int64_t>(id)].push_back(
         {t, Field(f[2], path, number, "x"), Field(f[3], path, number, "y"), number});
   }
@@ -144,8 +148,10 @@ TrackSet ReadEthObsmat(const std::string& path, double annotation_step) {
                     f.size());
     const double frame = Field(f[0], path, number, "frame");
     const double id = Field(f[1], path, number, "ped_id");
-    FS_THROW_UNLESS(id == std::floor(id) && frame == std::floor(frame), path, ":", number,
-                    ": frame and ped_id must be integers");
+    FS_THROW_UNLESS(id == std::floor(id) && frame == std::floor(frame) &&
+                        std::abs(id) <= kMaxInteger && std::abs(frame) <= kMaxInteger,
+                    path, ":", number, ": frame '", f[0], "' and ped_id '", f[1],
+                    "' must be integers in [-2^53, 2^53]");
     rows.push_back({frame, static_cast<std::int64_t>(id), Field(f[2], path, number, "pos_x"),
                     Field(f[4], path, number, "pos_y"), number});
   }

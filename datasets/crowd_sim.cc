@@ -339,7 +339,8 @@ CrowdScenarioConfig ReadImplicitCrowdsScenario(const std::string& path) {
   const std::optional<long long> count = ParseInteger(lines[2].second[0]);
   FS_THROW_UNLESS(count && *count >= 1, path, ":", lines[2].first, ": '", lines[2].second[0],
                   "' is not a positive agent count");
-  FS_THROW_UNLESS(lines.size() == static_cast<std::size_t>(3 + *count), path,
+  // lines.size() >= 3 here; 3 + *count could overflow for a huge count.
+  FS_THROW_UNLESS(lines.size() - 3 == static_cast<unsigned long long>(*count), path,
                   ": the header announces ", *count, " agents but the file has ", lines.size() - 3,
                   " agent lines");
   s.walls.clear();

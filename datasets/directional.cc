@@ -331,7 +331,9 @@ DirectionalSamples ReadEdinburghTracks(const std::string& path, const HeadingFil
       // Pixels (y down) -> metres in a right-handed frame with y up, origin at the bottom-left
       // pixel; frames -> seconds since the earliest frame of the file at the nominal rate.
       const double dx = (b.x - a.x) * s, dy = -(b.y - a.y) * s;
-      const double dt = static_cast<double>(b.frame - a.frame) / kEdinburghFramesPerSecond;
+      // Frame differences in double: frames anywhere in the long long range must not overflow.
+      const double dt =
+          (static_cast<double>(b.frame) - static_cast<double>(a.frame)) / kEdinburghFramesPerSecond;
       if (dt > filter.max_gap) {
         ++stats.dropped_gap;  // starts a new segment: the step across the gap is not a heading
         ++segment;
@@ -348,7 +350,8 @@ DirectionalSamples ReadEdinburghTracks(const std::string& path, const HeadingFil
         ++stats.dropped_standing;
       } else {
         out.Add(b.x * s, (kEdinburghImageHeight - 1 - b.y) * s,
-                static_cast<double>(b.frame - frame0) / kEdinburghFramesPerSecond,
+                (static_cast<double>(b.frame) - static_cast<double>(frame0)) /
+                    kEdinburghFramesPerSecond,
                 WrapAngle(std::atan2(dy, dx)), segment);
         ++stats.kept;
       }

@@ -53,10 +53,13 @@ TrackSet ReadEthUcy(const std::string& path, double seconds_per_step, EthUcyRead
     Row r{};
     r.frame = ParseField(tok[0], path, line, kColumns[0]);
     const double ped = ParseField(tok[1], path, line, kColumns[1]);
-    FS_THROW_UNLESS(ped == std::floor(ped), path, ":", line, ": ped_id is not an integer: '",
-                    tok[1], "'");
-    FS_THROW_UNLESS(r.frame == std::floor(r.frame), path, ":", line,
-                    ": frame_id is not an integer: '", tok[0], "'");
+    // Ids and frames are integers; beyond 2^53 a double no longer holds every integer (and the
+    // conversions below would overflow).
+    constexpr double kMaxInteger = 9007199254740992.0;  // 2^53
+    FS_THROW_UNLESS(ped == std::floor(ped) && std::abs(ped) <= kMaxInteger, path, ":", line,
+                    ": ped_id is not an integer in [-2^53, 2^53]: '", tok[1], "'");
+    FS_THROW_UNLESS(r.frame == std::floor(r.frame) && std::abs(r.frame) <= kMaxInteger, path, ":",
+                    line, ": frame_id is not an integer in [-2^53, 2^53]: '", tok[0], "'");
     r.ped = static_cast<std::int64_t>(ped);
     r.x = ParseField(tok[2], path, line, kColumns[2]);
     r.y = ParseField(tok[3], path, line, kColumns[3]);

@@ -88,8 +88,9 @@ DemoSet ReadLasaShape(const std::string& lasa_dir, const std::string& shape) {
     }
     FS_THROW_UNLESS(count == v.size(), path, ":", line, ": ", count, " fields, expected ", v.size(),
                     " (", kHeader, ")");
-    FS_THROW_UNLESS(v[0] == std::floor(v[0]) && v[0] >= 0, path, ":", line,
-                    ": demo index is not a non-negative integer: ", v[0]);
+    // At most 2^53: larger doubles do not hold every integer and overflow the size_t conversion.
+    FS_THROW_UNLESS(v[0] == std::floor(v[0]) && v[0] >= 0 && v[0] <= 9007199254740992.0, path, ":",
+                    line, ": demo index is not a non-negative integer (at most 2^53): ", v[0]);
     const auto demo = static_cast<std::size_t>(v[0]);
     const std::size_t current = demos.empty() ? 0 : demos.size() - 1;
     FS_THROW_UNLESS(demo == demos.size() || (!demos.empty() && demo == current), path, ":", line,

@@ -31,17 +31,21 @@ seed_corpus() {
   rm -rf "$dir" && mkdir -p "$dir"
   cp "$ROOT/tests/fuzz/corpus/$target/"* "$dir/" 2>/dev/null || true
   [ -d "$DATA" ] || return 0
-  local n=0
+  local n=0 per_line
   while IFS=$'\t' read -r name prefix glob; do
     [ "$name" = "$target" ] || continue
+    [ "$prefix" != - ] || prefix=""
+    per_line=0
     for f in $DATA/$glob; do
       [ -f "$f" ] || continue
       { printf '%b' "$prefix"; head -c 4096 "$f"; } > "$dir/data_$((n++))"
-      ((n < 8)) || break
+      ((++per_line < 8)) || break
     done
-  done < <(grep -v '^#' "$ROOT/tests/fuzz/data_seeds.txt" 2>/dev/null || true)
+  done < <(grep -v -e '^#' -e '^$' "$ROOT/tests/fuzz/data_seeds.txt" 2>/dev/null || true)
 }
 
+# Third-party leaks LeakSanitizer should not report (urdfdom's parser): tests/fuzz/lsan.supp.
+export LSAN_OPTIONS="suppressions=$ROOT/tests/fuzz/lsan.supp${LSAN_OPTIONS:+:$LSAN_OPTIONS}"
 STATUS=0
 printf '%-24s %8s %12s  %s\n' target seconds executions result
 for t in "${TARGETS[@]}"; do

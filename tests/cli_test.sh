@@ -33,6 +33,10 @@ expect_error "num_tracks" data generate -o "$TMP/x.h5" num_tracks=-3
 expect_error "not found" data info "$TMP/none.h5"
 printf '0\t1\t0.0\t0.0\n10\t1\tzz\t1.0\n' > "$TMP/bad.txt"
 expect_error "bad.txt:2" data convert "$TMP/bad.txt" -o "$TMP/bad.h5"
+printf '0\t1\t0.0\t0.0\n10\t1\t1.0\t1.0\n' > "$TMP/good.txt"
+expect_error "seconds-per-step: nan" data convert "$TMP/good.txt" -o "$TMP/nan.h5" --seconds-per-step nan
+expect_error "not a regular file" data convert "$TMP/good.txt" -o /dev/null
+[ -c /dev/null ] || fail "data convert -o /dev/null replaced the device"
 
 # Occupancy maps: torch-free, so in both builds.
 json_number() {  # json_number FILE KEY: the number of "KEY": on its own line
@@ -71,6 +75,11 @@ check_json "$FUS/eval.json"
 "$BIN" map info "$TMP/fused.h5" | grep -q '"model_type": "occupancy.fast_bhm"' || fail "map info of a fused map"
 expect_error "variance-threshold" map fuse "$FUS/single.h5" "$FUS/fuse_once.h5" -o "$TMP/nan.h5" --variance-threshold nan
 expect_error "given twice" map fuse "$FUS/single.h5" "$FUS/single.h5" -o "$TMP/twice.h5"
+cp "$FUS/single.h5" "$TMP/single_copy.h5"
+expect_error "same bytes as input 1" map fuse "$FUS/single.h5" "$TMP/single_copy.h5" -o "$TMP/twice.h5"
+expect_error "the output is also an input" map fuse "$FUS/single.h5" "$FUS/fuse_once.h5" -o "$FUS/single.h5"
+expect_error "not a regular file" map fuse "$FUS/single.h5" "$FUS/fuse_once.h5" -o /dev/null
+[ -c /dev/null ] || fail "map fuse -o /dev/null replaced the device"
 "$BIN" train configs/occupancy/synthetic.yaml features.spacing=0.6 --run-dir "$TMP/occ_coarse" >/dev/null 2>&1 || fail "coarse train"
 expect_error "feature grid" map fuse "$OCC/model.h5" "$TMP/occ_coarse/model.h5" -o "$TMP/refused.h5"
 grep -q "occ_coarse/model.h5" "$TMP/err" || fail "refused fusion does not name the map"
@@ -96,6 +105,9 @@ expect_error "'navigation' has no export step" export "$NAV"
 expect_error "'navigation' has no eval step" eval "$NAV"
 expect_error "robot_goal" navigate configs/navigation/sim2.yaml "methods=[reactive]" "scenario.robot_goal=[30, 0]" --run-dir "$TMP/nav3"
 expect_error "'max_time'" navigate configs/navigation/sim2.yaml max_time=3e8 --run-dir "$TMP/nav6"
+expect_error "raster cells" navigate configs/navigation/sim2.yaml "scenario.extent=[-1e4, 1e4, -1e4, 1e4]" --run-dir "$TMP/nav7"
+expect_error "record_duration" navigate configs/navigation/sim2.yaml predictor.record_duration=1e9 --run-dir "$TMP/nav8"
+expect_error "simulation steps" navigate configs/navigation/sim2.yaml predictor.record_episodes=10000 predictor.record_duration=80000 --run-dir "$TMP/nav9"
 # Manipulation (torch-free): the synthetic quickstart with the built-in Panda, and bad input.
 PLAN="$TMP/plan"
 "$BIN" plan default problems.synthetic_count=1 --run-dir "$PLAN" >/dev/null 2>"$TMP/plan.log" || { cat "$TMP/plan.log"; fail "plan"; }
@@ -143,6 +155,17 @@ if [ "${FORESIGHT_WITH_TORCH:-1}" = "1" ] || [ "${FORESIGHT_WITH_TORCH}" = "ON" 
   for f in eval.json training_summary.json; do check_json "$RUN/$f"; done
   "$BIN" train default "${TINY[@]}" train.epochs=3 --run-dir "$RUN" --resume >/dev/null 2>&1 && fail "resume with another config must fail"
   expect_error "--resume" train default "${TINY[@]}" --run-dir "$RUN"  # a fresh start does not mix runs
+  # Resuming a finished run changes nothing, and keeps the summary of the run that finished.
+  cp "$RUN/training_summary.json" "$TMP/summary_before.json"
+  "$BIN" train default "${TINY[@]}" --run-dir "$RUN" --resume >/dev/null 2>&1 || fail "resume of a finished run"
+  cmp -s "$RUN/training_summary.json" "$TMP/summary_before.json" || fail "resuming a finished run rewrote its summary"
+  # A run stopped while writing its first checkpoint (only a .tmp left) can start again, and
+  # --resume without last.pt starts at epoch 1.
+  mkdir -p "$TMP/tmp_only/checkpoints" && : > "$TMP/tmp_only/checkpoints/last.pt.tmp"
+  "$BIN" train default "${TINY[@]}" train.epochs=1 --run-dir "$TMP/tmp_only" >/dev/null 2>&1 || fail "a run dir holding only a .tmp is refused"
+  rm "$TMP/tmp_only/checkpoints/last.pt"
+  "$BIN" train default "${TINY[@]}" train.epochs=1 --run-dir "$TMP/tmp_only" --resume >/dev/null 2>"$TMP/tmp_only.err" || { cat "$TMP/tmp_only.err"; fail "--resume without last.pt"; }
+  grep -q "starting at epoch 1" "$TMP/tmp_only.err" "$TMP/tmp_only/log.txt" || fail "--resume without last.pt does not say it starts over"
   "$BIN" export "$RUN" >/dev/null
   "$BIN" eval "$RUN" | grep -q '"cv_nll"' || fail "eval"
   expect_error "data.synthetic.num_tracks = 120, not 100" eval "$RUN" data.synthetic.num_tracks=100

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/file_io.h"
 #include "core/log.h"
 
 namespace foresight {
@@ -16,6 +17,16 @@ std::string ReadText(const std::string& path) {
   ss << in.rdbuf();
   return ss.str();
 }
+
+namespace {
+/// A folder holds something an earlier run completed: any entry but a temporary file (NAME.tmp),
+/// which a run killed while writing leaves behind and which never replaced a complete file.
+bool HoldsCompleteFile(const fs::path& dir) {
+  for (const fs::directory_entry& e : fs::directory_iterator(dir))
+    if (e.path().extension() != ".tmp") return true;
+  return false;
+}
+}  // namespace
 
 void StartRunDirectory(const std::string& run_dir, const std::string& resolved_yaml, bool resume,
                        const RunDirectoryRules& rules) {
@@ -31,16 +42,13 @@ void StartRunDirectory(const std::string& run_dir, const std::string& resolved_y
   } else {
     for (const std::string& marker : rules.markers) {
       const fs::path p = fs::path(run_dir) / marker;
-      const bool present = fs::is_directory(p) ? !fs::is_empty(p) : fs::exists(p);
+      const bool present = fs::is_directory(p) ? HoldsCompleteFile(p) : fs::exists(p);
       FS_THROW_UNLESS(!present, run_dir, ": already holds a run (", marker, "); ",
                       rules.resumable ? "continue it with --resume, or " : "",
                       "use a new or empty --run-dir");
     }
     fs::create_directories(run_dir);
-    std::ofstream out(config_path);
-    out << resolved_yaml;
-    out.close();
-    FS_THROW_UNLESS(out.good(), config_path, ": cannot write the resolved config");
+    WriteFileAtomically(config_path, resolved_yaml);
   }
   log::SetFile(run_dir + "/log.txt");
 }

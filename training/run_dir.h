@@ -10,8 +10,9 @@ namespace foresight {
 
 /// What shows that a directory already holds a run of a kind, and whether it can be continued.
 struct RunDirectoryRules {
-  /// Files or folders (relative to the run directory) an earlier run leaves; an empty folder
-  /// counts as absent (a run killed before its first checkpoint left nothing to continue).
+  /// Files or folders (relative to the run directory) an earlier run leaves; a folder holding
+  /// nothing but temporary files (NAME.tmp) counts as absent (a run killed before its first
+  /// checkpoint left nothing to continue).
   std::vector<std::string> markers;
   bool resumable = false;  ///< the kind continues a killed run with --resume
 };

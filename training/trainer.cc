@@ -82,9 +82,19 @@ std::string TrainingSummary::ToJson() const {
   return os.str();
 }
 
+void WriteTrainingSummary(const std::string& path, const TrainingSummary& s) {
+  if (s.reason == TerminationReason::kAlreadyComplete && fs::exists(path)) return;
+  WriteFileAtomically(path, s.ToJson());
+}
+
 namespace {
 std::atomic<bool> g_interrupted{false};
-extern "C" void SetInterrupted(int) { g_interrupted = true; }
+extern "C" void SetInterrupted(int sig) {
+  if (g_interrupted.exchange(true)) {  // the second signal: stop waiting for the next batch
+    std::signal(sig, SIG_DFL);
+    std::raise(sig);
+  }
+}
 }  // namespace
 
 ScopedInterruptFlag::ScopedInterruptFlag() {
@@ -187,7 +197,8 @@ void SaveCheckpoint(const std::string& path, torch::nn::Module& module,
   try {
     WriteFileAtomically(path, WithChecksum(bytes.str()));
   } catch (const Error& e) {
-    Fail(e.what(), "; the previous checkpoint is kept");
+    Fail(e.what(), fs::exists(path) ? "; the previous checkpoint is kept"
+                                    : "; no checkpoint of this run was saved yet");
   }
 }
 
@@ -325,10 +336,9 @@ void TruncateMetrics(const std::string& path, int epoch) {
     if (*row_epoch <= epoch) keep.push_back(line);
   }
   in.close();
-  std::ofstream out(path, std::ios::trunc);
-  for (const auto& l : keep) out << l << "\n";
-  out.close();
-  FS_THROW_UNLESS(out.good(), path, ": cannot rewrite the metrics");
+  std::string text;
+  for (const auto& l : keep) text += l + "\n";
+  WriteFileAtomically(path, text);
 }
 
 /// Appends one row (starting the file with the header when it is missing) and flushes it to disk.
@@ -373,6 +383,17 @@ TrainingSummary Train(TrainingTask* task, const TrainConfig& c, const RunPaths& 
                          torch::optim::AdamOptions(c.learning_rate).weight_decay(c.weight_decay));
   if (distributed) CheckRanksAgree(group, task, c, seed, resume);
   State state;
+  // A run killed (or stopped by a full disk) before its first complete last.pt has nothing to
+  // continue: --resume then starts at epoch 1 (only rank 0's disk holds checkpoints).
+  if (resume) {
+    const bool has_checkpoint =
+        FromRankZero(group, writer && fs::exists(run.Checkpoint()) ? 1.0 : 0.0) == 1.0;
+    if (!has_checkpoint && writer)
+      log::Warn(run.Checkpoint(),
+                " does not exist (the run stopped before its first complete "
+                "checkpoint); starting at epoch 1");
+    resume = has_checkpoint;
+  }
   if (resume) {
     state = distributed ? LoadCheckpointEverywhere(group, run.Checkpoint(), &module, &opt)
                         : LoadCheckpoint(run.Checkpoint(), &module, &opt);

@@ -52,6 +52,10 @@ struct TrainingSummary {
   std::string ToJson() const;
 };
 
+/// Writes `s` to `path` (training_summary.json) atomically. A run resumed after it had finished
+/// (reason kAlreadyComplete) keeps the summary its finishing invocation wrote, if there is one.
+void WriteTrainingSummary(const std::string& path, const TrainingSummary& s);
+
 /// Files of a run directory.
 struct RunPaths {
   std::string dir;
@@ -70,6 +74,9 @@ struct TrainHooks {
 
 /// While alive, SIGINT and SIGTERM set flag() (for TrainHooks::interrupt) instead of ending the
 /// process; the handlers that were there before are restored on destruction. One at a time.
+/// The flag is polled between batches, so a signal during loading or model building waits for
+/// the first batch; a second signal ends the process at once (the default action: a run loses at
+/// most its epoch in progress, as with kill -9).
 class ScopedInterruptFlag {
  public:
   ScopedInterruptFlag();

@@ -12,6 +12,7 @@
 #include <fstream>
 #include <limits>
 #include <mutex>
+#include <set>
 #include <sstream>
 #include <utility>
 
@@ -61,6 +62,7 @@ SerialChain SerialChain::FromText(const std::string& urdf_text, const std::strin
                                   const std::string& base_link, const std::string& tip_link,
                                   std::vector<BodyPoint> points) {
   urdf::ModelInterfaceSharedPtr urdf;
+  const urdf_util::FreeLinkCyclesOnExit free_cycles(urdf);  // a looped URDF must not leak
   {
     urdf_util::CaptureUrdfdomErrors errors;
     urdf = urdf::parseURDF(urdf_text);
@@ -81,12 +83,17 @@ SerialChain SerialChain::FromText(const std::string& urdf_text, const std::strin
   // The path tip -> base through the parent joints.
   std::vector<urdf::JointConstSharedPtr> path;
   std::vector<std::string> links = {tip_link};
+  std::set<std::string> seen = {tip_link};
   for (urdf::LinkConstSharedPtr link = urdf->getLink(tip_link); link->name != base_link;) {
     FS_THROW_UNLESS(link->parent_joint != nullptr, source, ": link '", base_link,
                     "' is not an ancestor of link '", tip_link, "' (the chain from '",
                     urdf->getRoot()->name, "' to the tip does not pass through it)");
     path.push_back(link->parent_joint);
     link = urdf->getLink(link->parent_joint->parent_link_name);
+    // urdfdom accepts a loop of joints that is not connected to the root.
+    FS_THROW_UNLESS(seen.insert(link->name).second, source, ": the parent joints above link '",
+                    tip_link, "' form a loop through link '", link->name,
+                    "' (expected a tree from the root)");
     links.push_back(link->name);
   }
   std::reverse(path.begin(), path.end());

@@ -8,12 +8,15 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
+#include <optional>
 #include <regex>
 #include <set>
 #include <sstream>
 
 #include "core/error.h"
+#include "core/one_line.h"
 #include "core/parse.h"
 
 namespace foresight::manipulation {
@@ -345,13 +348,22 @@ const std::vector<std::string>& MbmArmJointNames() {
 
 ManipulationProblem LoadMbmProblem(const std::string& scene_yaml, const std::string& request_yaml) {
   ManipulationProblem p;
-  p.world = ReadScene(scene_yaml);
-  ReadRequest(request_yaml, &p.start, &p.goal);
+  try {
+    p.world = ReadScene(scene_yaml);
+    ReadRequest(request_yaml, &p.start, &p.goal);
+  } catch (const Error& e) {
+    throw Error(OneLine(e.what()));  // names, keys and values from the files may hold newlines
+  }
   const fs::path scene(scene_yaml);
   p.family = scene.parent_path().filename().string();
   std::smatch m;
   const std::string stem = scene.filename().string();
-  if (std::regex_match(stem, m, std::regex(R"(scene0*(\d+)\.yaml)"))) p.index = std::stoi(m[1]);
+  if (std::regex_match(stem, m, std::regex(R"(scene0*(\d+)\.yaml)"))) {
+    const std::optional<long long> index = ParseInteger(m[1]);
+    FS_THROW_UNLESS(index && *index <= std::numeric_limits<int>::max(), scene_yaml,
+                    ": problem number '", m[1].str(), "' in the file name is out of range");
+    p.index = static_cast<int>(*index);
+  }
   p.source = scene_yaml + ", " + request_yaml;
   return p;
 }
@@ -465,7 +477,9 @@ std::vector<ManipulationProblem> LoadCompactFamily(const std::string& json_path,
   try {
     return ReadCompactFamily(json_path, first, last);
   } catch (const YAML::Exception& e) {
-    Fail(json_path, ": unexpected structure: ", e.msg);
+    Fail(json_path, ": unexpected structure: ", OneLine(e.msg));
+  } catch (const Error& e) {
+    throw Error(OneLine(e.what()));  // names, keys and values from the file may hold newlines
   }
 }
 

@@ -208,6 +208,7 @@ RobotModel RobotModel::FromTexts(const std::string& urdf_text, const std::string
 
   // Kinematic tree (urdfdom), depth first from the root so parents precede children.
   urdf::ModelInterfaceSharedPtr urdf;
+  const urdf_util::FreeLinkCyclesOnExit free_cycles(urdf);  // a looped URDF must not leak
   {
     urdf_util::CaptureUrdfdomErrors errors;
     urdf = urdf::parseURDF(urdf_text);

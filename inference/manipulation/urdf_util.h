@@ -42,6 +42,28 @@ class CaptureUrdfdomErrors : public console_bridge::OutputHandler {
   std::string messages_;
 };
 
+/// Frees a parsed model when it goes out of scope even if its links form a loop: urdfdom links own
+/// their children (shared_ptr), and urdfdom accepts a loop of joints that is not connected to the
+/// root, which then is a reference cycle (a leak). Clears every link's child lists on destruction;
+/// use it where the model is parsed and drop the model with it.
+class FreeLinkCyclesOnExit {
+ public:
+  explicit FreeLinkCyclesOnExit(const urdf::ModelInterfaceSharedPtr& model) : model_(model) {}
+  ~FreeLinkCyclesOnExit() {
+    if (!model_) return;
+    for (auto& [name, link] : model_->links_) {
+      if (!link) continue;
+      link->child_links.clear();
+      link->child_joints.clear();
+    }
+  }
+  FreeLinkCyclesOnExit(const FreeLinkCyclesOnExit&) = delete;
+  FreeLinkCyclesOnExit& operator=(const FreeLinkCyclesOnExit&) = delete;
+
+ private:
+  const urdf::ModelInterfaceSharedPtr& model_;
+};
+
 inline Eigen::Isometry3d ToIsometry(const urdf::Pose& pose) {
   Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
   X.linear() =

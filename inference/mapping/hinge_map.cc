@@ -66,6 +66,12 @@ HingeMap::HingeMap(HingeMapKind kind, HingeGrid grid, HingeWeights weights, doub
     FS_THROW_UNLESS(weights_.covariance.rows() == t && weights_.covariance.cols() == t,
                     ModelType(kind_), ": covariance is ", weights_.covariance.rows(), " x ",
                     weights_.covariance.cols(), ", expected ", t, " x ", t);
+    // Only the diagonal is checked below; a NaN off-diagonal entry made every query NaN.
+    for (Eigen::Index j = 0; j < t; ++j)
+      for (Eigen::Index i = 0; i < t; ++i)
+        FS_THROW_UNLESS(std::isfinite(weights_.covariance(i, j)), ModelType(kind_),
+                        ": covariance entry (", i, ", ", j, ") is ", weights_.covariance(i, j),
+                        "; expected finite values");
     weights_.variance = weights_.covariance.diagonal();
   } else {
     weights_.covariance.resize(0, 0);

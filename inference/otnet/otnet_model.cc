@@ -232,6 +232,10 @@ OtnetModel OtnetModel::Load(const std::string& path) {
       FS_THROW_UNLESS(o.shape.size() == 1 && o.Size() == static_cast<std::size_t>(2 * num_basis),
                       path, ": dataset /model/log_scale_offset has ", o.Size(),
                       " values, expected ", 2 * num_basis, " (2 num_basis)");
+      // exp(clamp(z - o) + o) must stay finite (and its square, the variance): |o| <= 100.
+      for (std::size_t i = 0; i < o.Size(); ++i)
+        FS_THROW_UNLESS(std::abs(o.data[i]) <= 100, path, ": /model/log_scale_offset[", i, "] is ",
+                        o.data[i], "; expected a log scale from -100 to 100");
       model.SetLogScaleOffset(
           Eigen::Map<const Eigen::VectorXd>(o.data.data(), static_cast<Eigen::Index>(o.Size())));
     }

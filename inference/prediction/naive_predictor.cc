@@ -1,5 +1,7 @@
 #include "inference/prediction/naive_predictor.h"
 
+#include <cmath>
+
 #include "core/ego_frame.h"
 #include "core/error.h"
 #include "inference/engine/artifact.h"
@@ -19,6 +21,12 @@ NaivePredictor NaivePredictor::Load(const std::string& path) {
   p.input_std_ = f.ReadMatrixD("/normalisation/input_std", in, 1).col(0);
   FS_THROW_UNLESS((p.input_std_.array() > 0).all() && p.input_mean_.allFinite(), path,
                   ": /normalisation has non-positive or non-finite entries");
+  // A subnormal std passes "> 0" but turns a finite past into inf/NaN network inputs. Trainers
+  // floor it at 1 cm (training/span/pipeline.cc).
+  for (Eigen::Index i = 0; i < p.input_std_.size(); ++i)
+    FS_THROW_UNLESS(std::isfinite(p.input_std_[i]) && p.input_std_[i] >= 1e-6, path,
+                    ": /normalisation/input_std[", i, "] is ", p.input_std_[i],
+                    "; expected a finite standard deviation >= 1e-6");
   p.mlp_ = Mlp::LoadListed(f, "/model", "dense_layers", "/weights/");
   FS_THROW_UNLESS(p.mlp_.input_size() == in, path, ": network takes ", p.mlp_.input_size(),
                   " inputs, expected 2 x observed = ", in);

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include "core/layer_widths.h"
 #include "tests/test_util.h"
 
 namespace foresight {
@@ -234,6 +235,45 @@ TEST(Config, VectorOfStructsRoundTripsAndIsDocumented) {
     EXPECT_NE(table.find(key), std::string::npos) << key << "\n" << table;
   EXPECT_NE(table.find("list of mapping"), std::string::npos);
   EXPECT_NE(table.find("`2 entries`"), std::string::npos) << table;
+}
+
+// Found by fuzz_config_yaml (tests/fuzz/corpus/config_yaml/regress_model_line_break and
+// regress_list_key): a quoted value with a line break made multi-line errors (the experiment's
+// Validate quotes it), and a key that is a list escaped as a yaml-cpp exception.
+TEST(Config, LineBreaksInValuesAndNonScalarKeysAreErrors) {
+  testing::ExpectErrorContains([] { config::ParseYaml("model: \"a\\nb\"\n", "nl.yaml"); },
+                               {"nl.yaml:1", "'a\\nb'", "line break"});
+  testing::ExpectErrorContains([] { config::ParseYaml("x:\n  - \"\\x01\"\n", "c.yaml"); },
+                               {"c.yaml:2", "'\\x01'", "control character"});
+  testing::ExpectErrorContains([] { config::ParseYaml("{[1]: 2}\n", "k.yaml"); },
+                               {"k.yaml:1", "a key is a list"});
+  testing::ExpectErrorContains([] { config::ParseYaml("? {a: 1}\n: 2\n", "m.yaml"); },
+                               {"m.yaml:1", "a key is a mapping"});
+  EXPECT_NO_THROW(config::ParseYaml("name: \"tab\\tinside\"\n", "tab.yaml"));
+}
+
+// Issue 18: a hidden-layer list is bounded before any network is built (a 10 M-entry list took
+// 23.8 GB in the model constructor); errors name the source and the key.
+TEST(LayerWidths, BoundsCountWidthAndWeights) {
+  EXPECT_NO_THROW(CheckLayerWidths({560, 180, 180}, "c.yaml", "network.hidden"));
+  EXPECT_NO_THROW(CheckLayerWidths(std::vector<int>(16, 1000), "c.yaml", "network.hidden"));
+  testing::ExpectErrorContains([] { CheckLayerWidths({}, "c.yaml", "network.hidden"); },
+                               {"c.yaml", "network.hidden", "empty"});
+  testing::ExpectErrorContains(
+      [] { CheckLayerWidths(std::vector<int>(17, 8), "c.yaml", "otnet.hidden"); },
+      {"c.yaml", "otnet.hidden", "17 layers"});
+  testing::ExpectErrorContains(
+      [] {
+        CheckLayerWidths({8, 0}, "c.yaml", "naive.hidden");
+      },
+      {"c.yaml", "naive.hidden[1]", "outside [1, 65536]"});
+  // 8000 x 8000 = 6.4e7 weights > 5e7; 7000 x 7000 = 4.9e7 passes.
+  testing::ExpectErrorContains(
+      [] {
+        CheckLayerWidths({8000, 8000}, "c.yaml", "network.hidden");
+      },
+      {"c.yaml", "network.hidden", "hidden-to-hidden weights"});
+  EXPECT_NO_THROW(CheckLayerWidths({7000, 7000}, "c.yaml", "network.hidden"));
 }
 
 }  // namespace

@@ -144,6 +144,23 @@ TEST(H5, ScalarReadsRefuseArrays) {
   testing::ExpectErrorContains([&] { f.ReadString("/texts"); }, {path, "'/texts'", "3 elements"});
 }
 
+// Fuzz finding (tests/fuzz/corpus/directional_artifact/regress_newline_model_type): an edited
+// model_type "e\n_min[" was echoed into a two-line loader error. String attributes must be text.
+TEST(H5, StringAttributesWithControlCharactersAreRefused) {
+  testing::TempDir dir;
+  const std::string path = dir.File("control.h5");
+  {
+    h5::File f = h5::File::Create(path);
+    f.SetAttr("/", "model_type", std::string("e\n_min["));
+    f.SetAttr("/", "plain", std::string("span_predictor"));
+    f.Close();
+  }
+  h5::File f = h5::File::Open(path);
+  EXPECT_EQ(f.GetStringAttr("/", "plain"), "span_predictor");
+  testing::ExpectErrorContains([&] { f.GetStringAttr("/", "model_type"); },
+                               {path, "'model_type'", "control character 10 at position 1"});
+}
+
 TEST(H5, TruncatedAndForeignFilesAreClearErrors) {
   testing::TempDir dir;
   const std::string path = dir.File("c.h5");

@@ -80,6 +80,21 @@ TEST(CrowdReplay, ReadsEthObsmatWithYInTheFifthColumnAndInferredFrameStep) {
   testing::ExpectErrorContains([&] { ReadEthObsmat(path); }, {path + ":1", "pos_y", "'inf'"});
 }
 
+// Found by fuzz_crowd_replay (tests/fuzz/corpus/crowd_replay/regress_huge_frame): integral but
+// huge frames and ids overflowed the conversions to integers (undefined behaviour).
+TEST(CrowdReplay, HugeFramesAndIdsAreErrors) {
+  testing::TempDir dir;
+  const std::string path = dir.File("huge.txt");
+  testing::WriteText(path, "780 1 8 0 3 1 0 0\n7.92e+82 1 8.5 0 3.25 1 0 0\n");
+  testing::ExpectErrorContains([&] { ReadEthObsmat(path); },
+                               {path + ":2", "frame '7.92e+82'", "[-2^53, 2^53]"});
+  testing::WriteText(path, "780 1 8 0 3 1 0 0\n786 -1e19 8.5 0 3.25 1 0 0\n");
+  testing::ExpectErrorContains([&] { ReadEthObsmat(path); }, {path + ":2", "ped_id '-1e19'"});
+  testing::WriteText(path, "0.02,12001,0.5,2.0,0.1,0.0\n0.43,1e30,1.0,2.0,0.1,0.0\n");
+  testing::ExpectErrorContains([&] { ReadThorTracks(path); },
+                               {path + ":2", "person_id '1e30'", "[-2^53, 2^53]"});
+}
+
 TEST(CrowdReplay, ResamplingInterpolatesOnTheGridWithoutExtrapolationAndSplitsGaps) {
   TrackSet raw;
   Track tr;

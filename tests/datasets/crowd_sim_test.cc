@@ -292,6 +292,16 @@ std::string ImplicitCrowdsDir() {
   return "";
 }
 
+// Found by review with fuzz_crowd_replay (tests/fuzz/corpus/crowd_replay/
+// regress_huge_agent_count): the largest agent count overflowed 3 + count (undefined behaviour).
+TEST(ImplicitCrowds, HugeAgentCountIsAnError) {
+  testing::TempDir dir;
+  const std::string path = dir.File("huge.csv");
+  testing::WriteText(path, "-15 15\n-10 10\n9223372036854775807\n0 -9 -1 9 -1 1.3 0.75\n");
+  testing::ExpectErrorContains([&] { ReadImplicitCrowdsScenario(path); },
+                               {path, "announces 9223372036854775807 agents", "has 1 agent lines"});
+}
+
 TEST(ImplicitCrowds, ReaderParsesTheFormatAndRejectsBadFiles) {
   testing::TempDir dir;
   const std::string path = dir.File("two.csv");

@@ -212,6 +212,32 @@ TEST(EdinburghTracks, BadInputIsAnErrorWithFileAndLine) {
                                {"heading filter", "max_speed -1"});
 }
 
+// Found by review with fuzz_directional_csv (tests/fuzz/corpus/directional_csv/
+// regress_frame_overflow): frame differences overflowed long long (undefined behaviour) for
+// frames at both ends of its range; they are taken in double now.
+TEST(EdinburghTracks, FramesAtTheEndsOfTheRangeDoNotOverflow) {
+  testing::TempDir dir;
+  const std::string path = dir.File("tracks.huge.txt");
+  testing::WriteText(path,
+                     " TRACK.R1=[[1 2 -9000000000000000000];[4 5 9000000000000000000];"
+                     "[8 5 9000000000000000001];[12 5 9000000000000000002];"
+                     "[16 5 9000000000000000003]];\n");
+  DirectionalReadStats st;
+  testing::ExpectErrorContains([&] { ReadEdinburghTracks(path, HeadingFilter{}, &st); },
+                               {path, "no direction samples left"});
+  // A gap that large is a gap; the track restarts after it.
+  testing::WriteText(path,
+                     " TRACK.R1=[[1 2 -9000000000000000000];[100 200 9000000000000000000];"
+                     "[104 200 9000000000000001024];[108 200 9000000000000002048];"
+                     "[112 200 9000000000000003072]];\n");
+  HeadingFilter slow;
+  slow.max_gap = 1e3;
+  slow.min_speed = 0;
+  const DirectionalSamples s = ReadEdinburghTracks(path, slow, &st);
+  EXPECT_EQ(st.dropped_gap, 1);
+  EXPECT_EQ(s.size(), 3);
+}
+
 TEST(DirectionalSamples, SelectAndValidate) {
   DirectionalSamples s;
   s.x = Eigen::VectorXd::LinSpaced(5, 0, 4);

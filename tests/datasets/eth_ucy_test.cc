@@ -49,6 +49,19 @@ TEST(EthUcy, MalformedInputNamesFileAndLine) {
                                {"/nonexistent/eth.txt"});
 }
 
+// Found by fuzz_eth_ucy (tests/fuzz/corpus/eth_ucy/regress_huge_ped_id): an integral but huge
+// ped_id or frame_id overflowed the conversion to an integer (undefined behaviour).
+TEST(EthUcy, HugeIdsAndFramesAreErrors) {
+  testing::TempDir dir;
+  const std::string path = dir.File("huge.txt");
+  testing::WriteText(path, "0 1 0 0\n6 2.00e+40 1 1\n");
+  testing::ExpectErrorContains([&] { ReadEthUcy(path, 0.4); },
+                               {path + ":2:", "ped_id", "'2.00e+40'", "[-2^53, 2^53]"});
+  testing::WriteText(path, "0 1 0 0\n1e300 1 1 1\n");
+  testing::ExpectErrorContains([&] { ReadEthUcy(path, 0.4); },
+                               {path + ":2:", "frame_id", "'1e300'", "[-2^53, 2^53]"});
+}
+
 TEST(EthUcy, ReadsEveryRealSceneWhenPresent) {
   const std::string data = testing::SharedDataDir();
   if (data.empty()) GTEST_SKIP() << "../shared/data is absent: skipping the real ETH/UCY files";

@@ -132,6 +132,10 @@ TEST_F(LasaMalformed, ErrorsNameFileAndLine) {
   ExpectErrorContains([&] { Read(); }, {path + ":2:", "first row must be demo 0"});
   path = Write(std::string(kHead) + "0.5,0,1,2,0,0,0,0\n");
   ExpectErrorContains([&] { Read(); }, {path + ":2:", "demo index is not a non-negative integer"});
+  // Found with fuzz_lasa (tests/fuzz/corpus/lasa/regress_huge_demo_index): a huge demo index
+  // overflowed the conversion to size_t (undefined behaviour).
+  path = Write(std::string(kHead) + kRow0 + "1e300,0.1,0,0,0,0,0,0\n");
+  ExpectErrorContains([&] { Read(); }, {path + ":5:", "demo index", "1e+300", "at most 2^53"});
   path = Write(std::string(kHead) + "0,0,1,2,0,0,0,0\n0,0,1,2,0,0,0,0\n");
   ExpectErrorContains([&] { Read(); }, {path + ":3:", "time 0 does not increase within demo 0"});
   path = Write(kHead);

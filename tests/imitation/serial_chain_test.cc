@@ -449,6 +449,12 @@ TEST(SerialChainErrors, NameTheFileJointOrLink) {
                       {"arm.urdf", "body point 0", "'finger'", "not on the chain"});
   ExpectErrorContains(load(urdf, "base", "tool", {{"l2", Eigen::Vector3d::Zero(), -1}}),
                       {"arm.urdf", "body point 0", "radius"});
+  // Found by fuzz_urdf (tests/fuzz/corpus/urdf/regress_joint_loop): urdfdom accepts a loop of
+  // joints off the root's tree (l3 <-> l4 here), and the walk up from the tip never ended.
+  ExpectErrorContains(load(Replace(urdf, R"(type="continuous"><parent link="l2b"/>)",
+                                   R"(type="continuous"><parent link="l4"/>)"),
+                           "base", "tool", {}),
+                      {"arm.urdf", "form a loop through link 'l4'"});
   ExpectErrorContains([] { SerialChain::Load("/nonexistent/arm.urdf", "a", "b", {}); },
                       {"/nonexistent/arm.urdf"});
   ExpectErrorContains([] { SerialChain::LoadJaco("/nonexistent"); },

@@ -3,6 +3,7 @@
 #include "inference/prediction/span_predictor.h"
 
 #include <gtest/gtest.h>
+#include <hdf5.h>
 
 #include <atomic>
 #include <cmath>
@@ -268,6 +269,47 @@ TEST(SpanEngineErrors, EditedAttributesAreRefusedWithFileAndValue) {
   testing::ExpectErrorContains([&] { SpanPredictor::Load(gamma); }, {gamma, "basis_gamma", "-1"});
   const std::string many = edited("components", std::int64_t{1} << 40);
   testing::ExpectErrorContains([&] { SpanPredictor::Load(many); }, {many, "components"});
+}
+
+// Fuzz finding (tests/fuzz/corpus/span_artifact/regress_subnormal_input_std): a subnormal
+// /normalisation/input_std entry passed "> 0" and the model answered NaN for a finite past.
+TEST(SpanEngineErrors, SubnormalInputStdIsRefused) {
+  testing::TempDir dir;
+  const std::string path = dir.File("model.h5");
+  testing::WriteRandomSpanArtifact(path, {});
+  {
+    const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    ASSERT_GE(file, 0);
+    const hid_t ds = H5Dopen2(file, "/normalisation/input_std", H5P_DEFAULT);
+    std::vector<double> std_values(16, 2.0);  // observed = 8: [16]
+    std_values[5] = 4.8e-322;
+    ASSERT_GE(H5Dwrite(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, std_values.data()), 0);
+    H5Dclose(ds);
+    H5Fclose(file);
+  }
+  testing::ExpectErrorContains([&] { SpanPredictor::Load(path); },
+                               {path, "/normalisation/input_std[5]", ">= 1e-6"});
+}
+
+// Fuzz finding (tests/fuzz/corpus/span_artifact/regress_huge_input_mean): input_mean 1.8e162
+// overflowed the float network input and the model answered NaN.
+TEST(SpanEngineErrors, HugeInputMeanIsRefused) {
+  testing::TempDir dir;
+  const std::string path = dir.File("model.h5");
+  testing::WriteRandomSpanArtifact(path, {});
+  {
+    const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    ASSERT_GE(file, 0);
+    const hid_t ds = H5Dopen2(file, "/normalisation/input_mean", H5P_DEFAULT);
+    std::vector<double> mean_values(16, 0.0);
+    mean_values[3] = 1.76e162;
+    ASSERT_GE(H5Dwrite(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, mean_values.data()),
+              0);
+    H5Dclose(ds);
+    H5Fclose(file);
+  }
+  testing::ExpectErrorContains([&] { SpanPredictor::Load(path); },
+                               {path, "/normalisation/input_mean[3]", "1.76e+162"});
 }
 
 }  // namespace

@@ -413,5 +413,31 @@ TEST(CompactJson, BadInputIsNamed) {
                       {tmp.File("extra.json"), "unknown key 'size'"});
 }
 
+// Found by fuzz_mbm_problem (tests/fuzz/corpus/mbm_problem/regress_multiline_yaml_error, which
+// the ctest fuzz.mbm_problem replays): a backslash before a line break in a quoted string made
+// yaml-cpp's message (and so the Error) span two lines; names and values quoted from the files
+// (below) could do the same.
+TEST(CompactJson, ErrorsStayOnOneLine) {
+  TempDir tmp;
+  WriteText(tmp.File("cone.json"), CompactJson("co\\nne"));
+  try {
+    LoadCompactFamily(tmp.File("cone.json"), 2, 2);
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+    EXPECT_NE(what.find("unknown primitive type 'co\\nne'"), std::string::npos) << what;
+  }
+  const Files f(Scene("id: Can1", "id: \"Can\\n1\"\n      bad: 1"));
+  try {
+    f.Load();
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+    EXPECT_NE(what.find(f.scene), std::string::npos) << what;
+  }
+}
+
 }  // namespace
 }  // namespace foresight::manipulation

@@ -928,6 +928,20 @@ TEST(OtnetArtifact, RoundTripGivesIdenticalPredictions) {
   }
 }
 
+// Fuzz finding (tests/fuzz/corpus/otnet_artifact/regress_huge_log_scale_offset): an offset of
+// 1.8e162 loaded and the mixture scales overflowed to inf on the first query.
+TEST(OtnetArtifact, HugeLogScaleOffsetIsRefused) {
+  testing::TempDir dir;
+  OtnetModel model = SmallModel(MixtureFamily::kNormal, 17);
+  Eigen::VectorXd offset = Eigen::VectorXd::Zero(2 * kBasis);
+  offset[1] = 1.76e162;
+  model.SetLogScaleOffset(offset);
+  const std::string path = dir.File("offset.h5");
+  model.Save(path, "kind: otnet\n", 42);
+  ExpectErrorContains([&] { OtnetModel::Load(path); },
+                      {path, "/model/log_scale_offset[1]", "1.76e+162", "-100 to 100"});
+}
+
 // Raw HDF5 edits (independent of core/h5).
 void OverwriteStringAttr(const std::string& path, const std::string& object,
                          const std::string& name, const std::string& value) {

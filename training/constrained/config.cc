@@ -1,6 +1,7 @@
 #include "training/constrained/config.h"
 
 #include "core/error.h"
+#include "core/layer_widths.h"
 
 namespace foresight {
 
@@ -21,12 +22,8 @@ void ConstrainedConfig::Validate(const std::string& source) const {
   FS_THROW_UNLESS(constraint.margin < constraint.epsilon, source, ": constraint.margin (",
                   constraint.margin, ") must be below constraint.epsilon (", constraint.epsilon,
                   ")");
-  for (const auto* hidden : {&network.hidden, &naive.hidden}) {
-    FS_THROW_UNLESS(!hidden->empty(), source, ": network.hidden / naive.hidden: empty");
-    for (int h : *hidden)
-      FS_THROW_UNLESS(h >= 1 && h <= 65536, source, ": hidden width ", h,
-                      " is outside [1, 65536] (network.hidden / naive.hidden)");
-  }
+  CheckLayerWidths(network.hidden, source, "network.hidden");
+  CheckLayerWidths(naive.hidden, source, "naive.hidden");
 }
 
 }  // namespace foresight

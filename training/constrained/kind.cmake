@@ -4,6 +4,6 @@ foresight_add_library(foresight_training_constrained
   SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/constrained/config.cc ${CMAKE_CURRENT_SOURCE_DIR}/constrained/data.cc
           ${CMAKE_CURRENT_SOURCE_DIR}/constrained/eval.cc ${CMAKE_CURRENT_SOURCE_DIR}/constrained/plots.cc
           ${CMAKE_CURRENT_SOURCE_DIR}/constrained/pipeline.cc ${CMAKE_CURRENT_SOURCE_DIR}/constrained/kind.cc
-  DEPS foresight_training_constrained_learners foresight_training_core foresight_constrained
+  DEPS foresight_image_io foresight_training_constrained_learners foresight_training_core foresight_constrained
        foresight_models_occupancy foresight_map_canvas foresight_datasets opencv_core opencv_imgproc
        opencv_imgcodecs ${TORCH_LIBRARIES})

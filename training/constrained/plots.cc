@@ -4,13 +4,13 @@
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <random>
 #include <sstream>
 
 #include "core/error.h"
 #include "inference/constrained/gauss_hermite.h"
+#include "training/image_io.h"
 #include "training/map_canvas.h"
 
 namespace foresight::constrained {
@@ -107,7 +107,7 @@ void DrawWindowPicture(const std::string& path, const OccupancyRaster& raster,
   cv::Mat both;
   cv::hconcat(
       std::vector<cv::Mat>{left, cv::Mat(left.rows, 6, CV_8UC3, cv::Scalar(0, 0, 0)), right}, both);
-  FS_THROW_UNLESS(cv::imwrite(path, both), path, ": cannot write the PNG");
+  WriteImage(path, both);
 }
 
 }  // namespace foresight::constrained

@@ -1,10 +1,10 @@
 #include "training/diffeo/plots.h"
 
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
+#include "training/image_io.h"
 
 namespace foresight {
 namespace {
@@ -85,7 +85,7 @@ void DrawPlanar(const PlanarPicture& pic, const std::string& png) {
                 cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
     cv::hconcat(left, right, out);
   }
-  FS_THROW_UNLESS(cv::imwrite(png, out), png, ": could not write the picture");
+  WriteImage(png, out);
 }
 
 }  // namespace foresight

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/file_io.h"
 #include "core/h5.h"
 #include "core/log.h"
 #include "core/von_mises.h"
@@ -333,7 +334,7 @@ TrainingSummary TrainDirectionalNet(const DirectionalExperimentConfig& c,
     tc.patience = static_cast<int>(std::ceil(tc.patience / c.data.train_fraction));
   }
   TrainingSummary s = Train(&task, tc, run, static_cast<std::uint64_t>(c.seed), can_resume, hooks);
-  std::ofstream(dir + "/training_summary.json") << s.ToJson();
+  WriteTrainingSummary(dir + "/training_summary.json", s);
   if (s.reason == TerminationReason::kInterrupted) return s;
   const std::string ckpt =
       fs::exists(run.BestCheckpoint()) ? run.BestCheckpoint() : run.Checkpoint();
@@ -638,8 +639,8 @@ DirectionalRunResult RunFolds(const DirectionalExperimentConfig& c, const std::s
     ++report.folds_evaluated;
   }
   PublishFoldZero(c, run_dir);
-  std::ofstream(run_dir + "/eval.json") << report.ToJson();
-  std::ofstream(run_dir + "/eval.csv") << report.ToCsv();
+  WriteFileAtomically(run_dir + "/eval.json", report.ToJson());
+  WriteFileAtomically(run_dir + "/eval.csv", report.ToCsv());
   if (c.eval.plots) {
     fs::create_directories(run_dir + "/plots");
     const DirectionalMap first = DirectionalMap::Load(run_dir + "/model.h5");

@@ -2,12 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
 #include "core/error.h"
 #include "core/von_mises.h"
+#include "training/image_io.h"
 
 namespace foresight {
 
@@ -124,7 +124,7 @@ void Draw(const DirectionalSamples& data, const std::vector<Panel>& panels,
     }
     cv::putText(canvas, p.title, {x0 + 4, 17}, cv::FONT_HERSHEY_SIMPLEX, 0.45, {0, 0, 0}, 1);
   }
-  FS_THROW_UNLESS(cv::imwrite(png, canvas), png, ": cannot write PNG");
+  WriteImage(png, canvas);
 }
 
 }  // namespace

@@ -1,10 +1,10 @@
 #include "training/manipulation/render.h"
 
 #include <cmath>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
+#include "training/image_io.h"
 
 namespace foresight {
 namespace {
@@ -141,7 +141,7 @@ void RenderEndEffectorPaths(const std::string& path,
   cv::circle(image, {kMargin + 115, y}, 5, {200, 0, 200}, cv::FILLED, cv::LINE_AA);
   cv::putText(image, "goal   (grey: obstacles, projected)", {kMargin + 140, y + 5},
               cv::FONT_HERSHEY_SIMPLEX, 0.45, {0, 0, 0}, 1, cv::LINE_AA);
-  FS_THROW_UNLESS(cv::imwrite(path, image), "could not write ", path);
+  WriteImage(path, image);
 }
 
 }  // namespace foresight

@@ -78,6 +78,27 @@ void NavigationExperimentConfig::Validate(const std::string& path) const {
                   ": predictor.tracks: '", c.predictor.tracks, "', expected scenario or replay");
   (void)ParseNavigationMethod(c.video.method, path + ": video.method");
   c.scenario.Validate(path + ": scenario");
+  // Sizes the config implies, checked before anything is allocated: the rasters of the scenario's
+  // extent (obstacle sampling and swept-occupancy field) and the recorded training crowd.
+  const double width = c.scenario.extent[1] - c.scenario.extent[0];
+  const double height = c.scenario.extent[3] - c.scenario.extent[2];
+  const double finest = std::min(c.map.raster_resolution, c.map.field_resolution);
+  const double cells = (width / finest + 1) * (height / finest + 1);
+  constexpr double kMaxCells = 2.5e7;  // 100 MB of floats: a 250 m square at 5 cm
+  FS_THROW_UNLESS(cells <= kMaxCells, path, ": scenario.extent ", width, " m x ", height, " m at ",
+                  finest,
+                  " m (the finer of map.raster_resolution and "
+                  "map.field_resolution) needs ",
+                  cells, " raster cells, more than ", kMaxCells,
+                  "; shrink the extent or coarsen the resolution");
+  if (c.predictor.tracks == "scenario") {
+    const double steps = c.predictor.record_episodes * (c.predictor.record_duration / c.dt);
+    constexpr double kMaxSteps = 2e6;
+    FS_THROW_UNLESS(steps <= kMaxSteps, path, ": predictor.record_episodes ",
+                    c.predictor.record_episodes, " x predictor.record_duration ",
+                    c.predictor.record_duration, " s at dt ", c.dt, " s records ", steps,
+                    " simulation steps, more than ", kMaxSteps);
+  }
 }
 
 }  // namespace foresight

@@ -43,7 +43,8 @@ struct NavigationPredictorConfig {
     a->Visit("tracks", &tracks, config::Range::Any(), "training tracks: scenario | replay");
     a->Visit("record_episodes", &record_episodes, config::Range::Closed(1, 10000),
              "simulated runs recorded");
-    a->Visit("record_duration", &record_duration, config::Range::Positive(),
+    // At most a day per run, like max_time; Validate bounds the total recorded steps.
+    a->Visit("record_duration", &record_duration, config::Range::OpenClosed(0, 86400),
              "seconds per recorded run");
     a->Visit("position_noise", &position_noise, config::Range::NonNegative(),
              "std of measurement noise added to recorded simulated positions (m)");

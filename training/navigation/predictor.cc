@@ -68,7 +68,7 @@ std::string EnsureNavigationPredictor(const NavigationExperimentConfig& c,
     hooks.interrupt = interrupt.flag();
     s = TrainSpan(span, run_dir, resume, hooks);
   }
-  std::ofstream(run_dir + "/training_summary.json") << s.ToJson();
+  WriteTrainingSummary(run_dir + "/training_summary.json", s);
   std::cout << s.BriefReport() << "\n";
   FS_THROW_UNLESS(s.reason != TerminationReason::kInterrupted,
                   "predictor training interrupted; run again to resume");

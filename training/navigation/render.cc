@@ -2,11 +2,11 @@
 
 #include <cmath>
 #include <iomanip>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
 #include "core/error.h"
+#include "training/image_io.h"
 
 namespace foresight {
 
@@ -90,7 +90,7 @@ void DrawPaths(const std::string& path, const OccupancyRaster& raster,
     cv::putText(img, m, {10, y}, cv::FONT_HERSHEY_SIMPLEX, 0.55, MethodColour(m), 2, cv::LINE_AA);
     y += 20;
   }
-  FS_THROW_UNLESS(cv::imwrite(path, img), path, ": cannot write the PNG");
+  WriteImage(path, img);
 }
 
 }  // namespace foresight

@@ -15,6 +15,7 @@
 #include <unordered_map>
 
 #include "core/error.h"
+#include "core/file_io.h"
 #include "core/log.h"
 #include "inference/mapping/grid_map.h"
 #include "inference/navigation/cl_rrt_star.h"
@@ -466,7 +467,8 @@ std::vector<MethodSummary> RunNavigation(const NavigationExperimentConfig& c,
                     " is unreachable from the start on the map artifact");
   }
   std::vector<EpisodeResult> results;
-  std::ofstream csv(out_dir + "/episodes.csv");
+  // Rewritten (atomically) after every episode: a stopped run keeps the episodes it finished.
+  std::ostringstream csv;
   csv << "method,episode,seed,reached,ttg,doc,doc_static,min_clearance,path_length,cycles,solve_"
          "failures,cycle_ms_median,cycle_ms_p99,robot_caused_doc\n";
   for (const NavigationMethod method : c.Methods()) {
@@ -480,7 +482,7 @@ std::vector<MethodSummary> RunNavigation(const NavigationExperimentConfig& c,
           << ',' << r.doc << ',' << r.doc_static << ',' << r.min_clearance << ',' << r.path_length
           << ',' << r.cycles << ',' << r.solve_failures << ',' << Percentile(r.cycle_ms, 0.5) << ','
           << Percentile(r.cycle_ms, 0.99) << ',' << r.robot_caused_doc << '\n';
-      csv.flush();
+      WriteFileAtomically(out_dir + "/episodes.csv", csv.str());
       log::Info(r.method, " episode ", e, ": ", r.reached ? "reached" : "not reached", " ttg ",
                 r.ttg, " s, doc ", r.doc, " s, min clearance ", r.min_clearance,
                 " m, cycle median ", Percentile(r.cycle_ms, 0.5), " ms");
@@ -489,7 +491,7 @@ std::vector<MethodSummary> RunNavigation(const NavigationExperimentConfig& c,
   }
   std::vector<MethodSummary> summaries;
   for (const std::string& method : c.methods) summaries.push_back(Summarise(method, results));
-  std::ofstream(out_dir + "/summary.json") << SummaryJson(c, n, summaries);
+  WriteFileAtomically(out_dir + "/summary.json", SummaryJson(c, n, summaries));
   DrawPaths(out_dir + "/paths.png", res.raster, c, results);
   return summaries;
 }

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/file_io.h"
 #include "core/log.h"
 #include "datasets/carmen.h"
 #include "datasets/data_root.h"
@@ -49,10 +50,11 @@ void WriteRoc(const OccupancyMap& map, const LabelledPoints& test, int points,
   std::vector<double> scores(test.size());
   for (std::int64_t i = 0; i < test.size(); ++i)
     scores[i] = map.Probability(test.xy(0, i), test.xy(1, i), &ws);
-  std::ofstream out(path);
+  std::ostringstream out;
   out << "false_positive_rate,true_positive_rate\n";
   for (const auto& [fpr, tpr] : RocCurve(scores, test.occupied, points))
     out << fpr << "," << tpr << "\n";
+  WriteFileAtomically(path, out.str());
 }
 
 }  // namespace
@@ -319,7 +321,7 @@ void TrainOccupancyRun(const OccupancyExperimentConfig& c, const std::string& ru
     if (r.conflated) SaveOccupancyMap(*r.conflated, run_dir + "/conflated.h5", c);
     // The run's map: the exactly fused learning map (coupled), else the repeated fusion.
     SaveOccupancyMap(r.repeated ? *r.repeated : *r.fuse_once, artifact, c);
-    std::ofstream out(run_dir + "/training_summary.json");
+    std::ostringstream out;
     out << "{\"seconds\": " << Json(Seconds(start)) << ", \"robots\": " << r.robot_scans.size()
         << ", \"robot_scans\": [";
     for (std::size_t i = 0; i < r.robot_scans.size(); ++i)
@@ -330,14 +332,16 @@ void TrainOccupancyRun(const OccupancyExperimentConfig& c, const std::string& ru
     out << "]";
     if (r.repeated) out << ", \"merges\": " << c.fusion.merges;  // coupled fuses once
     out << "}\n";
+    WriteFileAtomically(run_dir + "/training_summary.json", out.str());
   } else {
     double secs = 0;
     std::vector<BoundUpdateReport> bounds;
     const std::unique_ptr<OccupancyMap> map = TrainOccupancyMap(c.model, c, data, &secs, &bounds);
     SaveOccupancyMap(*map, artifact, c);
-    std::ofstream(run_dir + "/training_summary.json")
-        << "{\"seconds\": " << Json(secs) << ", \"bound_updates\": " << BoundReportsJson(bounds)
+    std::ostringstream out;
+    out << "{\"seconds\": " << Json(secs) << ", \"bound_updates\": " << BoundReportsJson(bounds)
         << "}\n";
+    WriteFileAtomically(run_dir + "/training_summary.json", out.str());
     log::Info(c.model, ": trained in ", secs, " s");
   }
 }
@@ -398,7 +402,7 @@ std::string EvaluateOccupancyRun(const OccupancyExperimentConfig& c, const std::
     WriteMapPanels({{c.model, loaded.get()}}, c.eval.plot_resolution, run_dir + "/plots/map.png");
     log::Info(c.model, ": AUC ", m.auc, ", precision ", m.precision, ", recall ", m.recall);
   }
-  std::ofstream(run_dir + "/eval.json") << json.str();
+  WriteFileAtomically(run_dir + "/eval.json", json.str());
   return json.str();
 }
 

@@ -2,10 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
+#include "training/image_io.h"
 
 namespace foresight {
 
@@ -48,7 +48,7 @@ void WriteMapPanels(const std::vector<MapPanel>& panels, double resolution,
     cv::putText(canvas, "log10 var (1e-3..1e4)", {x0 + 4, h + kTitle + 17},
                 cv::FONT_HERSHEY_SIMPLEX, 0.5, {0, 0, 0}, 1);
   }
-  FS_THROW_UNLESS(cv::imwrite(png_path, canvas), png_path, ": cannot write PNG");
+  WriteImage(png_path, canvas);
 }
 
 }  // namespace foresight

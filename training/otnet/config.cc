@@ -1,6 +1,7 @@
 #include "training/otnet/config.h"
 
 #include "core/error.h"
+#include "core/layer_widths.h"
 
 namespace foresight {
 
@@ -14,10 +15,7 @@ void OtnetConfig::Validate(const std::string& source) const {
                   data.val_fraction + data.test_fraction, " leaves too few training maps");
   FS_THROW_UNLESS(otnet.ridge > 0, source, ": otnet.ridge: ", otnet.ridge,
                   " must be > 0 (the fit of M basis weights needs it when points are few)");
-  FS_THROW_UNLESS(!otnet.hidden.empty(), source, ": otnet.hidden: empty (give >= 1 layer width)");
-  for (std::size_t i = 0; i < otnet.hidden.size(); ++i)
-    FS_THROW_UNLESS(otnet.hidden[i] >= 1 && otnet.hidden[i] <= 65536, source, ": otnet.hidden[", i,
-                    "]: ", otnet.hidden[i], " is outside [1, 65536]");
+  CheckLayerWidths(otnet.hidden, source, "otnet.hidden");
   FS_THROW_UNLESS(eval.max_attempts >= eval.generated, source, ": eval.max_attempts (",
                   eval.max_attempts, ") is below eval.generated (", eval.generated, ")");
   if (!transfer.occupancy_artifact.empty()) {

@@ -6,5 +6,5 @@ foresight_add_library(foresight_training_otnet
           ${CMAKE_CURRENT_SOURCE_DIR}/otnet/task.cc ${CMAKE_CURRENT_SOURCE_DIR}/otnet/transfer.cc
           ${CMAKE_CURRENT_SOURCE_DIR}/otnet/plots.cc
           ${CMAKE_CURRENT_SOURCE_DIR}/otnet/pipeline.cc ${CMAKE_CURRENT_SOURCE_DIR}/otnet/kind.cc
-  DEPS foresight_trainer foresight_training_core foresight_models_otnet_nets foresight_otnet
+  DEPS foresight_image_io foresight_trainer foresight_training_core foresight_models_otnet_nets foresight_otnet
        foresight_datasets opencv_core opencv_imgproc opencv_imgcodecs ${TORCH_LIBRARIES})

@@ -2,10 +2,10 @@
 
 #include <algorithm>
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
+#include "training/image_io.h"
 
 namespace foresight::otnet {
 namespace {
@@ -66,7 +66,7 @@ void DrawTrajectoryPanels(const std::vector<std::vector<TrajectoryPanel>>& rows,
           out(cv::Rect(static_cast<int>(j) * (kPanel + 4),
                        static_cast<int>(i) * (kPanel + kTitle + 4), kPanel, kPanel + kTitle)));
     }
-  FS_THROW_UNLESS(cv::imwrite(png, out), png, ": could not write the picture");
+  WriteImage(png, out);
 }
 
 }  // namespace foresight::otnet

@@ -1,5 +1,7 @@
 #include "training/span/config.h"
 
+#include "core/layer_widths.h"
+
 namespace foresight {
 
 void SpanExperimentConfig::Validate(const std::string& source) const {
@@ -16,8 +18,7 @@ void SpanExperimentConfig::Validate(const std::string& source) const {
       c.data.synthetic.min_steps >= c.windows.observed + c.windows.predicted ||
           c.data.format != TrackFormat::kSynthetic,
       source, ": key 'data.synthetic.min_steps' must be >= windows.observed + windows.predicted");
-  FS_THROW_UNLESS(!c.network.hidden.empty(), source,
-                  ": key 'network.hidden' must list at least one layer");
+  CheckLayerWidths(c.network.hidden, source, "network.hidden");
 }
 
 }  // namespace foresight

@@ -10,6 +10,7 @@
 
 #include "core/ego_frame.h"
 #include "core/error.h"
+#include "core/file_io.h"
 #include "core/log.h"
 #include "core/matrix_normal.h"
 #include "inference/engine/artifact.h"
@@ -235,7 +236,7 @@ SpanEvalReport EvaluateSpan(const SpanExperimentConfig& c, const std::string& ar
     rep.val_cv = v.cv;
   }
   fs::create_directories(out_dir + "/plots");
-  std::ofstream(out_dir + "/eval.json") << rep.ToJson(c.eval.num_samples);
+  WriteFileAtomically(out_dir + "/eval.json", rep.ToJson(c.eval.num_samples));
   if (c.eval.plot_tracks > 0)
     PlotSpanSamples(artifact, test, c.eval, out_dir + "/plots/samples.png");
   log::Info("eval on ", rep.windows, " windows: ADE ", rep.model.ade, " FDE ", rep.model.fde,

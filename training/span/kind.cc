@@ -26,7 +26,7 @@ void TrainSpanRun(const TrainRequest& req, const std::string& embedded_default) 
     hooks.interrupt = interrupt.flag();
     s = TrainSpan(c, req.run_dir, req.resume, hooks);
   }
-  std::ofstream(req.run_dir + "/training_summary.json") << s.ToJson();
+  WriteTrainingSummary(req.run_dir + "/training_summary.json", s);
   std::cout << s.BriefReport() << "\n";
   if (s.reason == TerminationReason::kInterrupted && s.epochs_completed == 0)
     Fail("interrupted in epoch 1 before the first checkpoint; nothing was saved to resume from");

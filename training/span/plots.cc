@@ -1,11 +1,11 @@
 #include "training/span/plots.h"
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <random>
 
 #include "core/error.h"
 #include "inference/prediction/span_predictor.h"
+#include "training/image_io.h"
 
 namespace foresight {
 
@@ -78,7 +78,7 @@ void PlotSpanSamples(const std::string& artifact, const WindowSet& test, const S
   cv::putText(image, "blue: observed  green: truth  red: samples  dark red: mean",
               cv::Point(6, rows * size - 8), cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar(60, 60, 60),
               1, cv::LINE_AA);
-  FS_THROW_UNLESS(cv::imwrite(png_path, image), png_path, ": cannot write PNG");
+  WriteImage(png_path, image);
 }
 
 }  // namespace foresight

@@ -1,0 +1,69 @@
+#include "core/file_io.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "tests/test_util.h"
+
+namespace foresight {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string Contents(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+TEST(FileIo, WritesAtomicallyAndLeavesNoTemporary) {
+  testing::TempDir dir;
+  const std::string path = dir.File("a.txt");
+  WriteFileAtomically(path, "first");
+  WriteFileAtomically(path, "second");
+  EXPECT_EQ(Contents(path), "second");
+  EXPECT_FALSE(fs::exists(path + ".tmp"));
+}
+
+// Issue 18: an atomic write renames over its target, so a device (e.g. `-o /dev/full`) or a
+// directory given as the output would be replaced. Refused, naming the path, and left as it was.
+TEST(FileIo, RefusesToReplaceSomethingThatIsNotARegularFile) {
+  testing::TempDir dir;
+  const std::string sub = dir.File("sub");
+  fs::create_directories(sub);
+  testing::ExpectErrorContains([&] { WriteFileAtomically(sub, "x"); },
+                               {"sub", "not a regular file"});
+  EXPECT_TRUE(fs::is_directory(sub));
+  EXPECT_FALSE(fs::exists(sub + ".tmp"));
+  if (fs::exists("/dev/null")) {
+    testing::ExpectErrorContains([&] { WriteFileAtomically("/dev/null", "x"); },
+                                 {"/dev/null", "not a regular file"});
+    EXPECT_TRUE(fs::is_character_file("/dev/null"));
+  }
+}
+
+// A symbolic link to a file is written through: the file it points to gets the new contents and
+// the link stays a link (a results file linked from elsewhere keeps working).
+TEST(FileIo, WritesThroughASymbolicLink) {
+  testing::TempDir dir;
+  const std::string target = dir.File("real.txt"), link = dir.File("link.txt");
+  WriteFileAtomically(target, "old");
+  fs::create_symlink(target, link);
+  WriteFileAtomically(link, "new");
+  EXPECT_TRUE(fs::is_symlink(fs::symlink_status(link)));
+  EXPECT_EQ(Contents(target), "new");
+  EXPECT_EQ(Contents(link), "new");
+  // A dangling link creates the file it names.
+  const std::string dangling = dir.File("dangling.txt"), absent = dir.File("absent.txt");
+  fs::create_symlink(absent, dangling);
+  WriteFileAtomically(dangling, "made");
+  EXPECT_TRUE(fs::is_symlink(fs::symlink_status(dangling)));
+  EXPECT_EQ(Contents(absent), "made");
+}
+
+}  // namespace
+}  // namespace foresight
