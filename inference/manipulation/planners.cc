@@ -13,6 +13,7 @@
 #include <ompl/util/Console.h>
 #include <ompl/util/RandomNumbers.h>
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <iomanip>
@@ -194,7 +195,23 @@ PlannerResult Plan(PlannerKind kind, const JointVector& start, const JointVector
     // OMPL's resolution is a fraction of the box diagonal: convert the absolute step.
     space->setLongestValidSegmentFraction(options.resolution_rad / space->getMaximumExtent());
     auto si = std::make_shared<ob::SpaceInformation>(space);
-    si->setStateValidityChecker([&counted](const ob::State* s) { return counted(ToJoints(s)); });
+    // An exception must not cross OMPL's solve (its planners leak the states they hold then): the
+    // first one is kept, the state counts as invalid, and the termination condition stops the
+    // planner, which returns normally.
+    std::atomic<bool> check_failed{false};
+    std::string check_error;
+    si->setStateValidityChecker([&](const ob::State* st) {
+      if (check_failed) return false;
+      try {
+        return counted(ToJoints(st));
+      } catch (const std::exception& e) {
+        check_error = e.what();
+      } catch (...) {
+        check_error = "unknown exception";
+      }
+      check_failed = true;
+      return false;
+    });
     si->setup();
 
     auto pdef = std::make_shared<ob::ProblemDefinition>(si);
@@ -212,9 +229,15 @@ PlannerResult Plan(PlannerKind kind, const JointVector& start, const JointVector
     const ob::PlannerPtr planner = MakePlanner(kind, si, options);
     planner->setProblemDefinition(pdef);
     planner->setup();
-    const ob::PlannerStatus status =
-        planner->solve(ob::timedPlannerTerminationCondition(options.time_budget_s));
+    const ob::PlannerStatus status = planner->solve(ob::plannerOrTerminationCondition(
+        ob::timedPlannerTerminationCondition(options.time_budget_s),
+        ob::PlannerTerminationCondition([&check_failed] { return check_failed.load(); })));
     out.collision_checks = checks;
+    const auto failed_check = [&] {
+      out.waypoints.resize(kDof, 0);
+      return finish(PlannerStatus::kError, "planning failed: " + check_error);
+    };
+    if (check_failed) return failed_check();
     switch (ob::PlannerStatus::StatusType(status)) {
       case ob::PlannerStatus::EXACT_SOLUTION:
         break;
@@ -241,6 +264,7 @@ PlannerResult Plan(PlannerKind kind, const JointVector& start, const JointVector
       simplifier.reduceVertices(path);
       simplifier.collapseCloseVertices(path);
       simplifier.shortcutPath(path);
+      if (check_failed) return failed_check();
     }
     out.collision_checks = checks;
     out.waypoints.resize(kDof, static_cast<Eigen::Index>(path.getStateCount()));

@@ -3,8 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 #include "tests/test_util.h"
 
@@ -13,19 +11,12 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string Contents(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 TEST(FileIo, WritesAtomicallyAndLeavesNoTemporary) {
   testing::TempDir dir;
   const std::string path = dir.File("a.txt");
   WriteFileAtomically(path, "first");
   WriteFileAtomically(path, "second");
-  EXPECT_EQ(Contents(path), "second");
+  EXPECT_EQ(testing::ReadText(path), "second");
   EXPECT_FALSE(fs::exists(path + ".tmp"));
 }
 
@@ -55,14 +46,14 @@ TEST(FileIo, WritesThroughASymbolicLink) {
   fs::create_symlink(target, link);
   WriteFileAtomically(link, "new");
   EXPECT_TRUE(fs::is_symlink(fs::symlink_status(link)));
-  EXPECT_EQ(Contents(target), "new");
-  EXPECT_EQ(Contents(link), "new");
+  EXPECT_EQ(testing::ReadText(target), "new");
+  EXPECT_EQ(testing::ReadText(link), "new");
   // A dangling link creates the file it names.
   const std::string dangling = dir.File("dangling.txt"), absent = dir.File("absent.txt");
   fs::create_symlink(absent, dangling);
   WriteFileAtomically(dangling, "made");
   EXPECT_TRUE(fs::is_symlink(fs::symlink_status(dangling)));
-  EXPECT_EQ(Contents(absent), "made");
+  EXPECT_EQ(testing::ReadText(absent), "made");
 }
 
 }  // namespace

@@ -674,9 +674,11 @@ TEST(CheckMotion, BadResolutionIsAnError) {
   KinematicsData data = scene.robot.MakeData();
   const std::vector<std::pair<double, std::string>> bad = {
       {0.0, "got 0"}, {-0.01, "got -0.01"}, {std::numeric_limits<double>::quiet_NaN(), "got nan"}};
-  for (const auto& [resolution, text] : bad)
+  for (const auto& [value, text] : bad) {
+    const double resolution = value;  // C++17 lambdas cannot capture structured bindings (Clang)
     ExpectErrorContains([&] { checker.CheckMotion(scene.a, scene.b, resolution, &data); },
                         {"resolution must be positive", text});
+  }
 }
 
 // ---- margin -----------------------------------------------------------------------------------
