@@ -111,7 +111,11 @@ std::vector<double> ReadShaped(const h5::File& f, const std::string& name,
 
 EFlowModel::EFlowModel(int dimension, std::vector<EFlowCouplingLayer> layers, Eigen::VectorXd goal,
                        double speed, const std::string& source)
-    : dimension_(dimension), layers_(std::move(layers)), goal_(std::move(goal)), speed_(speed) {
+    : dimension_(dimension),
+      layers_(std::move(layers)),
+      goal_(std::move(goal)),
+      speed_(speed),
+      source_(source) {
   FS_THROW_UNLESS(dimension >= 2 && dimension <= kMaxDimension, source, ": dimension ", dimension,
                   " is outside [2, ", kMaxDimension, "]");
   FS_THROW_UNLESS(!layers_.empty(), source, ": no coupling layers");
@@ -143,6 +147,12 @@ EFlowModel::EFlowModel(int dimension, std::vector<EFlowCouplingLayer> layers, Ei
   FS_THROW_UNLESS(goal_image_.allFinite(), source, ": psi(goal) is not finite");
 }
 
+void EFlowModel::CheckAnswer(bool finite, const Eigen::VectorXd& x, const char* what) const {
+  if (finite || !x.allFinite()) return;
+  Fail(source_, ": ", what, " overflows at the state (", x.transpose(),
+       "): the coupling layers' weights are too large for it");
+}
+
 Eigen::VectorXd EFlowModel::Forward(const Eigen::VectorXd& x, Eigen::MatrixXd* J) const {
   FS_THROW_UNLESS(x.size() == dimension_, "EFlowModel::Forward: x has ", x.size(),
                   " entries, expected ", dimension_);
@@ -151,8 +161,10 @@ Eigen::VectorXd EFlowModel::Forward(const Eigen::VectorXd& x, Eigen::MatrixXd* J
     SmallMat jac;
     Propagate(layers_, x, &z, &jac);
     *J = jac;
+    CheckAnswer(z.allFinite() && jac.allFinite(), x, "psi(x) or its Jacobian");
   } else {
     Propagate(layers_, x, &z, nullptr);
+    CheckAnswer(z.allFinite(), x, "psi(x)");
   }
   return z;
 }
@@ -166,6 +178,7 @@ Eigen::VectorXd EFlowModel::Inverse(const Eigen::VectorXd& z) const {
     LayerTerms(*it, x, &s, &t, nullptr, nullptr);  // depends on the fixed coordinates only
     x[it->transformed] = (x[it->transformed] - t) * std::exp(-s);
   }
+  CheckAnswer(x.allFinite(), z, "psi^-1(z)");
   return x;
 }
 
@@ -177,10 +190,12 @@ Eigen::VectorXd EFlowModel::Velocity(const Eigen::VectorXd& x) const {
   Propagate(layers_, x, &z, &jac);
   const SmallVec diff = z - goal_image_;
   const double norm = diff.norm();
-  if (!(norm > 0)) return Eigen::VectorXd::Zero(dimension_);
+  CheckAnswer(std::isfinite(norm) && jac.allFinite(), x, "psi(x) or its Jacobian");
+  if (norm == 0) return Eigen::VectorXd::Zero(dimension_);
   // det J = prod_l exp(s_l) > 0: J is always invertible.
   const Eigen::PartialPivLU<SmallMat> lu(jac);
   const SmallVec v = (-speed_ / norm) * lu.solve(diff);
+  CheckAnswer(v.allFinite(), x, "the velocity");
   return v;
 }
 

@@ -59,6 +59,9 @@ class EFlowModel {
   /// Writes the artifact atomically (the schema: the file comment of eflow.cc).
   void Save(const std::string& path, const std::string& config_yaml, std::int64_t seed) const;
 
+  /// Forward, Inverse and Velocity answer a finite state with finite numbers or throw an Error
+  /// naming the model's source: finite weights can still overflow double range for some states
+  /// (e.g. an edited artifact), and that must not pass as an answer.
   /// z = psi(x) [d]; with J not null also J = d psi/dx [d x d].
   Eigen::VectorXd Forward(const Eigen::VectorXd& x, Eigen::MatrixXd* J = nullptr) const;
   /// x = psi^-1(z) (exact).
@@ -92,6 +95,10 @@ class EFlowModel {
   std::vector<EFlowCouplingLayer> layers_;
   Eigen::VectorXd goal_, goal_image_;
   double speed_ = 1;
+  std::string source_;  ///< the artifact's path (named by the errors of the queries)
+
+  /// An Error naming source_ when a finite `x` gave a non-finite `what`.
+  void CheckAnswer(bool finite, const Eigen::VectorXd& x, const char* what) const;
 };
 
 }  // namespace foresight::imitation

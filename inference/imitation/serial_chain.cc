@@ -63,12 +63,7 @@ SerialChain SerialChain::FromText(const std::string& urdf_text, const std::strin
                                   std::vector<BodyPoint> points) {
   urdf::ModelInterfaceSharedPtr urdf;
   const urdf_util::FreeLinkCyclesOnExit free_cycles(urdf);  // a looped URDF must not leak
-  {
-    urdf_util::CaptureUrdfdomErrors errors;
-    urdf = urdf::parseURDF(urdf_text);
-    FS_THROW_UNLESS(urdf != nullptr, source, ": not a valid URDF: ",
-                    errors.messages().empty() ? "urdfdom gave no reason" : errors.messages());
-  }
+  urdf = urdf_util::ParseUrdf(urdf_text, source);
   SerialChain c;
   c.name_ = urdf->getName();
   c.base_link_ = base_link;
@@ -193,10 +188,8 @@ SerialChain SerialChain::LoadJaco(const std::string& jaco_dir) {
   const std::string text = ReadWholeFile(path);
   std::string base;
   {
-    urdf_util::CaptureUrdfdomErrors errors;
-    const urdf::ModelInterfaceSharedPtr urdf = urdf::parseURDF(text);
-    FS_THROW_UNLESS(urdf != nullptr, path, ": not a valid URDF: ",
-                    errors.messages().empty() ? "urdfdom gave no reason" : errors.messages());
+    const urdf::ModelInterfaceSharedPtr urdf = urdf_util::ParseUrdf(text, path);
+    const urdf_util::FreeLinkCyclesOnExit free_cycles(urdf);
     base = urdf->getLink("root") != nullptr ? "root" : urdf->getRoot()->name;
   }
   SerialChain chain = FromText(text, path, base, "j2n6s300_end_effector", JacoBodyPoints());

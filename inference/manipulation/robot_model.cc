@@ -109,6 +109,7 @@ struct DisabledPair {
 
 /// <disable_collisions link1 link2> entries of an SRDF text; `name` (a path) prefixes the messages.
 std::vector<DisabledPair> ReadDisabledPairs(const std::string& text, const std::string& name) {
+  urdf_util::CheckUtf8(text, name);
   TiXmlDocument doc;
   doc.Parse(text.c_str());
   if (doc.Error())
@@ -209,12 +210,7 @@ RobotModel RobotModel::FromTexts(const std::string& urdf_text, const std::string
   // Kinematic tree (urdfdom), depth first from the root so parents precede children.
   urdf::ModelInterfaceSharedPtr urdf;
   const urdf_util::FreeLinkCyclesOnExit free_cycles(urdf);  // a looped URDF must not leak
-  {
-    urdf_util::CaptureUrdfdomErrors errors;
-    urdf = urdf::parseURDF(urdf_text);
-    FS_THROW_UNLESS(urdf != nullptr, urdf_name, ": not a valid URDF: ",
-                    errors.messages().empty() ? "urdfdom gave no reason" : errors.messages());
-  }
+  urdf = urdf_util::ParseUrdf(urdf_text, urdf_name);
   FS_THROW_UNLESS(urdf->getRoot() != nullptr, urdf_name, ": no root link");
   m.name_ = urdf->getName();
   std::vector<Eigen::Isometry3d> X_BJ;

@@ -5,13 +5,38 @@
 
 #include <console_bridge/console.h>
 #include <urdf_model/model.h>
+#include <urdf_parser/urdf_parser.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <cstddef>
 #include <mutex>
 #include <string>
 
+#include "core/error.h"
+
 namespace foresight::urdf_util {
+
+/// Refuses XML text that is not UTF-8, naming the offending byte. TinyXML (which urdfdom parses
+/// with) steps over a multi-byte sequence by its lead byte without checking what follows, so a
+/// truncated sequence at the end of the text makes it read past the buffer (found by fuzzing).
+inline void CheckUtf8(const std::string& text, const std::string& source) {
+  const std::size_t n = text.size();
+  for (std::size_t i = 0; i < n;) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    const std::size_t len = c < 0x80           ? 1
+                            : (c >> 5) == 0x6  ? 2
+                            : (c >> 4) == 0xE  ? 3
+                            : (c >> 3) == 0x1E ? 4
+                                               : 0;
+    bool ok = len > 0 && i + len <= n;
+    for (std::size_t k = 1; ok && k < len; ++k)
+      ok = (static_cast<unsigned char>(text[i + k]) & 0xC0) == 0x80;
+    FS_THROW_UNLESS(ok, source, ": byte ", i, " (value ", static_cast<int>(c),
+                    ") starts no valid UTF-8 character; XML text must be UTF-8");
+    i += len;
+  }
+}
 
 /// While alive, collects urdfdom's error messages (console_bridge) instead of printing them, so
 /// that a failed parse can say why. console_bridge's handler is global: one capture at a time.
@@ -63,6 +88,17 @@ class FreeLinkCyclesOnExit {
  private:
   const urdf::ModelInterfaceSharedPtr& model_;
 };
+
+/// The urdfdom model of `text` (CheckUtf8 first); an Error naming `source` and urdfdom's reasons
+/// when it is not a valid URDF. Pair it with FreeLinkCyclesOnExit.
+inline urdf::ModelInterfaceSharedPtr ParseUrdf(const std::string& text, const std::string& source) {
+  CheckUtf8(text, source);
+  CaptureUrdfdomErrors errors;
+  urdf::ModelInterfaceSharedPtr urdf = urdf::parseURDF(text);
+  FS_THROW_UNLESS(urdf != nullptr, source, ": not a valid URDF: ",
+                  errors.messages().empty() ? "urdfdom gave no reason" : errors.messages());
+  return urdf;
+}
 
 inline Eigen::Isometry3d ToIsometry(const urdf::Pose& pose) {
   Eigen::Isometry3d X = Eigen::Isometry3d::Identity();

@@ -154,6 +154,38 @@ TEST(EFlowModel, ConstructorRejectsBadLayers) {
   ExpectErrorContains([&] { good.Forward(Eigen::Vector3d::Zero()); }, {"Forward", "3"});
 }
 
+// Issue 18 (found by fuzzing an edited artifact): finite but huge weights overflow double range for
+// some states; the queries then stop with an Error naming the model instead of answering NaN or 0.
+TEST(EFlowModel, OverflowingWeightsAreAnErrorNotAnAnswer) {
+  const EFlowModel good = RandomModel(2, 3, 5, 52);
+  std::vector<EFlowCouplingLayer> layers = good.layers();
+  layers[1].scale.setConstant(400.0);  // |s| up to 400 * 5 * sqrt(2 / 5) = 1265 > 709
+  bool threw = false;
+  const auto check = [&](const Error& e) {
+    threw = true;
+    EXPECT_NE(std::string(e.what()).find("huge.h5"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("overflows"), std::string::npos) << e.what();
+  };
+  try {
+    // psi(goal) may already overflow (the constructor evaluates it).
+    const EFlowModel huge(2, layers, Eigen::Vector2d(0.0, 0.0), 1.0, "huge.h5");
+    for (double a = -3; a <= 3 && !threw; a += 0.05) {
+      const Eigen::Vector2d x(a, -a);
+      try {
+        EXPECT_TRUE(huge.Velocity(x).allFinite()) << "non-finite velocity at " << x.transpose();
+        Eigen::MatrixXd J;
+        const Eigen::VectorXd z = huge.Forward(x, &J);
+        EXPECT_TRUE(z.allFinite() && J.allFinite());
+      } catch (const Error& e) {
+        check(e);
+      }
+    }
+  } catch (const Error& e) {
+    check(e);
+  }
+  EXPECT_TRUE(threw) << "no state overflowed; the test's weights are too small";
+}
+
 TEST(EFlowModel, SaveLoadRoundTrip) {
   TempDir dir;
   const std::string path = dir.File("eflow.h5");

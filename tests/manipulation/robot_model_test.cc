@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "inference/manipulation/urdf_util.h"
 #define FORESIGHT_ALLOC_COUNTER_MALLOC  // count Eigen's malloc too
 #include "tests/alloc_counter.h"        // replaces operator new: one per binary
 #include "tests/test_util.h"
@@ -564,9 +565,22 @@ TEST_F(PandaBadInput, MissingFiles) {
   ExpectErrorContains([&] { RobotModel::LoadPanda(dir_.path()); }, {"panda.urdf", dir_.path()});
 }
 
+// Issue 18 (found by fuzzing): TinyXML reads past the text on a truncated UTF-8 sequence, so XML
+// that is not UTF-8 is refused before parsing, naming the byte.
+TEST(UrdfText, NotUtf8IsAnErrorNamingTheByte) {
+  EXPECT_NO_THROW(urdf_util::CheckUtf8(
+      "<robot name=\"caf\xC3\xA9 \xE2\x82\xAC \xF0\x9F\x98\x80\"/>", "a.urdf"));
+  ExpectErrorContains([] { urdf_util::CheckUtf8("<robot/>\xF0\x9F", "a.urdf"); },
+                      {"a.urdf", "byte 8", "UTF-8"});
+  ExpectErrorContains([] { urdf_util::CheckUtf8("<r \x89/>", "b.srdf"); }, {"b.srdf", "byte 3"});
+  ExpectErrorContains([] { urdf_util::CheckUtf8("<r \xC3(/>", "c.urdf"); }, {"c.urdf", "byte 3"});
+}
+
 TEST_F(PandaBadInput, UrdfErrors) {
   ExpectLoadError("<robot name=\"x\"><link name=\"a\"></robot>", csv_, srdf_,
                   {Urdf(), "not a valid URDF"});
+  ExpectLoadError(urdf_ + "\xE2\x82", csv_, srdf_, {Urdf(), "UTF-8"});
+  ExpectLoadError(urdf_, csv_, srdf_ + "\xC3", {Srdf(), "UTF-8"});
   // A revolute arm joint without <limit> (urdfdom's reason is passed on).
   ExpectLoadError(
       Edit(urdf_, "<limit effort=\"87\" lower=\"-3.1416\" upper=\"0.0873\" velocity=\"2.3925\" />",
