@@ -66,8 +66,11 @@ void AddMapCommands(CLI::App* app) {
                         "); fusing a map with itself counts its evidence twice");
     for (std::size_t i = 0; i < args->inputs.size(); ++i)
       for (std::size_t j = 0; j < i; ++j)
-        FS_THROW_UNLESS(!SameBytes(args->inputs[i], args->inputs[j]), args->inputs[i],
-                        ": holds the same bytes as input ", j + 1, " (", args->inputs[j],
+        // Copies of --base itself are robots that saw nothing new: their increments are zero.
+        FS_THROW_UNLESS(!SameBytes(args->inputs[i], args->inputs[j]) ||
+                            (!args->base.empty() && SameBytes(args->inputs[i], args->base)),
+                        args->inputs[i], ": holds the same bytes as input ", j + 1, " (",
+                        args->inputs[j],
                         "), a copy of one map; fusing a map with itself counts its evidence twice");
     std::vector<std::string> read = args->inputs;
     if (!args->base.empty()) read.push_back(args->base);

@@ -12,10 +12,70 @@ function(foresight_add_library name)
   set_target_properties(${name} PROPERTIES POSITION_INDEPENDENT_CODE ON)
 endfunction()
 
+# foresight_links_torch(TARGET OUT): OUT is TRUE when TARGET links LibTorch, directly or through
+# the libraries it links (a source may include LibTorch only under #ifdef in a torch-free target).
+function(foresight_links_torch target out)
+  get_property(known GLOBAL PROPERTY "FORESIGHT_LINKS_TORCH:${target}" SET)
+  if(known)
+    get_property(value GLOBAL PROPERTY "FORESIGHT_LINKS_TORCH:${target}")
+    set(${out} ${value} PARENT_SCOPE)
+    return()
+  endif()
+  set_property(GLOBAL PROPERTY "FORESIGHT_LINKS_TORCH:${target}" FALSE)  # link cycles end here
+  get_target_property(type ${target} TYPE)
+  set(libraries "")
+  if(NOT type STREQUAL "INTERFACE_LIBRARY")
+    get_target_property(libraries ${target} LINK_LIBRARIES)
+  endif()
+  get_target_property(interface ${target} INTERFACE_LINK_LIBRARIES)
+  foresight_any_links_torch(result ${libraries} ${interface})
+  set_property(GLOBAL PROPERTY "FORESIGHT_LINKS_TORCH:${target}" ${result})
+  set(${out} ${result} PARENT_SCOPE)
+endfunction()
+
+# foresight_any_links_torch(OUT LIBRARY...): OUT is TRUE when one of the link items is LibTorch or
+# a project target that links it.
+function(foresight_any_links_torch out)
+  set(result FALSE)
+  foreach(library IN LISTS ARGN)
+    if(library STREQUAL "torch" OR library MATCHES "lib(torch|c10)[^/]*$")
+      set(result TRUE)
+    elseif(TARGET "${library}")
+      get_target_property(imported "${library}" IMPORTED)
+      if(NOT imported)
+        foresight_links_torch("${library}" result)
+      endif()
+    endif()
+    if(result)
+      break()
+    endif()
+  endforeach()
+  set(${out} ${result} PARENT_SCOPE)
+endfunction()
+
+# foresight_builds_test(OUT DEPS...): whether this build makes a test binary that links
+# DEPS. Always, except in a LibTorch build with -DFORESIGHT_TORCH_FREE_TESTS=OFF, for binaries that
+# link no LibTorch: scripts/test.sh's sanitizer build (a LibTorch-free build) builds and runs those.
+function(foresight_builds_test out)
+  set(result TRUE)
+  if(FORESIGHT_WITH_TORCH AND NOT FORESIGHT_TORCH_FREE_TESTS)
+    foresight_any_links_torch(result ${ARGN})
+  endif()
+  set(${out} ${result} PARENT_SCOPE)
+endfunction()
+
 # foresight_add_test(NAME SOURCES a_test.cc DEPS lib [PREFIX p.])
 # PREFIX is prepended to the discovered ctest names (so `ctest -R p` selects the binary's tests).
+# A binary this build leaves to another (foresight_builds_test) is defined but neither built by
+# default nor run.
 function(foresight_add_test name)
   cmake_parse_arguments(ARG "" "PREFIX" "SOURCES;DEPS" ${ARGN})
+  foresight_builds_test(builds ${ARG_DEPS})
+  if(NOT builds)
+    add_executable(${name} EXCLUDE_FROM_ALL ${ARG_SOURCES})
+    target_link_libraries(${name} PRIVATE ${ARG_DEPS} GTest::gtest GTest::gtest_main)
+    return()
+  endif()
   add_executable(${name} ${ARG_SOURCES})
   target_compile_options(${name} PRIVATE ${FORESIGHT_WARNINGS})
   target_link_libraries(${name} PRIVATE ${ARG_DEPS} GTest::gtest GTest::gtest_main)

@@ -13,7 +13,7 @@
 namespace foresight {
 
 void WriteFileBytes(const std::string& path, const char* data, std::size_t size) {
-  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0666);  // less the umask
   FS_THROW_UNLESS(fd >= 0, path, ": cannot create (", std::strerror(errno), ")");
   std::size_t done = 0;
   while (done < size) {

@@ -267,8 +267,8 @@ std::string File::GetStringAttr(const std::string& object, const std::string& na
   // Loaders echo these values in one-line errors: an edited file must not smuggle in line breaks.
   for (std::size_t i = 0; i < out.size(); ++i) {
     const auto c = static_cast<unsigned char>(out[i]);
-    FS_THROW_UNLESS(c >= 0x20 && c != 0x7f, path_, ": attribute '", name, "' on '", object,
-                    "' holds control character ", static_cast<int>(c), " at position ", i,
+    FS_THROW_UNLESS((c >= 0x20 || c == '\t') && c != 0x7f, path_, ": attribute '", name, "' on '",
+                    object, "' holds control character ", static_cast<int>(c), " at position ", i,
                     "; expected printable text");
   }
   return out;

@@ -4,9 +4,11 @@
 ///   g_allocations = 0; g_counting = true; <hot path>; g_counting = false;
 ///   EXPECT_EQ(g_allocations.load(), 0);
 /// Eigen's heap goes through std::malloc, not operator new: define FORESIGHT_ALLOC_COUNTER_MALLOC
-/// before the include to count malloc/calloc/realloc too (glibc lets the executable interpose them;
-/// the real allocator stays glibc's). Not under AddressSanitizer, which owns malloc; where it is
-/// counted, FORESIGHT_COUNTS_MALLOC is defined.
+/// before the include to count malloc/calloc/realloc too. With glibc the executable interposes them
+/// (the real allocator stays glibc's); under AddressSanitizer, which owns malloc, the counter is
+/// its allocation hook (<sanitizer/allocator_interface.h>). Where malloc is counted,
+/// FORESIGHT_COUNTS_MALLOC is defined. Either way operator new is counted twice (itself, then the
+/// malloc it calls): the tests ask for zero or for a bound measured in the same build.
 
 #include <atomic>
 #include <cstdlib>
@@ -38,8 +40,21 @@ void* operator new[](std::size_t n, const std::nothrow_t& t) noexcept { return o
 void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
 void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); }
 
-#if defined(FORESIGHT_ALLOC_COUNTER_MALLOC) && defined(__GLIBC__) && \
-    !defined(__SANITIZE_ADDRESS__) && !defined(FORESIGHT_SANITIZE)
+#if defined(FORESIGHT_ALLOC_COUNTER_MALLOC) && \
+    (defined(__SANITIZE_ADDRESS__) || defined(FORESIGHT_SANITIZE))
+#define FORESIGHT_COUNTS_MALLOC 1
+#include <sanitizer/allocator_interface.h>
+namespace {
+void CountMalloc(const volatile void*, std::size_t) {
+  if (g_counting) ++g_allocations;
+}
+void IgnoreFree(const volatile void*) {}
+// Installed before main() (both hooks must be given); ASan calls it on every malloc, calloc,
+// realloc and operator new.
+[[maybe_unused]] const int g_malloc_hook_installed =
+    __sanitizer_install_malloc_and_free_hooks(&CountMalloc, &IgnoreFree);
+}  // namespace
+#elif defined(FORESIGHT_ALLOC_COUNTER_MALLOC) && defined(__GLIBC__)
 #define FORESIGHT_COUNTS_MALLOC 1
 extern "C" {
 void* __libc_malloc(std::size_t);

@@ -35,8 +35,9 @@ printf '0\t1\t0.0\t0.0\n10\t1\tzz\t1.0\n' > "$TMP/bad.txt"
 expect_error "bad.txt:2" data convert "$TMP/bad.txt" -o "$TMP/bad.h5"
 printf '0\t1\t0.0\t0.0\n10\t1\t1.0\t1.0\n' > "$TMP/good.txt"
 expect_error "seconds-per-step: nan" data convert "$TMP/good.txt" -o "$TMP/nan.h5" --seconds-per-step nan
-expect_error "not a regular file" data convert "$TMP/good.txt" -o /dev/null
-[ -c /dev/null ] || fail "data convert -o /dev/null replaced the device"
+mkfifo "$TMP/fifo"  # stands in for a device such as /dev/full (never touch the real ones)
+expect_error "not a regular file" data convert "$TMP/good.txt" -o "$TMP/fifo"
+[ -p "$TMP/fifo" ] || fail "data convert -o FIFO replaced it"
 
 # Occupancy maps: torch-free, so in both builds.
 json_number() {  # json_number FILE KEY: the number of "KEY": on its own line
@@ -78,8 +79,9 @@ expect_error "given twice" map fuse "$FUS/single.h5" "$FUS/single.h5" -o "$TMP/t
 cp "$FUS/single.h5" "$TMP/single_copy.h5"
 expect_error "same bytes as input 1" map fuse "$FUS/single.h5" "$TMP/single_copy.h5" -o "$TMP/twice.h5"
 expect_error "the output is also an input" map fuse "$FUS/single.h5" "$FUS/fuse_once.h5" -o "$FUS/single.h5"
-expect_error "not a regular file" map fuse "$FUS/single.h5" "$FUS/fuse_once.h5" -o /dev/null
-[ -c /dev/null ] || fail "map fuse -o /dev/null replaced the device"
+mkdir -p "$TMP/a_dir"
+expect_error "not a regular file" map fuse "$FUS/single.h5" "$FUS/fuse_once.h5" -o "$TMP/a_dir"
+[ -d "$TMP/a_dir" ] || fail "map fuse -o DIR replaced the directory"
 "$BIN" train configs/occupancy/synthetic.yaml features.spacing=0.6 --run-dir "$TMP/occ_coarse" >/dev/null 2>&1 || fail "coarse train"
 expect_error "feature grid" map fuse "$OCC/model.h5" "$TMP/occ_coarse/model.h5" -o "$TMP/refused.h5"
 grep -q "occ_coarse/model.h5" "$TMP/err" || fail "refused fusion does not name the map"

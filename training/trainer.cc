@@ -83,7 +83,18 @@ std::string TrainingSummary::ToJson() const {
 }
 
 void WriteTrainingSummary(const std::string& path, const TrainingSummary& s) {
-  if (s.reason == TerminationReason::kAlreadyComplete && fs::exists(path)) return;
+  if (s.reason == TerminationReason::kAlreadyComplete) {
+    // Keep the summary of the invocation that finished, if it got to write one (a run killed
+    // after its last epoch but before its summary left an earlier, interrupted one).
+    std::ifstream in(path);
+    std::stringstream text;
+    text << in.rdbuf();
+    for (const TerminationReason finished :
+         {TerminationReason::kMaxEpochs, TerminationReason::kEarlyStopped})
+      if (text.str().find(std::string("\"reason\": \"") + ToString(finished) + "\"") !=
+          std::string::npos)
+        return;
+  }
   WriteFileAtomically(path, s.ToJson());
 }
 
@@ -197,8 +208,9 @@ void SaveCheckpoint(const std::string& path, torch::nn::Module& module,
   try {
     WriteFileAtomically(path, WithChecksum(bytes.str()));
   } catch (const Error& e) {
-    Fail(e.what(), fs::exists(path) ? "; the previous checkpoint is kept"
-                                    : "; no checkpoint of this run was saved yet");
+    const std::string name = fs::path(path).filename().string();
+    Fail(e.what(), fs::exists(path) ? "; the previous " + name + " is kept"
+                                    : "; no " + name + " was saved before");
   }
 }
 

@@ -65,7 +65,8 @@ void ExpectNoAllocation(const OccupancyMap& map, const ComponentParams& c0,
 
 TEST(CollisionCostHotPath, ComponentAllocatesNothingAfterWarmUp) {
 #ifndef FORESIGHT_COUNTS_MALLOC
-  GTEST_SKIP() << "malloc is not counted in this build (sanitizer); operator new only";
+  GTEST_SKIP() << "malloc is not counted in this build (neither glibc nor AddressSanitizer); "
+                  "operator new only";
 #endif
   const TimeBasis basis(8, 0.0, 4.8, 1.0);
   const SmoothHalfPlane plane;

@@ -383,7 +383,8 @@ TEST(DistributionProjector, RejectsMisuse) {
 
 TEST(DistributionProjector, CostAllocatesNothing) {
 #ifndef FORESIGHT_COUNTS_MALLOC
-  GTEST_SKIP() << "malloc is not counted in this build (sanitizer); operator new only";
+  GTEST_SKIP() << "malloc is not counted in this build (neither glibc nor AddressSanitizer); "
+                  "operator new only";
 #endif
   const SmoothHalfPlane map = Wall();
   const DistributionProjector projector(&map, Basis(), Times(), ProjectorOptions{});

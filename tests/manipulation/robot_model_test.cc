@@ -503,7 +503,7 @@ TEST(Kinematics, AllocatesNothing) {
   const RobotFiles files = WriteSyntheticRobot(dir);
   const RobotModel synthetic = RobotModel::Load(files.urdf, files.spheres, "");
 #ifndef FORESIGHT_COUNTS_MALLOC
-  GTEST_SKIP() << "malloc is not interposed in this build (sanitizers or not glibc)";
+  GTEST_SKIP() << "malloc is not counted in this build (neither glibc nor AddressSanitizer)";
 #endif
   // The counter sees Eigen's heap (malloc), not only operator new.
   volatile double sink = 0;

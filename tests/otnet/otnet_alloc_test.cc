@@ -62,7 +62,7 @@ void PlaceMixture(const OtnetModel& model, Mixture* m) {
 
 TEST(OtnetAlloc, HotPathsAllocateNothingAfterSetUp) {
 #ifndef FORESIGHT_COUNTS_MALLOC
-  GTEST_SKIP() << "malloc is not counted in this build (sanitizer)";
+  GTEST_SKIP() << "malloc is not counted in this build (neither glibc nor AddressSanitizer)";
 #endif
   for (const MixtureFamily family : {MixtureFamily::kNormal, MixtureFamily::kLaplace}) {
     const OtnetModel model = Model(family);

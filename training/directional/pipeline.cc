@@ -569,7 +569,7 @@ void CheckFoldRows(const std::string& work, const std::vector<Eigen::Index>& row
                   " holds a fold trained before path folds existed (point folds): evaluate it "
                   "with eval.folds_by=point");
   fs::create_directories(work);
-  std::ofstream(path) << want.str() << "\n";
+  WriteFileAtomically(path, want.str() + "\n");
 }
 
 DirectionalRunResult RunFolds(const DirectionalExperimentConfig& c, const std::string& run_dir,
