@@ -1,8 +1,9 @@
 // `foresight bench fabric [CONFIG] [--json]`: manipulation runtime figures measured in one run on
 // one thread (except the GFCS solve, which uses the config's threads): forward kinematics of every
 // collision sphere (positions; with Jacobians and J' q_d), one fabric step, a full rollout to the
-// goal, and a GFCS solve (one batch, uniform sampler). Medians of repeated runs over the config's
-// problems. KDL side by side: the bench_kinematics benchmark (experiments/).
+// goal, and a GFCS solve (one batch, uniform sampler) with and without pruning (GfcsParams::prune:
+// the same top candidates). Medians of repeated runs over the config's problems. KDL side by side:
+// the bench_kinematics benchmark (experiments/).
 
 #include <algorithm>
 #include <chrono>
@@ -80,7 +81,7 @@ void RunFabricBench(const BenchFabricArgs& a) {
   });
 
   // Fabric step and rollout on each problem's world (valid start states).
-  std::vector<double> steps, rollouts, rollout_times, solves;
+  std::vector<double> steps, rollouts, rollout_times, solves, unpruned_solves, pruned_shares;
   for (const ManipulationProblem& problem : problems) {
     const ValidityChecker checker(robot, problem.world);
     if (checker.Check(problem.start, &data) != Validity::kValid) continue;
@@ -102,11 +103,19 @@ void RunFabricBench(const BenchFabricArgs& a) {
     GfcsQuery query;
     query.start = problem.start;
     query.goal = problem.goal;
-    solves.push_back(
+    params.prune = false;
+    unpruned_solves.push_back(
         PerCall(a.repeats, 1, [&](int) { SolveGfcop(fabric, query, &sampler, params); }));
+    params.prune = true;
+    GfcsSolution solution;
+    solves.push_back(PerCall(a.repeats, 1,
+                             [&](int) { solution = SolveGfcop(fabric, query, &sampler, params); }));
+    pruned_shares.push_back(static_cast<double>(solution.pruned) /
+                            std::max(1, solution.evaluations));
   }
   FS_THROW_UNLESS(!steps.empty(), "bench fabric: no problem has a valid start");
   const double step = Median(steps), rollout = Median(rollouts), solve = Median(solves);
+  const double unpruned = Median(unpruned_solves), pruned_share = Median(pruned_shares);
   const double integrated = Median(rollout_times);
 
   if (a.json) {
@@ -114,6 +123,8 @@ void RunFabricBench(const BenchFabricArgs& a) {
               << ", \"fk_us\": " << fk * 1e6 << ", \"fk_jacobians_us\": " << fk_jac * 1e6
               << ", \"fabric_step_us\": " << step * 1e6 << ", \"rollout_ms\": " << rollout * 1e3
               << ", \"rollout_integrated_s\": " << integrated << ", \"gfcs_solve_s\": " << solve
+              << ", \"gfcs_solve_unpruned_s\": " << unpruned
+              << ", \"gfcs_pruned_share\": " << pruned_share
               << ", \"gfcs_batch_size\": " << c.gfcs.batch_size
               << ", \"problems\": " << steps.size() << "}\n";
     return;
@@ -127,7 +138,11 @@ void RunFabricBench(const BenchFabricArgs& a) {
             << "rollout to the goal               " << std::setw(8) << rollout * 1e3 << " ms   ("
             << integrated << " s integrated)\n"
             << "GFCS solve, 1 batch of " << c.gfcs.batch_size << "       " << std::setw(8) << solve
-            << " s   (" << (c.gfcs.threads > 0 ? c.gfcs.threads : 0) << " threads; 0: all cores)\n";
+            << " s   (" << (c.gfcs.threads > 0 ? c.gfcs.threads : 0)
+            << " threads, 0: all cores; pruned, median share of candidates stopped " << pruned_share
+            << ")\n"
+            << "  the same, unpruned              " << std::setw(8) << unpruned << " s   ("
+            << unpruned / solve << "x the pruned time)\n";
 }
 }  // namespace
 

@@ -83,6 +83,8 @@ const char* ToString(RolloutStatus status) {
       return "joint_limit";
     case RolloutStatus::kNonFinite:
       return "non_finite";
+    case RolloutStatus::kStopped:
+      return "stopped";
   }
   return "unknown";
 }
@@ -187,7 +189,7 @@ bool Fabric::Acceleration(const JointVector& q, const JointVector& qd, const Joi
 
 RolloutResult Fabric::Rollout(const JointVector& q0, const JointVector& qd0,
                               const JointVector& command, FabricWorkspace* ws,
-                              std::vector<JointVector>* path) const {
+                              std::vector<JointVector>* path, double stop_beyond_s) const {
   const FabricParams& p = params_;
   const JointLimits& limits = robot_.limits();
   const int max_steps = static_cast<int>(std::llround(p.t_max / p.dt));
@@ -216,6 +218,10 @@ RolloutResult Fabric::Rollout(const JointVector& q0, const JointVector& qd0,
     }
     if (step >= max_steps) {
       result.status = RolloutStatus::kTimeout;
+      return result;
+    }
+    if (result.t > stop_beyond_s) {
+      result.status = RolloutStatus::kStopped;
       return result;
     }
     result.qd += p.dt * qdd;

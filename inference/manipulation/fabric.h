@@ -35,6 +35,7 @@
 /// do not allocate.
 
 #include <Eigen/Core>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -140,6 +141,7 @@ enum class RolloutStatus {
   kCollision,   ///< a sphere penetrated an obstacle or another sphere
   kJointLimit,  ///< a joint left its limits
   kNonFinite,   ///< the acceleration became non-finite (the last finite state is returned)
+  kStopped,     ///< the caller's time limit (below t_max) passed first: the outcome is unknown
 };
 const char* ToString(RolloutStatus status);
 
@@ -190,9 +192,12 @@ class Fabric {
 
   /// Integrates from (q0, qd0) towards `command` until rollout_t (thesis), a collision, a limit
   /// violation or a non-finite state. When `path` is given, every state's q is appended to it
-  /// (this allocates; leave it null in optimisation loops).
+  /// (this allocates; leave it null in optimisation loops). A caller that only needs to know
+  /// whether the rollout lasts longer than `stop_beyond_s` gets kStopped at the first step whose
+  /// time exceeds it (the rollout is identical up to there).
   RolloutResult Rollout(const JointVector& q0, const JointVector& qd0, const JointVector& command,
-                        FabricWorkspace* ws, std::vector<JointVector>* path = nullptr) const;
+                        FabricWorkspace* ws, std::vector<JointVector>* path = nullptr,
+                        double stop_beyond_s = std::numeric_limits<double>::infinity()) const;
 
  private:
   const RobotModel& robot_;

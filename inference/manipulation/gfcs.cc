@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <limits>
+#include <mutex>
 #include <thread>
 
 #include "core/error.h"
@@ -11,16 +13,45 @@
 namespace foresight::manipulation {
 namespace {
 
-/// Evaluates the columns of `candidates` on `workspaces.size()` threads into `out`.
+/// The m-th lowest cost among the candidates finished so far (+inf before m have finished),
+/// shared by the rollout threads of a batch.
+class TopCostBound {
+ public:
+  explicit TopCostBound(int m) : m_(m) { best_.reserve(static_cast<std::size_t>(m) + 1); }
+  double Get() const { return bound_.load(std::memory_order_relaxed); }
+  void Offer(double cost) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    best_.insert(std::upper_bound(best_.begin(), best_.end(), cost), cost);
+    if (static_cast<int>(best_.size()) > m_) best_.pop_back();
+    if (static_cast<int>(best_.size()) == m_) bound_.store(best_.back(), std::memory_order_relaxed);
+  }
+
+ private:
+  const int m_;
+  std::mutex mutex_;
+  std::vector<double> best_;  ///< ascending, at most m
+  std::atomic<double> bound_{std::numeric_limits<double>::infinity()};
+};
+
+/// Evaluates the columns of `candidates` on `workspaces.size()` threads into `out`. With `prune_m`
+/// > 0 a candidate stops once its time exceeds the prune_m-th best finished cost: which ones stop
+/// depends on the threads' timing, the prune_m best (exact) candidates do not.
 void EvaluateBatch(const Fabric& fabric, const GfcsQuery& query, const Eigen::MatrixXd& candidates,
-                   double penalty, std::vector<FabricWorkspace>* workspaces,
+                   double penalty, int prune_m, std::vector<FabricWorkspace>* workspaces,
                    std::vector<GfcsCandidate>* out) {
   const int count = static_cast<int>(candidates.cols());
   out->resize(count);
   std::atomic<int> next{0};
+  TopCostBound bound(std::max(prune_m, 1));
   auto work = [&](FabricWorkspace* ws) {
-    for (int i = next++; i < count; i = next++)
-      (*out)[i] = EvaluateCommandSequence(fabric, query, candidates.col(i), penalty, ws);
+    for (int i = next++; i < count; i = next++) {
+      const double prune_above =
+          prune_m > 0 ? bound.Get() : std::numeric_limits<double>::infinity();
+      GfcsCandidate& c = (*out)[i];
+      c = EvaluateCommandSequence(fabric, query, candidates.col(i), penalty, ws, nullptr,
+                                  prune_above);
+      if (!c.pruned) bound.Offer(c.cost);
+    }
   };
   const int threads = std::min<int>(static_cast<int>(workspaces->size()), count);
   std::vector<std::thread> pool;
@@ -62,7 +93,8 @@ void UniformSampler::Sample(const GfcsQuery& /*query*/, int intermediate_command
 
 GfcsCandidate EvaluateCommandSequence(const Fabric& fabric, const GfcsQuery& query,
                                       const Eigen::VectorXd& commands, double penalty,
-                                      FabricWorkspace* ws, std::vector<JointVector>* path) {
+                                      FabricWorkspace* ws, std::vector<JointVector>* path,
+                                      double prune_above) {
   const int intermediate = static_cast<int>(commands.size() / kDof);
   GfcsCandidate c;
   c.commands = commands;
@@ -71,9 +103,14 @@ GfcsCandidate EvaluateCommandSequence(const Fabric& fabric, const GfcsQuery& que
   for (int i = 0; i <= intermediate; ++i) {
     const JointVector command =
         i < intermediate ? JointVector(commands.segment<kDof>(i * kDof)) : query.goal;
-    const RolloutResult r = fabric.Rollout(q, qd, command, ws, path);
+    const RolloutResult r = fabric.Rollout(q, qd, command, ws, path, prune_above - c.time);
     c.time += r.t;
     c.last_status = r.status;
+    if (r.status == RolloutStatus::kStopped) {
+      c.pruned = true;
+      c.cost = c.time;
+      return c;
+    }
     if (!r.ok()) {  // collision, joint limit or non-finite: infeasible, worse than any timeout
       c.feasible = false;
       c.cost = (intermediate + 1) * fabric.params().t_max + penalty;
@@ -114,7 +151,7 @@ GfcsSolution SolveGfcop(const Fabric& fabric, const GfcsQuery& query, CommandSam
   Eigen::MatrixXd candidates;
   if (intermediate == 0) {  // a single command: the goal itself; nothing to optimise
     candidates.resize(0, 1);
-    EvaluateBatch(fabric, query, candidates, params.penalty, &workspaces, &batch);
+    EvaluateBatch(fabric, query, candidates, params.penalty, /*prune_m=*/0, &workspaces, &batch);
     all = batch;
   } else {
     sampler->Sample(query, intermediate, params.batch_size, &rng, &candidates);
@@ -129,7 +166,10 @@ GfcsSolution SolveGfcop(const Fabric& fabric, const GfcsQuery& query, CommandSam
     es.Inject(candidates);
     for (int b = 0; b < params.batches; ++b) {
       const Eigen::MatrixXd& asked = es.Ask();
-      EvaluateBatch(fabric, query, asked, params.penalty, &workspaces, &batch);
+      // CMA-ES ranks every cost it is told: only the last batch (told nothing) is pruned.
+      const bool last = b + 1 == params.batches;
+      EvaluateBatch(fabric, query, asked, params.penalty, last && params.prune ? params.top_m : 0,
+                    &workspaces, &batch);
       Eigen::VectorXd costs(static_cast<Eigen::Index>(batch.size()));
       for (std::size_t i = 0; i < batch.size(); ++i)
         costs[static_cast<Eigen::Index>(i)] = batch[i].cost;
@@ -138,8 +178,14 @@ GfcsSolution SolveGfcop(const Fabric& fabric, const GfcsQuery& query, CommandSam
     }
   }
   solution.evaluations = static_cast<int>(all.size());
-  std::stable_sort(all.begin(), all.end(),
-                   [](const GfcsCandidate& a, const GfcsCandidate& b) { return a.cost < b.cost; });
+  solution.pruned = static_cast<int>(
+      std::count_if(all.begin(), all.end(), [](const GfcsCandidate& c) { return c.pruned; }));
+  // Pruned candidates cost more than the top_m-th exact cost of their batch: they sort last, so the
+  // top m are those of an unpruned solve.
+  std::stable_sort(all.begin(), all.end(), [](const GfcsCandidate& a, const GfcsCandidate& b) {
+    if (a.pruned != b.pruned) return b.pruned;
+    return a.cost < b.cost;
+  });
   if (static_cast<int>(all.size()) > params.top_m)
     all.resize(static_cast<std::size_t>(params.top_m));
   solution.top = std::move(all);

@@ -10,9 +10,13 @@
 /// A rollout that collides, leaves the joint limits or becomes non-finite makes the candidate
 /// infeasible: its cost is (n+1) t_max + M, above every collision-free candidate (the thesis's
 /// cost has no collision term because its fabric never collides; ours reports when it does).
+/// Pruning (GfcsParams::prune, not in the thesis): since a cost is never below its summed rollout
+/// time, a last-batch candidate whose time passes the top_m-th best cost finished so far cannot be
+/// in the top m; it is stopped there. The returned top m are exactly those of a full evaluation.
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -32,6 +36,9 @@ struct GfcsParams {
   double sigma0 = 0.5;    ///< CMA-ES initial step size after the first batch (rad)
   int threads = 0;        ///< rollout threads; 0: the hardware's
   std::int64_t seed = 0;  ///< sampler and CMA-ES seed
+  /// Stop a candidate of the last batch once its rollout time exceeds the m-th best cost the
+  /// batch has finished (its cost can only be higher). The top m are the same as without it.
+  bool prune = true;
 
   template <class A>
   void Serialize(A* a) {
@@ -45,6 +52,9 @@ struct GfcsParams {
     a->Visit("sigma0", &sigma0, config::Range::Positive(), "CMA-ES initial step size (rad)");
     a->Visit("threads", &threads, config::Range::Closed(0, 256), "rollout threads (0: all cores)");
     a->Visit("seed", &seed, config::Range::Any(), "seed of the sampler and CMA-ES");
+    a->Visit("prune", &prune, config::Range::Any(),
+             "stop last-batch candidates whose time already exceeds the top_m-th best cost "
+             "(same top_m, less time)");
   }
 };
 
@@ -85,14 +95,19 @@ struct GfcsCandidate {
   bool reached = false;      ///< the goal was reached (within t_max) without collision
   bool feasible = true;      ///< no rollout collided, left the limits or became non-finite
   RolloutStatus last_status = RolloutStatus::kTimeout;  ///< status of the last rollout run
+  /// Stopped once `time` exceeded the caller's bound: `cost` (= time) is a lower bound, and
+  /// reached/feasible are unknown (false/true).
+  bool pruned = false;
 };
 
 /// Rolls out `commands` [7n] (then the goal) from the query's start state and prices the sequence
 /// (`penalty` = M). When `path` is given every integration state is appended, the start included.
+/// Once the summed rollout time exceeds `prune_above` the evaluation stops (`pruned`): a cost is
+/// never below the summed time, so the candidate costs more than `prune_above`.
 GfcsCandidate EvaluateCommandSequence(const Fabric& fabric, const GfcsQuery& query,
                                       const Eigen::VectorXd& commands, double penalty,
-                                      FabricWorkspace* ws,
-                                      std::vector<JointVector>* path = nullptr);
+                                      FabricWorkspace* ws, std::vector<JointVector>* path = nullptr,
+                                      double prune_above = std::numeric_limits<double>::infinity());
 
 enum class GfcsStatus {
   kSolved,     ///< the best candidate reaches the goal
@@ -106,6 +121,7 @@ struct GfcsSolution {
   std::string message;
   std::vector<GfcsCandidate> top;  ///< best first, at most top_m
   int evaluations = 0;
+  int pruned = 0;           ///< of the evaluations, stopped early (GfcsParams::prune)
   double solve_time_s = 0;  ///< wall time of SolveGfcop
   bool solved() const { return status == GfcsStatus::kSolved; }
 };

@@ -162,6 +162,33 @@ TEST(Fabric, RolloutReachesTheCommandInAnEmptyWorld) {
   EXPECT_NEAR(r.t, r.steps * fabric.params().dt, 1e-12);
 }
 
+TEST(Fabric, AStoppedRolloutIsThePrefixOfTheFullOne) {
+  const World world = TwoObstacleWorld();
+  const Fabric fabric(Panda(), world, FabricParams{});
+  FabricWorkspace ws = fabric.MakeWorkspace();
+  JointVector start, goal;
+  start << 0, -0.785, 0, -2.356, 0, 1.571, 0.785;
+  goal << 0.8, 0.2, -0.3, -1.8, 0.4, 2.0, 0.2;
+  std::vector<JointVector> full_path;
+  const RolloutResult full = fabric.Rollout(start, JointVector::Zero(), goal, &ws, &full_path);
+  ASSERT_GT(full.steps, 10) << ToString(full.status);
+  const double limit = 0.5 * full.t;
+  std::vector<JointVector> path;
+  const RolloutResult stopped = fabric.Rollout(start, JointVector::Zero(), goal, &ws, &path, limit);
+  EXPECT_EQ(stopped.status, RolloutStatus::kStopped);
+  EXPECT_GT(stopped.t, limit);  // the first step past the limit
+  EXPECT_LE(stopped.t - fabric.params().dt, limit);
+  ASSERT_EQ(static_cast<int>(path.size()), stopped.steps);
+  for (int i = 0; i < stopped.steps; ++i) EXPECT_EQ(path[i], full_path[i]);
+  EXPECT_EQ(stopped.q, full_path[stopped.steps - 1]);
+  // A limit beyond the rollout changes nothing.
+  const RolloutResult same =
+      fabric.Rollout(start, JointVector::Zero(), goal, &ws, nullptr, full.t + 1.0);
+  EXPECT_EQ(same.status, full.status);
+  EXPECT_EQ(same.q, full.q);
+  EXPECT_EQ(same.t, full.t);
+}
+
 TEST(Fabric, RolloutsNeverPenetrateTheObstacles) {
   const World world = TwoObstacleWorld();
   const Fabric fabric(Panda(), world, FabricParams{});
@@ -281,6 +308,74 @@ TEST(Gfcs, SolveIsDeterministicSortedAndBeatsOrMatchesItsFirstBatch) {
     }
   }
   EXPECT_EQ(a.solved(), !a.top.empty() && a.top.front().reached);
+}
+
+TEST(Gfcs, APrunedCandidateCostsMoreThanItsBound) {
+  const ManipulationProblem problem = SyntheticProblem(3);
+  const Fabric fabric(Panda(), problem.world, FabricParams{});
+  FabricWorkspace ws = fabric.MakeWorkspace();
+  GfcsQuery query;
+  query.start = problem.start;
+  query.goal = problem.goal;
+  const JointVector mid = 0.5 * (problem.start + problem.goal);
+  const GfcsCandidate exact = EvaluateCommandSequence(fabric, query, mid, 100.0, &ws);
+  ASSERT_FALSE(exact.pruned);
+  ASSERT_GT(exact.time, 0.1);
+  for (const double bound : {0.3 * exact.time, 0.9 * exact.time}) {
+    const GfcsCandidate c = EvaluateCommandSequence(fabric, query, mid, 100.0, &ws, nullptr, bound);
+    EXPECT_TRUE(c.pruned) << bound;
+    EXPECT_GT(c.cost, bound);
+    EXPECT_LE(c.cost, exact.cost);  // a lower bound of the exact cost
+    EXPECT_EQ(c.last_status, RolloutStatus::kStopped);
+  }
+  const GfcsCandidate loose =
+      EvaluateCommandSequence(fabric, query, mid, 100.0, &ws, nullptr, exact.cost + 1.0);
+  EXPECT_FALSE(loose.pruned);
+  EXPECT_EQ(loose.cost, exact.cost);
+  EXPECT_EQ(loose.reached, exact.reached);
+}
+
+TEST(Gfcs, PruningKeepsTheTopCandidatesOfAnUnprunedSolve) {
+  // Short rollouts keep this quick under the sanitizers; with top_m = 2 some candidates of most
+  // problems finish below others' times, so pruning happens.
+  FabricParams fabric_params;
+  fabric_params.t_max = 3.0;
+  int pruned = 0;
+  for (const std::uint64_t seed : {3u, 5u, 8u}) {
+    const ManipulationProblem problem = SyntheticProblem(seed);
+    const Fabric fabric(Panda(), problem.world, fabric_params);
+    GfcsQuery query;
+    query.start = problem.start;
+    query.goal = problem.goal;
+    for (const auto& [batches, threads] : {std::pair{1, 2}, std::pair{2, 1}}) {
+      GfcsParams params;
+      params.batch_size = 8;
+      params.batches = batches;
+      params.top_m = 2;
+      params.threads = threads;
+      params.seed = static_cast<std::int64_t>(seed);
+      params.prune = false;
+      UniformSampler sampler(Panda().limits().lower, Panda().limits().upper);
+      const GfcsSolution full = SolveGfcop(fabric, query, &sampler, params);
+      params.prune = true;
+      const GfcsSolution fast = SolveGfcop(fabric, query, &sampler, params);
+      const std::string where = "problem " + std::to_string(seed) + ", " + std::to_string(batches) +
+                                " batches, " + std::to_string(threads) + " threads";
+      ASSERT_NE(full.status, GfcsStatus::kError) << full.message;
+      EXPECT_EQ(full.pruned, 0) << where;
+      EXPECT_EQ(fast.status, full.status) << where;
+      EXPECT_EQ(fast.evaluations, full.evaluations) << where;
+      ASSERT_EQ(fast.top.size(), full.top.size()) << where;
+      for (std::size_t i = 0; i < full.top.size(); ++i) {
+        EXPECT_EQ(fast.top[i].commands, full.top[i].commands) << where << ", rank " << i;
+        EXPECT_EQ(fast.top[i].cost, full.top[i].cost) << where << ", rank " << i;
+        EXPECT_EQ(fast.top[i].reached, full.top[i].reached) << where << ", rank " << i;
+        EXPECT_FALSE(fast.top[i].pruned) << where << ", rank " << i;
+      }
+      pruned += fast.pruned;
+    }
+  }
+  EXPECT_GT(pruned, 0) << "no candidate was ever pruned: the test did not test pruning";
 }
 
 TEST(Gfcs, BadQueriesAreStatusesNotExceptions) {
