@@ -255,13 +255,19 @@ ManipulationProblem SyntheticProblem(std::uint64_t seed) {
                               Panda().limits().upper, is_valid, seed);
 }
 
+/// The problem's start (at rest) and goal.
+GfcsQuery QueryOf(const ManipulationProblem& problem) {
+  GfcsQuery query;
+  query.start = problem.start;
+  query.goal = problem.goal;
+  return query;
+}
+
 TEST(Gfcs, CostIsTheSumOfRolloutTimesPlusThePenaltyOnTimeout) {
   const ManipulationProblem problem = SyntheticProblem(3);
   const Fabric fabric(Panda(), problem.world, FabricParams{});
   FabricWorkspace ws = fabric.MakeWorkspace();
-  GfcsQuery query;
-  query.start = problem.start;
-  query.goal = problem.goal;
+  const GfcsQuery query = QueryOf(problem);
   const JointVector mid = 0.5 * (problem.start + problem.goal);
   const GfcsCandidate c = EvaluateCommandSequence(fabric, query, mid, 100.0, &ws);
   // The same two rollouts by hand.
@@ -286,9 +292,7 @@ TEST(Gfcs, CostIsTheSumOfRolloutTimesPlusThePenaltyOnTimeout) {
 TEST(Gfcs, SolveIsDeterministicSortedAndBeatsOrMatchesItsFirstBatch) {
   const ManipulationProblem problem = SyntheticProblem(5);
   const Fabric fabric(Panda(), problem.world, FabricParams{});
-  GfcsQuery query;
-  query.start = problem.start;
-  query.goal = problem.goal;
+  const GfcsQuery query = QueryOf(problem);
   GfcsParams params;
   params.batch_size = 8;
   params.batches = 2;
@@ -314,9 +318,7 @@ TEST(Gfcs, APrunedCandidateCostsMoreThanItsBound) {
   const ManipulationProblem problem = SyntheticProblem(3);
   const Fabric fabric(Panda(), problem.world, FabricParams{});
   FabricWorkspace ws = fabric.MakeWorkspace();
-  GfcsQuery query;
-  query.start = problem.start;
-  query.goal = problem.goal;
+  const GfcsQuery query = QueryOf(problem);
   const JointVector mid = 0.5 * (problem.start + problem.goal);
   const GfcsCandidate exact = EvaluateCommandSequence(fabric, query, mid, 100.0, &ws);
   ASSERT_FALSE(exact.pruned);
@@ -344,9 +346,7 @@ TEST(Gfcs, PruningKeepsTheTopCandidatesOfAnUnprunedSolve) {
   for (const std::uint64_t seed : {3u, 5u, 8u}) {
     const ManipulationProblem problem = SyntheticProblem(seed);
     const Fabric fabric(Panda(), problem.world, fabric_params);
-    GfcsQuery query;
-    query.start = problem.start;
-    query.goal = problem.goal;
+    const GfcsQuery query = QueryOf(problem);
     for (const auto& [batches, threads] : {std::pair{1, 2}, std::pair{2, 1}}) {
       GfcsParams params;
       params.batch_size = 8;
