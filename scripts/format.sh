@@ -8,19 +8,23 @@ command -v clang-format >/dev/null || { echo "clang-format is not installed (apt
 mapfile -t files < <(find apps core datasets experiments inference models tests training \
                        -type f \( -name '*.cc' -o -name '*.h' \) | sort)
 # The files that differ from their formatted text: clang-format on batches of files, two at a time,
-# each batch reporting to its own file (parallel writers would interleave their lines); names are
-# taken from its "-Wclang-format-violations" reports.
+# each batch reporting to its own file (parallel writers would interleave their lines). A report is
+# "FILE:L:C: error: code should be clang-formatted" followed by the source line and a caret line;
+# any other output (a bad .clang-format, a missing file, a crash: exit status above 1) is a failure.
 reports=$(mktemp -d)
 trap 'rm -rf "$reports"' EXIT
 printf '%s\0' "${files[@]}" |
-  xargs -0 -n 50 -P 2 sh -c 'clang-format --dry-run --Werror --ferror-limit=1 "$@" \
-                               >/dev/null 2>"$(mktemp -p "$0")"' "$reports" || true
-report=$(cat "$reports"/*)
-mapfile -t bad < <(grep -oE '^[^:]+:[0-9]+:[0-9]+: error: code should be clang-formatted' <<< "$report" |
-                     cut -d: -f1 | sort -u)
-# Anything else clang-format calls an error (not the echoed source lines that follow each report).
-other=$(grep -E '^(error|Error)|^[^ ]+: (error|Error)' <<< "$report" |
-          grep -v 'code should be clang-formatted' | sort -u || true)
+  xargs -0 -n 50 -P 2 sh -c 'out=$(mktemp -p "$0")
+    clang-format --dry-run --Werror --ferror-limit=1 "$@" >/dev/null 2>"$out"
+    rc=$?; [ "$rc" -le 1 ] || echo "error: clang-format exited with status $rc" >>"$out"' "$reports" ||
+  true
+violation=': error: code should be clang-formatted'
+mapfile -t bad < <(cat "$reports"/* | grep -F -- "$violation" | sed -E 's/:[0-9]+:[0-9]+: error: .*//' |
+                     sort -u)
+other=$(cat "$reports"/* | awk -v v="$violation" '
+  skip > 0 { skip--; next }
+  index($0, v) { skip = 2; next }
+  { print }' | sort -u)
 if [ -n "$other" ]; then
   printf 'clang-format failed:\n%s\n' "$other" >&2
   exit 2

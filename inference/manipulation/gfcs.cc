@@ -50,7 +50,7 @@ void EvaluateBatch(const Fabric& fabric, const GfcsQuery& query, const Eigen::Ma
       GfcsCandidate& c = (*out)[i];
       c = EvaluateCommandSequence(fabric, query, candidates.col(i), penalty, ws, nullptr,
                                   prune_above);
-      if (!c.pruned) bound.Offer(c.cost);
+      if (prune_m > 0 && !c.pruned) bound.Offer(c.cost);
     }
   };
   const int threads = std::min<int>(static_cast<int>(workspaces->size()), count);
@@ -139,6 +139,8 @@ GfcsSolution SolveGfcop(const Fabric& fabric, const GfcsQuery& query, CommandSam
     return fail("non-finite start, start velocity or goal");
   if (params.commands < 1 || params.batch_size < 2 || params.batches < 1 || params.top_m < 1)
     return fail("commands, batch_size, batches and top_m must be >= 1 (batch_size >= 2)");
+  // Pruning relies on a cost never being below its summed rollout time.
+  if (!(params.penalty >= 0)) return fail("penalty M must be >= 0");
 
   std::vector<FabricWorkspace> workspaces;
   const int threads = params.threads > 0
