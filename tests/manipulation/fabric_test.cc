@@ -11,6 +11,7 @@
 #include <cmath>
 #include <map>
 #include <random>
+#include <utility>
 
 #include "inference/manipulation/builtin_panda.h"
 #include "inference/manipulation/gfcs.h"
@@ -146,13 +147,19 @@ TEST(Fabric, MetricIsSymmetricPositiveDefiniteAndGeometryKeepsTheSpeed) {
   EXPECT_GT(active, 0) << "no barrier term was ever active: the test did not test them";
 }
 
+/// The Panda's ready pose and a goal the fabric reaches from it in an empty world.
+std::pair<JointVector, JointVector> ReadyToReachPoses() {
+  JointVector start, goal;
+  start << 0, -0.785, 0, -2.356, 0, 1.571, 0.785;
+  goal << 0.8, 0.2, -0.3, -1.8, 0.4, 2.0, 0.2;
+  return {start, goal};
+}
+
 TEST(Fabric, RolloutReachesTheCommandInAnEmptyWorld) {
   const World world;
   const Fabric fabric(Panda(), world, FabricParams{});
   FabricWorkspace ws = fabric.MakeWorkspace();
-  JointVector start, goal;
-  start << 0, -0.785, 0, -2.356, 0, 1.571, 0.785;
-  goal << 0.8, 0.2, -0.3, -1.8, 0.4, 2.0, 0.2;
+  const auto [start, goal] = ReadyToReachPoses();
   std::vector<JointVector> path;
   const RolloutResult r = fabric.Rollout(start, JointVector::Zero(), goal, &ws, &path);
   EXPECT_EQ(r.status, RolloutStatus::kReached) << ToString(r.status);
@@ -167,9 +174,7 @@ TEST(Fabric, AStoppedRolloutIsThePrefixOfTheFullOne) {
   const World world = TwoObstacleWorld();
   const Fabric fabric(Panda(), world, FabricParams{});
   FabricWorkspace ws = fabric.MakeWorkspace();
-  JointVector start, goal;
-  start << 0, -0.785, 0, -2.356, 0, 1.571, 0.785;
-  goal << 0.8, 0.2, -0.3, -1.8, 0.4, 2.0, 0.2;
+  const auto [start, goal] = ReadyToReachPoses();
   std::vector<JointVector> full_path;
   const RolloutResult full = fabric.Rollout(start, JointVector::Zero(), goal, &ws, &full_path);
   ASSERT_GT(full.steps, 10) << ToString(full.status);
