@@ -1,6 +1,6 @@
-// `foresight train | export | eval | docs config | kinds`: the same commands for every experiment
-// kind. A command looks the kind up (from the config's `model:`, or from the run directory's
-// config.yaml) and calls its step; no command here names a method.
+// `foresight train | export | eval | bench | docs config | kinds`: the same commands for every
+// experiment kind. A command looks the kind up (from the config's `model:`, the run directory's
+// config.yaml or the config stored in an artifact) and calls its step; no command names a method.
 
 #include <filesystem>
 #include <iostream>
@@ -75,6 +75,28 @@ void AddExperimentCommands(CLI::App* app, std::shared_ptr<const ExperimentRegist
     std::cout << kind.evaluate(eargs->run_dir, eargs->overrides);
   });
 
+  auto breq = std::make_shared<BenchRequest>();
+  auto bsettings = std::make_shared<std::vector<std::string>>();
+  auto* bench = app->add_subcommand(
+      "bench", "time TARGET's engine or runtime: figures side by side in one run (medians)");
+  bench->add_option("target", breq->target, "a config, a run directory or an artifact (.h5)")
+      ->required();
+  bench->add_option("settings", *bsettings,
+                    "key.path=value overrides of the config; bench.key=value options of the bench");
+  bench->add_flag("--json", breq->json, "print one JSON object");
+  bench->callback([registry, breq, bsettings] {
+    BenchRequest r = *breq;
+    for (const std::string& s : *bsettings) {
+      if (s.rfind("bench.", 0) == 0)
+        r.options.push_back(s.substr(6));
+      else
+        r.overrides.push_back(s);
+    }
+    const ExperimentKind& kind = registry->ForBenchTarget(&r);
+    if (!kind.bench) kind.NoSuchStep("bench");
+    kind.bench(r);
+  });
+
   auto docs_out = std::make_shared<std::string>();
   auto* docs = app->add_subcommand("docs", "generate reference documentation");
   docs->require_subcommand(1);
@@ -96,7 +118,8 @@ void AddExperimentCommands(CLI::App* app, std::shared_ptr<const ExperimentRegist
     for (const ExperimentKind& k : registry->kinds())
       std::cout << k.tag << (k.tag_is_prefix ? "*" : "") << "\t" << k.summary
                 << "\tsteps:" << (k.train ? " train" : "") << (k.export_run ? " export" : "")
-                << (k.evaluate ? " eval" : "") << (k.resumable ? " (resumable)" : "") << "\n";
+                << (k.evaluate ? " eval" : "") << (k.bench ? " bench" : "")
+                << (k.resumable ? " (resumable)" : "") << "\n";
   });
 }
 

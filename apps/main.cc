@@ -13,16 +13,9 @@ int main(int argc, char** argv) {
     foresight::app::AddExperimentCommands(
         &app, std::make_shared<const foresight::ExperimentRegistry>(foresight::BuiltinKinds()));
     foresight::app::AddDataCommands(&app);
-    foresight::app::AddBenchCommands(&app);
-#ifdef FORESIGHT_WITH_TORCH
-    foresight::app::AddBenchDirectionalCommand(app.get_subcommand("bench"));
-    foresight::app::AddBenchDiffeoCommand(app.get_subcommand("bench"));
-    foresight::app::AddBenchOtnetCommand(app.get_subcommand("bench"));
-#endif
     foresight::app::AddMapCommands(&app);
     foresight::app::AddNavigateCommand(&app);
     foresight::app::AddPlanCommand(&app);
-    foresight::app::AddBenchFabricCommand(app.get_subcommand("bench"));
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);

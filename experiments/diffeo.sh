@@ -22,9 +22,9 @@ for name in lasa jaco_push_box jaco_lift_box; do
 done
 {
   echo '{"planar":'
-  "$BIN" bench diffeo --artifact runs/diffeo_lasa/models/Sshape.h5 --json
+  "$BIN" bench runs/diffeo_lasa/models/Sshape.h5 --json
   echo ', "cspace":'
-  "$BIN" bench diffeo --artifact runs/diffeo_jaco_push_box/models/push_box.h5 --json
+  "$BIN" bench runs/diffeo_jaco_push_box/models/push_box.h5 --json
   echo '}'
 } > results/diffeo_bench.json
 python3 experiments/diffeo_table.py results > results/diffeo.md

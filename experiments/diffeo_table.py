@@ -87,7 +87,7 @@ if push or lift:
     out.append("")
 if bench:
     arts = ", ".join(bench.get(p, {}).get("artifact", "-") for p in ("planar", "cspace"))
-    out += ["## Time per rollout step (one core; `foresight bench diffeo`)", "",
+    out += ["## Time per rollout step (one core; `foresight bench ARTIFACT`)", "",
             f"Artifacts: {arts}. The composed 2-D step uses a 16-step obstacle flow and the C-space step "
             "a 10-step one; the evaluation's selected obstacle flows take 7 to 760 steps, and the step "
             "time grows with them.", "", "| step | us |", "|---|---|"]

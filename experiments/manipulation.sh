@@ -30,7 +30,7 @@ for f in $FAMILIES; do
 done
 cp runs/plan_table_under_pick/ee_paths.png "$OUT/manipulation_table_under_pick_ee_paths.png"
 cp runs/plan_bookshelf_tall/ee_paths.png "$OUT/manipulation_bookshelf_tall_ee_paths.png"
-"$BIN" bench fabric configs/manipulation/bookshelf_thin.yaml problems.last=60 --json \
+"$BIN" bench configs/manipulation/bookshelf_thin.yaml problems.last=60 --json \
   > "$OUT/manipulation_bench_fabric.json"
 # FK of the 59 spheres with Jacobians: ours against KDL's solvers in the same run (Google Benchmark).
 "$(dirname "$BIN")/bench_kinematics" --benchmark_repetitions=5 --benchmark_report_aggregates_only=true \

@@ -69,6 +69,6 @@ cp runs/otnet_chosen/plots/transfer.png results/otnet_transfer.png
 python3 experiments/otnet_select.py runs/otnet_sweep --table > results/otnet_sweep.md
 
 # 4. The benchmark: encode a new map and generate 100 start-conditioned trajectories.
-"$BIN" bench otnet --artifact runs/otnet_chosen/model.h5 --json > results/otnet_bench.json
+"$BIN" bench runs/otnet_chosen --json > results/otnet_bench.json
 python3 experiments/otnet_table.py results > results/otnet.md
 cat results/otnet.md

@@ -60,7 +60,7 @@ if e:
             "Pictures: otnet_test_maps.png (test maps: OTNet, k-NN, start-conditioned OTNet; "
             "ground truth in blue), otnet_transfer.png (sections of the Intel-lab Hilbert map; samples that fail the collision check drawn orange).", ""]
 if b:
-    out += ["## Engine benchmark (`foresight bench otnet --artifact runs/otnet_chosen/model.h5 "
+    out += ["## Engine benchmark (`foresight bench runs/otnet_chosen "
             "--json`, one core, medians)", "",
             "| step | us |", "|---|---|",
             f"| encode a new map (database {b.get('database_size')}) | {f(b.get('encode_us'), 1)} |",

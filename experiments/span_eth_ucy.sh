@@ -14,7 +14,7 @@ for scene in eth hotel univ zara1; do
   "$BIN" train "configs/span/eth_ucy_$scene.yaml" --run-dir "runs/span_$scene" train.progress=lines "$@" \
     > "runs/span_$scene.out" 2>&1
 done
-"$BIN" bench engine --artifact runs/span_eth/model.h5 --json > "$OUT/span_bench_engine.json"
+"$BIN" bench runs/span_eth --json > "$OUT/span_bench_engine.json"
 python3 - "$OUT" <<'PY'
 import json, sys
 out = sys.argv[1]

@@ -20,14 +20,14 @@ rm -rf runs/navigate_quickstart
 # holds one), unless it continues the last one with --resume.
 [[ " $* " == *" --resume "* ]] || rm -rf runs/quickstart
 ./build/bin/foresight train default --run-dir runs/quickstart "$@"
-./build/bin/foresight bench engine --artifact runs/quickstart/model.h5
+./build/bin/foresight bench runs/quickstart
 # Occupancy maps on the simulated two-robot floor plan: Fast-BHMs, fused once and repeatedly.
 rm -rf runs/occupancy_synthetic_fusion
 ./build/bin/foresight train configs/occupancy/synthetic_fusion.yaml --run-dir runs/occupancy_synthetic_fusion
 # Manipulation (thesis ch 9): GFCS, the single-attractor fabric and RRT-Connect on synthetic scenes.
 rm -rf runs/plan_quickstart
 ./build/bin/foresight plan default --run-dir runs/plan_quickstart
-./build/bin/foresight bench fabric
+./build/bin/foresight bench configs/manipulation/synthetic.yaml
 # Self-supervised GFCS (thesis ch 9): the loop on 12 generated scenes, then the learned sampler
 # against the uniform one on 6 others (runs/gfcs_quickstart/eval.json).
 rm -rf runs/gfcs_quickstart
@@ -37,13 +37,13 @@ rm -rf runs/gfcs_quickstart
 # step-time benchmark.
 rm -rf runs/diffeo_quickstart
 ./build/bin/foresight train configs/diffeo/synthetic.yaml --run-dir runs/diffeo_quickstart
-./build/bin/foresight bench diffeo --artifact runs/diffeo_quickstart/models/s_curve.h5
+./build/bin/foresight bench runs/diffeo_quickstart/models/s_curve.h5
 # OTNet (thesis ch 6): synthetic rooms and corridors, trajectories generated on unseen maps against
 # k-NN and the mean trajectory (runs/otnet_quickstart/eval.json, plots/test_maps.png), then the
 # encode-and-generate benchmark.
 rm -rf runs/otnet_quickstart
 ./build/bin/foresight train configs/otnet/synthetic.yaml --run-dir runs/otnet_quickstart
-./build/bin/foresight bench otnet --artifact runs/otnet_quickstart/model.h5
+./build/bin/foresight bench runs/otnet_quickstart
 # Structurally constrained prediction (thesis ch 7): synthetic scenes with maps; the mixture prior,
 # KTM, constant velocity and the naive network, and the prior projected onto the collision chance
 # constraint (runs/constrained_quickstart/eval.json, tracks.csv, plots/window_*.png; about 15 s).

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # CLI checks: one-line errors with non-zero exit, train -> export -> eval on a tiny synthetic run,
-# resume, bench engine --json; occupancy maps (train, map fuse, map info) in both builds.
+# resume, bench of every kind that has one; occupancy maps (train, map fuse, map info) in both builds.
 # Usage: cli_test.sh path/to/foresight
 set -euo pipefail
 BIN="$1"
@@ -59,6 +59,13 @@ expect_error "already holds a run (model.h5)" train configs/occupancy/synthetic.
 "$BIN" export "$OCC" | grep -q "$OCC/model.h5" || fail "occupancy export"
 "$BIN" eval "$OCC" | grep -q "\"auc\": $AUC" || fail "occupancy eval"
 "$BIN" kinds | grep -q "^occupancy" || fail "kinds lists occupancy"
+# bench: one command for every kind, the kind from a config, a run directory or an artifact.
+"$BIN" bench "$OCC" --json bench.repeats=1 bench.bhm_scans=2 bench.bhm_spacing=2 | grep -q '"fast_bhm_train_s"' ||
+  fail "bench of an occupancy run"
+expect_error "unknown key 'calls'" bench "$OCC" bench.calls=5
+expect_error "not an artifact" bench "$OCC/model.h5"
+expect_error "'navigation' has no bench step" bench configs/navigation/sim1.yaml
+expect_error "nowhere.yaml: no such file" bench "$TMP/nowhere.yaml"
 expect_error "not a run directory" eval "$TMP"
 
 FUS="$TMP/fusion"
@@ -130,7 +137,8 @@ expect_error "methods: 'GF' listed twice" plan default "methods=[{name: GF, kind
   --run-dir "$TMP/plan5"
 expect_error "missing MBM problems directory" plan configs/manipulation/box.yaml problems.family=no_such_family robot=builtin \
   problems.root="$TMP" --run-dir "$TMP/plan6"
-"$BIN" bench fabric --repeats 1 --json | grep -q '"fabric_step_us"' || fail "bench fabric --json"
+"$BIN" bench configs/manipulation/synthetic.yaml bench.repeats=1 --json | grep -q '"fabric_step_us"' ||
+  fail "bench of a manipulation config"
 printf 'model: occupancy.fast_bhm\nseed: 1\nseed: 2\n' > "$TMP/twice.yaml"
 expect_error "key 'seed' is repeated" train "$TMP/twice.yaml" --run-dir "$TMP/r_twice"
 printf '# empty\n' > "$TMP/empty.yaml"
@@ -190,13 +198,15 @@ if [ "${FORESIGHT_WITH_TORCH:-1}" = "1" ] || [ "${FORESIGHT_WITH_TORCH}" = "ON" 
   grep -q "before the first checkpoint" "$TMP/int.err" || { cat "$TMP/int.err"; fail "interrupt in epoch 1"; }
   grep -q -- "--resume" "$TMP/int.err" && { cat "$TMP/int.err"; fail "interrupt in epoch 1 suggests --resume"; }
   [ ! -e "$INT_RUN/checkpoints/last.pt" ] || fail "interrupt in epoch 1 left a checkpoint"
-  "$BIN" bench engine --artifact "$RUN/model.h5" --json --calls 500 > "$TMP/bench.json"
+  "$BIN" bench "$RUN" --json bench.calls=500 > "$TMP/bench.json"
   for k in engine_us libtorch_us ratio train_windows_per_s; do
     grep -q "\"$k\"" "$TMP/bench.json" || fail "bench lacks $k"
   done
   head -c 2000 "$RUN/model.h5" > "$TMP/trunc.h5"
-  expect_error "trunc.h5" bench engine --artifact "$TMP/trunc.h5"
-  expect_error "normalisation.h5" bench engine --artifact "$RUN/normalisation.h5"
+  expect_error "trunc.h5" bench "$TMP/trunc.h5"
+  expect_error "normalisation.h5" bench "$RUN/normalisation.h5"
+  expect_error "only bench.key=value options apply" bench "$RUN" seed=3
+  expect_error "times an exported artifact" bench configs/quickstart.yaml
   # Directional maps: crossing synthetic, 2 folds, few epochs; eval.json has the four methods.
   DIR_RUN="$TMP/dirmap"
   "$BIN" train configs/directional/crossing.yaml --run-dir "$DIR_RUN" eval.folds=2 train.epochs=2 \
@@ -210,19 +220,16 @@ if [ "${FORESIGHT_WITH_TORCH:-1}" = "1" ] || [ "${FORESIGHT_WITH_TORCH}" = "ON" 
   expect_error "already holds a run" train configs/directional/crossing.yaml --run-dir "$DIR_RUN"
   "$BIN" export "$DIR_RUN" | grep -q "$DIR_RUN/model.h5" || fail "directional export"
   "$BIN" eval "$DIR_RUN" | grep -q '"grid_mm": {"al": [0-9]' || fail "directional eval"
-  expect_error "expected 'span_predictor'" bench engine --artifact "$DIR_RUN/model.h5"
-  expect_error "expected 'directional_map'" bench directional --artifact "$RUN/model.h5"
-  "$BIN" bench directional --artifact "$DIR_RUN/model.h5" --json --calls 200 --repeats 2 | grep -q engine_batch1024_us ||
-    fail "bench directional"
+  "$BIN" bench "$DIR_RUN/model.h5" --json bench.calls=200 bench.repeats=2 | grep -q engine_batch1024_us ||
+    fail "bench of a directional artifact"
   # Diffeomorphic templates: a tiny synthetic run, then the step-time benchmark on its template.
   DIFF_RUN="$TMP/diffeo"
   "$BIN" train configs/diffeo/synthetic.yaml --run-dir "$DIFF_RUN" data.synthetic_demos=3 data.synthetic_points=40 \
     "data.held_out=[2]" train.epochs=2 eflow.train.epochs=2 eflow.layers=2 eval.plots=false eval.grid=2 \
     "obstacle.times=[0.002]" >/dev/null 2>"$TMP/diffeo.log" || { cat "$TMP/diffeo.log"; fail "diffeo train"; }
   check_json "$DIFF_RUN/eval.json"
-  "$BIN" bench diffeo --artifact "$DIFF_RUN/models/s_curve.h5" --json --calls 20 --repeats 1 |
-    grep -q engine_vs_libtorch_speedup || fail "bench diffeo"
-  expect_error "expected 'diffeo_template'" bench diffeo --artifact "$DIR_RUN/model.h5"
+  "$BIN" bench "$DIFF_RUN/models/s_curve.h5" --json bench.calls=20 bench.repeats=1 |
+    grep -q engine_vs_libtorch_speedup || fail "bench of a diffeo artifact"
   # OTNet: synthetic rooms, a few epochs, then the engine benchmark on its artifact.
   OT_RUN="$TMP/otnet"
   "$BIN" train configs/otnet/synthetic.yaml --run-dir "$OT_RUN" data.synthetic_maps=12 \
@@ -232,8 +239,7 @@ if [ "${FORESIGHT_WITH_TORCH:-1}" = "1" ] || [ "${FORESIGHT_WITH_TORCH}" = "ON" 
   check_json "$OT_RUN/eval.json"
   test -f "$OT_RUN/plots/test_maps.png" || fail "otnet plots"
   expect_error "would change the map split" eval "$OT_RUN" seed=3
-  "$BIN" bench otnet --artifact "$OT_RUN/model.h5" --json --repeats 1 --count 5 |
-    grep -q libtorch_over_engine || fail "bench otnet"
-  expect_error "expected 'otnet'" bench otnet --artifact "$DIR_RUN/model.h5"
+  "$BIN" bench "$OT_RUN" --json bench.repeats=1 bench.count=5 |
+    grep -q libtorch_over_engine || fail "bench of an otnet run"
 fi
 echo "cli ok"

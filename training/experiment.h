@@ -19,6 +19,18 @@ struct TrainRequest {
   bool evaluate = true;                ///< evaluate after export
 };
 
+/// What `foresight bench` asks of a kind. The target is a config file (benches that build what they
+/// time: occupancy maps, the manipulation runtime), a run directory (its config.yaml or its
+/// artifact) or an exported artifact (.h5; its kind is the `model:` of the config stored in it).
+struct BenchRequest {
+  enum class Target { kConfig, kRunDir, kArtifact };
+  std::string target;
+  Target what = Target::kConfig;
+  std::vector<std::string> overrides;  ///< `key.path=value` of the config
+  std::vector<std::string> options;  ///< the kind's bench options (`bench.` stripped): `repeats=5`
+  bool json = false;                 ///< print one JSON object instead of a table
+};
+
 /// One method's steps. An empty step is one the kind does not have: the command says so in one
 /// line. Steps report expected failures as foresight::Error with what and where.
 struct ExperimentKind {
@@ -38,9 +50,13 @@ struct ExperimentKind {
   /// run_dir/eval.json. @return its text.
   std::function<std::string(const std::string& run_dir, const std::vector<std::string>& overrides)>
       evaluate;
+  /// Prints figures measured side by side in one run (medians of repeated runs); never a test.
+  std::function<void(const BenchRequest&)> bench;
+  /// Every bench option with its default (config::ReferenceTable<Options>), for the reference.
+  std::function<std::string()> bench_reference;
 
   bool Matches(const std::string& model_tag) const;
-  /// The one-line Error for a step (`train`, `export`, `eval`) this kind does not have.
+  /// The one-line Error for a step (`train`, `export`, `eval`, `bench`) this kind does not have.
   [[noreturn]] void NoSuchStep(const std::string& step) const;
 };
 
@@ -58,6 +74,11 @@ class ExperimentRegistry {
   const ExperimentKind& ForConfig(const std::string& config) const;
   /// The kind of a run directory (the `model:` of run_dir/config.yaml).
   const ExperimentKind& ForRun(const std::string& run_dir) const;
+  /// The kind of an exported artifact (the `model:` of the config stored in it).
+  const ExperimentKind& ForArtifact(const std::string& artifact) const;
+  /// The kind of a bench target (a directory is a run, a `.h5` file an artifact, anything else a
+  /// config); sets request->what.
+  const ExperimentKind& ForBenchTarget(BenchRequest* request) const;
 
   const std::vector<ExperimentKind>& kinds() const { return kinds_; }
   /// The config reference of every kind (docs/config_reference.md).
@@ -68,6 +89,11 @@ class ExperimentRegistry {
   std::vector<ExperimentKind> kinds_;
   std::string default_tag_;
 };
+
+/// The artifact a bench times: the artifact target, or `in_run` (relative to the run directory:
+/// "model.h5"; a folder "models/" means its one .h5 file, an Error listing them if there are
+/// several) of a run. A config target, or config overrides, are an Error.
+std::string BenchArtifact(const BenchRequest& req, const std::string& in_run);
 
 /// The top-level `model:` of a YAML file (an Error naming the file when it has none).
 std::string ModelTagOfFile(const std::string& path);

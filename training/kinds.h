@@ -27,6 +27,15 @@ ExperimentKind OtnetKind();
 ExperimentKind ConstrainedKind();
 #endif
 
+// Each kind's bench step (SetBench), in its <method>/bench.cc (declared in every build: the
+// LibTorch kinds' libraries are built only with LibTorch).
+void SetOccupancyBench(ExperimentKind* kind);
+void SetManipulationBench(ExperimentKind* kind);
+void SetSpanBench(ExperimentKind* kind);
+void SetDirectionalBench(ExperimentKind* kind);
+void SetDiffeoBench(ExperimentKind* kind);
+void SetOtnetBench(ExperimentKind* kind);
+
 /// The config of a train request: the file, or `embedded_default` (named `default_name` in
 /// errors) when the request says "default".
 template <typename Config>
@@ -42,6 +51,33 @@ Config LoadRequestConfig(const TrainRequest& req, const std::string& embedded_de
 template <typename Config>
 Config LoadRunConfig(const std::string& run_dir, const std::vector<std::string>& overrides) {
   return config::LoadExperimentConfig<Config>(run_dir + "/config.yaml", overrides);
+}
+
+/// A kind's bench options: `bench.key=value` arguments (request.options, prefix stripped) read
+/// strictly into Options (an unknown key or a value out of range is an Error naming it).
+template <typename Options>
+Options LoadBenchOptions(const BenchRequest& req) {
+  return config::FromYaml<Options>(YAML::Node(YAML::NodeType::Map), "bench options", req.options);
+}
+
+/// Gives a kind its bench step: `run` with the request and its options (LoadBenchOptions), and
+/// the options' reference table.
+template <typename Options>
+void SetBench(ExperimentKind* kind, void (*run)(const BenchRequest&, const Options&)) {
+  kind->bench_reference = [] { return config::ReferenceTable<Options>(); };
+  kind->bench = [run](const BenchRequest& req) { run(req, LoadBenchOptions<Options>(req)); };
+}
+
+/// The config a bench builds from: the config target, or the run directory's config.yaml (plus
+/// overrides). An artifact target is an Error: this kind's bench times what a config builds.
+template <typename Config>
+Config LoadBenchConfig(const BenchRequest& req) {
+  FS_THROW_UNLESS(req.what != BenchRequest::Target::kArtifact, req.target,
+                  ": this bench builds what it times from a config; name the config or a run "
+                  "directory, not an artifact");
+  if (req.what == BenchRequest::Target::kRunDir)
+    return LoadRunConfig<Config>(req.target, req.overrides);
+  return config::LoadExperimentConfig<Config>(req.target, req.overrides);
 }
 
 }  // namespace foresight

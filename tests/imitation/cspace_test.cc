@@ -2,7 +2,7 @@
 // the field and the transform's Jacobian against central differences, the inverse round trip,
 // the pull-back identities (J_ee q_dot = f_world, J_o p_dot = q_dot_inner) against the closed
 // form of a straight-line attractor, a rollout that keeps every ball of the arm out of a fitted
-// spherical obstacle (exact distances), no allocation (speed: `foresight bench diffeo`).
+// spherical obstacle (exact distances), no allocation (speed: `foresight bench ARTIFACT`).
 
 #include "inference/imitation/cspace.h"
 
@@ -323,8 +323,9 @@ TEST(CSpaceSystem, RolloutKeepsEveryBallOutOfTheObstacleAndReachesTheGoal) {
 }
 
 TEST(CSpaceSystem, VelocityAllocatesNothing) {
-  // Speed is measured by `foresight bench diffeo`, not here. K = 10 Euler steps, 10 body points, a
-  // 5^3 window of inducing states per field query (the fitted weights with the cut-off at 0.29 m).
+  // Speed is measured by `foresight bench ARTIFACT`, not here. K = 10 Euler steps, 10 body points,
+  // a 5^3 window of inducing states per field query (the fitted weights with the cut-off at 0.29
+  // m).
   const OccupancyField<3>& fitted = TheScenario().field;
   RbfGridSpec<3> spec = fitted.grid().spec();
   spec.cutoff_radius = 0.29;

@@ -1,5 +1,5 @@
 // The engine's hot paths allocate nothing once the workspaces exist (own binary: it replaces the
-// global operator new, and malloc, to count allocations). Speed: `foresight bench diffeo`.
+// global operator new, and malloc, to count allocations). Speed: `foresight bench ARTIFACT`.
 
 #include <gtest/gtest.h>
 

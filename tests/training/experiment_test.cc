@@ -1,5 +1,6 @@
 // The experiment contract (training/experiment.h): lookups, one-line errors for missing steps, and
-// every kind of this build dispatched through train, export and eval on a tiny config.
+// every kind of this build dispatched through train, export and eval on a tiny config, and bench
+// targets (config, run directory, artifact) resolved to their kind.
 
 #include "training/experiment.h"
 
@@ -32,6 +33,27 @@ struct ToyConfig {
   }
 };
 
+/// The toy's bench options, and what its bench saw last (the toy prints nothing).
+struct ToyBenchOptions {
+  int repeats = 3;
+  template <class A>
+  void Serialize(A* a) {
+    a->Visit("repeats", &repeats, config::Range::Closed(1, 10), "timed runs");
+  }
+};
+struct ToyBenchSeen {
+  BenchRequest::Target what;
+  std::string config_value;
+  int repeats;
+};
+ToyBenchSeen& LastToyBench() {
+  static ToyBenchSeen seen{};
+  return seen;
+}
+void RunToyBench(const BenchRequest& req, const ToyBenchOptions& o) {
+  LastToyBench() = {req.what, std::to_string(LoadBenchConfig<ToyConfig>(req).value), o.repeats};
+}
+
 ExperimentKind ToyKind() {
   ExperimentKind k;
   k.tag = "toy";
@@ -48,6 +70,7 @@ ExperimentKind ToyKind() {
     return "{\"value\": " + testing::ReadText(run_dir + "/model.txt") +
            ", \"config\": " + std::to_string(c.value) + "}";
   };
+  SetBench<ToyBenchOptions>(&k, RunToyBench);
   return k;
 }
 
@@ -72,6 +95,34 @@ TEST(Experiment, RegistryDispatchesByModelTag) {
   testing::ExpectErrorContains([&] { kind.train(req); }, {"--resume", "cannot be continued"});
   EXPECT_NE(r.ReferenceMarkdown().find("| `value` | number | `1.0` |"), std::string::npos)
       << r.ReferenceMarkdown();
+  EXPECT_NE(r.ReferenceMarkdown().find("| `repeats` | integer | `3` |"), std::string::npos)
+      << "the bench options are in the reference: " << r.ReferenceMarkdown();
+
+  // bench: a config target and a run directory reach the same kind; options are strict.
+  BenchRequest bench{dir.File("toy.yaml"), BenchRequest::Target::kArtifact, {"value=5"}, {}, false};
+  r.ForBenchTarget(&bench).bench(bench);
+  EXPECT_EQ(LastToyBench().what, BenchRequest::Target::kConfig);
+  EXPECT_EQ(LastToyBench().config_value, "5.000000");
+  EXPECT_EQ(LastToyBench().repeats, 3);
+  bench = BenchRequest{req.run_dir, BenchRequest::Target::kConfig, {}, {"repeats=7"}, true};
+  r.ForBenchTarget(&bench).bench(bench);
+  EXPECT_EQ(LastToyBench().what, BenchRequest::Target::kRunDir);
+  EXPECT_EQ(LastToyBench().config_value, "4.000000") << "a run's bench reads the run's config";
+  EXPECT_EQ(LastToyBench().repeats, 7);
+  bench.options = {"nope=1"};
+  testing::ExpectErrorContains([&] { kind.bench(bench); }, {"bench options", "nope"});
+  bench.options = {"repeats=0"};
+  testing::ExpectErrorContains([&] { kind.bench(bench); }, {"bench options", "repeats"});
+  bench.options = {};
+  EXPECT_EQ(BenchArtifact(bench, "model.txt"), req.run_dir + "/model.txt");
+  testing::ExpectErrorContains([&] { (void)BenchArtifact(bench, "model.h5"); },
+                               {"model.h5", "not found"});
+  bench.overrides = {"value=2"};
+  testing::ExpectErrorContains([&] { (void)BenchArtifact(bench, "model.txt"); },
+                               {"value=2", "only bench.key=value"});
+  bench = BenchRequest{dir.File("nowhere"), BenchRequest::Target::kConfig, {}, {}, false};
+  testing::ExpectErrorContains([&] { (void)r.ForBenchTarget(&bench); },
+                               {"nowhere", "no such file"});
 }
 
 TEST(Experiment, LookupErrorsNameTheSourceAndTheKnownKinds) {
@@ -177,6 +228,9 @@ TEST(Experiment, EveryBuiltinKindRunsThroughTrainExportAndEval) {
       EXPECT_FALSE(kind.export_run || kind.evaluate);
       testing::ExpectErrorContains([&] { kind.NoSuchStep("train"); },
                                    {"'" + kind.tag + "' has no train step"});
+      BenchRequest b{config, BenchRequest::Target::kRunDir, {}, {}, false};
+      EXPECT_EQ(&registry.ForBenchTarget(&b), &kind);
+      EXPECT_EQ(b.what, BenchRequest::Target::kConfig);
       continue;
     }
     kind.train(TrainRequest{config, {}, run, false, true});
@@ -185,6 +239,12 @@ TEST(Experiment, EveryBuiltinKindRunsThroughTrainExportAndEval) {
     const std::string artifact = kind.export_run(run);
     EXPECT_TRUE(fs::exists(artifact)) << artifact;
     EXPECT_EQ(h5::File::Open(artifact).GetStringAttr("/", "kind"), kArtifactKind);
+    // bench finds the kind from the run and from its artifact (the config stored in it); the
+    // benches themselves print figures and run in tests/cli_test.sh.
+    for (const std::string& target : {run, artifact}) {
+      BenchRequest b{target, BenchRequest::Target::kConfig, {}, {}, false};
+      EXPECT_EQ(&registry.ForBenchTarget(&b), &kind) << target;
+    }
     const std::string first = testing::ReadText(run + "/eval.json");
     const std::string json = kind.evaluate(run, {});
     EXPECT_FALSE(json.empty());

@@ -51,6 +51,7 @@ ExperimentKind ConstrainedKind() {
     const auto c = LoadRunConfig<ConstrainedConfig>(run_dir, overrides);
     return constrained::EvaluateConstrainedRun(c, run_dir);
   };
+  k.no_step_hint = "its projection times are in eval.json (solve_time_ms, check_time_ms)";
   return k;
 }
 

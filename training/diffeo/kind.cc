@@ -39,6 +39,7 @@ ExperimentKind DiffeoKind() {
     const auto c = LoadRunConfig<DiffeoConfig>(run_dir, overrides);
     return EvaluateDiffeoRun(c, run_dir);
   };
+  SetDiffeoBench(&k);
   return k;
 }
 

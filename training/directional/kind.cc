@@ -39,6 +39,7 @@ ExperimentKind DirectionalKind() {
     const auto c = LoadRunConfig<DirectionalExperimentConfig>(run_dir, overrides);
     return EvaluateDirectionalRun(c, run_dir).ToJson();
   };
+  SetDirectionalBench(&k);
   return k;
 }
 

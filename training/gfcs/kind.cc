@@ -40,6 +40,9 @@ ExperimentKind GfcsKind() {
     const auto c = LoadRunConfig<GfcsTrainConfig>(run_dir, overrides);
     return EvaluateGfcsRun(c, run_dir);
   };
+  k.no_step_hint =
+      "time its runtime with `foresight bench` on a manipulation config "
+      "(configs/manipulation/*.yaml)";
   return k;
 }
 

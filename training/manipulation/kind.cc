@@ -14,6 +14,7 @@ ExperimentKind ManipulationKind() {
   k.configs = "configs/manipulation/*.yaml; run by `foresight plan`";
   k.reference = [] { return config::ReferenceTable<ManipulationExperimentConfig>(); };
   k.no_step_hint = "run it with `foresight plan CONFIG --run-dir DIR`";
+  SetManipulationBench(&k);
   return k;
 }
 

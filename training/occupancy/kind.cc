@@ -45,6 +45,7 @@ ExperimentKind OccupancyKind() {
     return EvaluateOccupancyRun(LoadRunConfig<OccupancyExperimentConfig>(run_dir, overrides),
                                 run_dir);
   };
+  SetOccupancyBench(&k);
   return k;
 }
 

@@ -44,6 +44,7 @@ ExperimentKind OtnetKind() {
     const auto c = LoadRunConfig<OtnetConfig>(run_dir, overrides);
     return otnet::EvaluateOtnetRun(c, run_dir);
   };
+  SetOtnetBench(&k);
   return k;
 }
 

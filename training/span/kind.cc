@@ -66,6 +66,7 @@ ExperimentKind SpanKind(const std::string& embedded_default) {
   k.train = [embedded_default](const TrainRequest& req) { TrainSpanRun(req, embedded_default); };
   k.export_run = [](const std::string& run_dir) { return ExportSpan(run_dir); };
   k.evaluate = EvaluateSpanRun;
+  SetSpanBench(&k);
   return k;
 }
 

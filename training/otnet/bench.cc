@@ -1,14 +1,14 @@
-// `foresight bench otnet --artifact FILE [--json] [--repeats N] [--count 100]`: the time OTNet
+// The OTNet kind's bench (`foresight bench RUN_DIR|ARTIFACT`): the time OTNet
 // (thesis ch 6) takes to turn a new map into collision-checked trajectories from a start point,
 // stage by stage, on one thread (medians of repeated runs): the Hausdorff encoding, the network
 // (the torch-free engine vs LibTorch on the same weights), start conditioning + sampling and
 // collision checking. A benchmark that prints figures, not a test.
 
+#include "core/bench.h"
+
 #include <torch/torch.h>
 
-#include <CLI/CLI.hpp>
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <iostream>
 #include <limits>
@@ -18,29 +18,29 @@
 #include <utility>
 #include <vector>
 
-#include "apps/commands.h"
 #include "core/error.h"
 #include "inference/otnet/otnet_model.h"
 #include "models/otnet/otnet_net.h"
+#include "training/kinds.h"
 
-namespace foresight::app {
+namespace foresight {
 
 namespace {
 
 using namespace otnet;  // NOLINT: a benchmark of the OTNet engine
-using Clock = std::chrono::steady_clock;
+using bench::Clock;
+using bench::Median;
 
-struct BenchOtnetArgs {
-  std::string artifact;
+struct OtnetBenchOptions {
   int repeats = 7;
   int count = 100;
-  bool json = false;
-};
 
-double Median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
+  template <class A>
+  void Serialize(A* a) {
+    a->Visit("repeats", &repeats, config::Range::Closed(1, 100), "timed runs (median reported)");
+    a->Visit("count", &count, config::Range::Closed(1, 10000), "trajectories to generate");
+  }
+};
 
 /// Median over `repeats` of the mean time (us) of one call of f; each timed run makes enough
 /// calls to last about a millisecond (one call for slow stages), after a warm-up call.
@@ -49,14 +49,14 @@ double MicrosPerCall(int repeats, F&& f) {
   f();
   const auto s = Clock::now();
   f();
-  const double once = std::chrono::duration<double, std::micro>(Clock::now() - s).count();
+  const double once = bench::Micros(s, Clock::now());
   const int calls =
       static_cast<int>(std::clamp(std::ceil(1000.0 / std::max(once, 1e-3)), 1.0, 1e5));
   std::vector<double> t;
   for (int r = 0; r < repeats; ++r) {
     const auto start = Clock::now();
     for (int i = 0; i < calls; ++i) f();
-    t.push_back(std::chrono::duration<double, std::micro>(Clock::now() - start).count() / calls);
+    t.push_back(bench::Micros(start, Clock::now()) / calls);
   }
   return Median(t);
 }
@@ -71,8 +71,7 @@ BinaryGrid QueryMap(const MapEncoder& encoder) {
       if (map.at(r, c) == 0 &&
           (map.at(r - 1, c) || map.at(r + 1, c) || map.at(r, c - 1) || map.at(r, c + 1)))
         candidates.emplace_back(r, c);
-  FS_THROW_UNLESS(candidates.size() >= 16, "bench otnet: database map 0 has only ",
-                  candidates.size(),
+  FS_THROW_UNLESS(candidates.size() >= 16, "bench: database map 0 has only ", candidates.size(),
                   " free interior cells next to a wall (16 needed to perturb it)");
   constexpr int kFlips = 6;
   for (int i = 1; i <= kFlips; ++i) {
@@ -105,7 +104,7 @@ Eigen::Vector2d StartPoint(const OtnetModel& model, const Mixture& mixture, cons
         best = centre;
       }
     }
-  FS_THROW_UNLESS(std::isfinite(best_d2), "bench otnet: the query map has no free cell");
+  FS_THROW_UNLESS(std::isfinite(best_d2), "bench: the query map has no free cell");
   return best;
 }
 
@@ -168,9 +167,10 @@ double Disagreement(const Mixture& m, const TorchMixture& t) {
   return worst;
 }
 
-void RunOtnetBench(const BenchOtnetArgs& a) {
+void RunOtnetBench(const BenchRequest& req, const OtnetBenchOptions& a) {
   torch::set_num_threads(1);
-  const OtnetModel model = OtnetModel::Load(a.artifact);
+  const std::string artifact = BenchArtifact(req, "model.h5");
+  const OtnetModel model = OtnetModel::Load(artifact);
   const MapEncoder& encoder = model.encoder();
   const BinaryGrid map = QueryMap(encoder);
   constexpr int kPoints = 100;
@@ -191,7 +191,7 @@ void RunOtnetBench(const BenchOtnetArgs& a) {
   const double libtorch = MicrosPerCall(a.repeats, [&] { torch_mixture = TorchPredict(net, x); });
   const double disagreement = Disagreement(mixture, torch_mixture);
   FS_THROW_UNLESS(disagreement < 1e-3,
-                  "bench otnet: the LibTorch copy of the network disagrees "
+                  "bench: the LibTorch copy of the network disagrees "
                   "with the engine by ",
                   disagreement, " (relative)");
 
@@ -209,7 +209,7 @@ void RunOtnetBench(const BenchOtnetArgs& a) {
   const double total = encode + engine + generate;
   const double ratio = libtorch / engine;
 
-  if (a.json) {
+  if (req.json) {
     std::cout << "{\"encode_us\": " << encode << ", \"network_engine_us\": " << engine
               << ", \"network_libtorch_us\": " << libtorch
               << ", \"libtorch_over_engine\": " << ratio << ", \"generate_us\": " << generate
@@ -236,17 +236,6 @@ void RunOtnetBench(const BenchOtnetArgs& a) {
 
 }  // namespace
 
-void AddBenchOtnetCommand(CLI::App* bench) {
-  auto a = std::make_shared<BenchOtnetArgs>();
-  auto* cmd = bench->add_subcommand(
-      "otnet", "OTNet: time from a new map to collision-checked trajectories, engine vs LibTorch");
-  cmd->add_option("--artifact", a->artifact, "exported OTNet model (run_dir/models/<name>.h5)")
-      ->required();
-  cmd->add_option("--repeats", a->repeats, "timed runs (median reported)")
-      ->check(CLI::Range(1, 100));
-  cmd->add_option("--count", a->count, "trajectories to generate")->check(CLI::Range(1, 10000));
-  cmd->add_flag("--json", a->json, "print one JSON object");
-  cmd->callback([a] { RunOtnetBench(*a); });
-}
+void SetOtnetBench(ExperimentKind* kind) { SetBench<OtnetBenchOptions>(kind, RunOtnetBench); }
 
-}  // namespace foresight::app
+}  // namespace foresight

@@ -1,64 +1,46 @@
-// `foresight bench fabric [CONFIG] [--json]`: manipulation runtime figures measured in one run on
-// one thread (except the GFCS solve, which uses the config's threads): forward kinematics of every
-// collision sphere (positions; with Jacobians and J' q_d), one fabric step, a full rollout to the
-// goal, and a GFCS solve (one batch, uniform sampler) with and without pruning (GfcsParams::prune:
-// the same top candidates). Medians of repeated runs over the config's problems. KDL side by side:
-// the bench_kinematics benchmark (experiments/).
+// The manipulation kind's bench (`foresight bench CONFIG|RUN_DIR`): manipulation runtime figures
+// measured in one run on one thread (except the GFCS solve, which uses the config's threads):
+// forward kinematics of every collision sphere (positions; with Jacobians and J' q_d), one fabric
+// step, a full rollout to the goal, and a GFCS solve (one batch, uniform sampler) with and without
+// pruning (GfcsParams::prune: the same top candidates). Medians of repeated runs over the config's
+// problems. KDL side by side: the bench_kinematics benchmark (experiments/).
+
+#include "core/bench.h"
 
 #include <algorithm>
-#include <chrono>
 #include <iomanip>
 #include <iostream>
 #include <random>
 #include <sstream>
 
-#include "apps/commands.h"
 #include "core/error.h"
-#include "embedded_manipulation_config.h"
 #include "inference/manipulation/fabric.h"
 #include "inference/manipulation/gfcs.h"
 #include "inference/manipulation/validity.h"
+#include "training/kinds.h"
 #include "training/manipulation/plan.h"
 
-namespace foresight::app {
+namespace foresight {
 namespace {
-using Clock = std::chrono::steady_clock;
+using bench::Clock;
+using bench::Median;
+using bench::SecondsPerCall;
 using namespace manipulation;  // NOLINT: a manipulation benchmark
 
-struct BenchFabricArgs {
-  std::string config = "default";
-  std::vector<std::string> overrides;
-  bool json = false;
+struct ManipulationBenchOptions {
   int repeats = 7;
+
+  template <class A>
+  void Serialize(A* a) {
+    a->Visit("repeats", &repeats, config::Range::Closed(1, 1000), "timed runs (median reported)");
+  }
 };
 
-double Median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
-
-/// Median over `repeats` of the mean time per call of `f` over `calls` calls (seconds).
-template <class F>
-double PerCall(int repeats, int calls, F&& f) {
-  std::vector<double> t;
-  for (int r = 0; r < repeats; ++r) {
-    const auto s = Clock::now();
-    for (int i = 0; i < calls; ++i) f(i);
-    t.push_back(std::chrono::duration<double>(Clock::now() - s).count() / calls);
-  }
-  return Median(t);
-}
-
-void RunFabricBench(const BenchFabricArgs& a) {
-  const ManipulationExperimentConfig c =
-      a.config == "default"
-          ? config::ExperimentConfigFromYaml<ManipulationExperimentConfig>(
-                kEmbeddedManipulationConfig, "<embedded configs/manipulation/synthetic.yaml>",
-                a.overrides)
-          : config::LoadExperimentConfig<ManipulationExperimentConfig>(a.config, a.overrides);
+void RunManipulationBench(const BenchRequest& req, const ManipulationBenchOptions& a) {
+  const auto c = LoadBenchConfig<ManipulationExperimentConfig>(req);
   const RobotModel robot = LoadExperimentRobot(c);
   const std::vector<ManipulationProblem> problems = LoadExperimentProblems(c, robot);
-  FS_THROW_UNLESS(!problems.empty(), "bench fabric: the config has no problems");
+  FS_THROW_UNLESS(!problems.empty(), "bench: the config has no problems");
 
   // Random configurations within the limits, shared by ours and KDL.
   std::mt19937_64 rng(7);
@@ -72,10 +54,10 @@ void RunFabricBench(const BenchFabricArgs& a) {
     }
   const int calls = 2000;
   KinematicsData data = robot.MakeData();
-  const double fk = PerCall(a.repeats, calls, [&](int i) {
+  const double fk = SecondsPerCall(a.repeats, calls, [&](int i) {
     ForwardKinematics(robot, qs[static_cast<std::size_t>(i) % qs.size()], &data);
   });
-  const double fk_jac = PerCall(a.repeats, calls, [&](int i) {
+  const double fk_jac = SecondsPerCall(a.repeats, calls, [&](int i) {
     const std::size_t k = static_cast<std::size_t>(i) % qs.size();
     ForwardKinematicsWithJacobians(robot, qs[k], qds[k], &data);
   });
@@ -88,12 +70,12 @@ void RunFabricBench(const BenchFabricArgs& a) {
     const Fabric fabric(robot, problem.world, c.fabric);
     FabricWorkspace ws = fabric.MakeWorkspace();
     JointVector qdd;
-    steps.push_back(PerCall(a.repeats, calls, [&](int i) {
+    steps.push_back(SecondsPerCall(a.repeats, calls, [&](int i) {
       fabric.Acceleration(problem.start, 0.1 * qds[static_cast<std::size_t>(i) % qds.size()],
                           problem.goal, &ws, &qdd);
     }));
     RolloutResult r;
-    rollouts.push_back(PerCall(a.repeats, 1, [&](int) {
+    rollouts.push_back(SecondsPerCall(a.repeats, 1, [&](int) {
       r = fabric.Rollout(problem.start, JointVector::Zero(), problem.goal, &ws);
     }));
     rollout_times.push_back(r.t);
@@ -106,20 +88,20 @@ void RunFabricBench(const BenchFabricArgs& a) {
     SolveGfcop(fabric, query, &sampler, params);  // warm-up: neither timed solve runs cold
     params.prune = false;
     unpruned_solves.push_back(
-        PerCall(a.repeats, 1, [&](int) { SolveGfcop(fabric, query, &sampler, params); }));
+        SecondsPerCall(a.repeats, 1, [&](int) { SolveGfcop(fabric, query, &sampler, params); }));
     params.prune = true;
     GfcsSolution solution;
-    solves.push_back(PerCall(a.repeats, 1,
-                             [&](int) { solution = SolveGfcop(fabric, query, &sampler, params); }));
+    solves.push_back(SecondsPerCall(
+        a.repeats, 1, [&](int) { solution = SolveGfcop(fabric, query, &sampler, params); }));
     pruned_shares.push_back(static_cast<double>(solution.pruned) /
                             std::max(1, solution.evaluations));
   }
-  FS_THROW_UNLESS(!steps.empty(), "bench fabric: no problem has a valid start");
+  FS_THROW_UNLESS(!steps.empty(), "bench: no problem has a valid start");
   const double step = Median(steps), rollout = Median(rollouts), solve = Median(solves);
   const double unpruned = Median(unpruned_solves), pruned_share = Median(pruned_shares);
   const double integrated = Median(rollout_times);
 
-  if (a.json) {
+  if (req.json) {
     std::cout << std::setprecision(6) << "{\"spheres\": " << robot.num_spheres()
               << ", \"fk_us\": " << fk * 1e6 << ", \"fk_jacobians_us\": " << fk_jac * 1e6
               << ", \"fabric_step_us\": " << step * 1e6 << ", \"rollout_ms\": " << rollout * 1e3
@@ -147,16 +129,8 @@ void RunFabricBench(const BenchFabricArgs& a) {
 }
 }  // namespace
 
-void AddBenchFabricCommand(CLI::App* bench) {
-  auto args = std::make_shared<BenchFabricArgs>();
-  auto* cmd = bench->add_subcommand(
-      "fabric", "FK, fabric step, rollout and GFCS solve times on manipulation problems");
-  cmd->add_option("config", args->config,
-                  "manipulation config (default: the embedded synthetic quickstart)");
-  cmd->add_option("overrides", args->overrides, "key.path=value overrides of the config");
-  cmd->add_flag("--json", args->json, "print one JSON object");
-  cmd->add_option("--repeats", args->repeats, "repeats (median)")->check(CLI::Range(1, 1000));
-  cmd->callback([args] { RunFabricBench(*args); });
+void SetManipulationBench(ExperimentKind* kind) {
+  SetBench<ManipulationBenchOptions>(kind, RunManipulationBench);
 }
 
-}  // namespace foresight::app
+}  // namespace foresight

@@ -1,68 +1,56 @@
-// `foresight bench map --config CONFIG [--json]`: occupancy-map figures measured side by side in
-// one run on one thread: Fast-BHM training time on the full training set, the full BHM on a
-// coarser grid against Fast-BHM on that same grid and data, engine query throughput (probability,
-// gradient and variance), and OctoMap (insertion time, serialized size, memory, AUC).
+// The occupancy kind's bench (`foresight bench CONFIG|RUN_DIR`): occupancy-map figures measured
+// side by side in one run on one thread: Fast-BHM training time on the full training set, the full
+// BHM on a coarser grid against Fast-BHM on that same grid and data, engine query throughput
+// (probability, gradient and variance), and OctoMap (insertion time, serialized size, memory, AUC).
+
+#include "core/bench.h"
 
 #include <algorithm>
-#include <chrono>
-#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <sstream>
 
-#include "apps/commands.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "inference/mapping/hinge_map.h"
 #include "models/occupancy/bhm.h"
 #include "models/occupancy/fast_bhm.h"
 #include "models/occupancy/scan_training.h"
-#include "training/experiment.h"
+#include "training/kinds.h"
 #include "training/occupancy/octomap_baseline.h"
 #include "training/occupancy/pipeline.h"
 
-namespace foresight::app {
+namespace foresight {
 namespace {
-namespace fs = std::filesystem;
-using Clock = std::chrono::steady_clock;
 
-struct BenchMapArgs {
-  std::string config;
-  std::vector<std::string> overrides;
-  bool json = false;
+using bench::MedianSeconds;
+
+struct OccupancyBenchOptions {
   int repeats = 5;
   double bhm_spacing = 1.0;
   int bhm_scans = 40;
   double octomap_resolution = 0.1;
+
+  template <class A>
+  void Serialize(A* a) {
+    a->Visit("repeats", &repeats, config::Range::Closed(1, 100), "timed runs (median reported)");
+    a->Visit("bhm_spacing", &bhm_spacing, config::Range::Positive(),
+             "feature spacing of the full-BHM comparison (m)");
+    a->Visit("bhm_scans", &bhm_scans, config::Range::Closed(1, 100000),
+             "training scans of the full-BHM comparison");
+    a->Visit("octomap_resolution", &octomap_resolution, config::Range::Positive(),
+             "OctoMap voxel size (m)");
+  }
 };
 
-double Median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
-
-template <class F>
-double TimeMedian(int repeats, F&& f) {
-  std::vector<double> t;
-  for (int r = 0; r < repeats; ++r) {
-    const auto s = Clock::now();
-    f();
-    t.push_back(std::chrono::duration<double>(Clock::now() - s).count());
-  }
-  return Median(t);
-}
-
-void RunMapBench(const BenchMapArgs& a) {
-  FS_THROW_UNLESS(ModelTagOfFile(a.config).rfind("occupancy.", 0) == 0, a.config,
-                  ": not an occupancy config (model: occupancy.*)");
-  OccupancyExperimentConfig c =
-      config::LoadExperimentConfig<OccupancyExperimentConfig>(a.config, a.overrides);
+void RunOccupancyBench(const BenchRequest& req, const OccupancyBenchOptions& a) {
+  const auto c = LoadBenchConfig<OccupancyExperimentConfig>(req);
   const OccupancyData data = LoadOccupancyData(c);
   const HingeGrid grid(c.features);
 
   // Fast-BHM on the full training set.
   std::unique_ptr<HingeMap> map;
-  const double fast_s = TimeMedian(a.repeats, [&] {
+  const double fast_s = MedianSeconds(a.repeats, [&] {
     FastBhmLearner l(grid, c.fast_bhm);
     UpdateOnScans(&l, data.train, FirstScans(data.train));
     map = std::make_unique<HingeMap>(l.ToMap());
@@ -78,11 +66,11 @@ void RunMapBench(const BenchMapArgs& a) {
   coarse.cutoff_radius = c.features.cutoff_radius * ratio;
   const HingeGrid bhm_grid(coarse);
   const int scans = std::min(a.bhm_scans, data.train.num_scans());
-  const double bhm_s = TimeMedian(1, [&] {
+  const double bhm_s = MedianSeconds(1, [&] {
     BhmLearner l(bhm_grid, c.fast_bhm);
     UpdateOnScans(&l, data.train, FirstScans(data.train, scans));
   });
-  const double fast_same_s = TimeMedian(a.repeats, [&] {
+  const double fast_same_s = MedianSeconds(a.repeats, [&] {
     FastBhmLearner l(bhm_grid, c.fast_bhm);
     UpdateOnScans(&l, data.train, FirstScans(data.train, scans));
   });
@@ -92,7 +80,7 @@ void RunMapBench(const BenchMapArgs& a) {
   double sink = 0;
   const std::int64_t n = data.test.size();
   const int passes = std::max<std::int64_t>(1, 2000000 / std::max<std::int64_t>(n, 1));
-  const double query_s = TimeMedian(a.repeats, [&] {
+  const double query_s = MedianSeconds(a.repeats, [&] {
     for (int p = 0; p < passes; ++p)
       for (std::int64_t i = 0; i < n; ++i) {
         const OccupancyQuery q = map->Query(data.test.xy(0, i), data.test.xy(1, i), &ws);
@@ -115,7 +103,7 @@ void RunMapBench(const BenchMapArgs& a) {
     << ", \"octomap_train_s\": " << octo.insert_s << ", \"octomap_auc\": " << octo.auc
     << ", \"octomap_bytes\": " << octo.bytes << ", \"octomap_memory_bytes\": " << octo.memory
     << ", \"repeats\": " << a.repeats << ", \"checksum\": " << (sink != 0 ? 1 : 0) << "}";
-  if (a.json) {
+  if (req.json) {
     std::cout << j.str() << "\n";
     return;
   }
@@ -131,23 +119,8 @@ void RunMapBench(const BenchMapArgs& a) {
 
 }  // namespace
 
-void AddBenchMapCommand(CLI::App* bench) {
-  auto a = std::make_shared<BenchMapArgs>();
-  auto* cmd = bench->add_subcommand(
-      "map", "occupancy maps: Fast-BHM vs full BHM vs OctoMap, query throughput");
-  cmd->add_option("--config", a->config, "occupancy config (e.g. configs/occupancy/intel.yaml)")
-      ->required();
-  cmd->add_option("overrides", a->overrides, "key.path=value overrides of the config");
-  cmd->add_flag("--json", a->json, "print one JSON object");
-  cmd->add_option("--repeats", a->repeats, "timed repetitions (median reported)")
-      ->check(CLI::Range(1, 100));
-  cmd->add_option("--bhm-spacing", a->bhm_spacing, "feature spacing of the full-BHM comparison (m)")
-      ->check(CLI::PositiveNumber);
-  cmd->add_option("--bhm-scans", a->bhm_scans, "training scans of the full-BHM comparison")
-      ->check(CLI::Range(1, 100000));
-  cmd->add_option("--octomap-resolution", a->octomap_resolution, "OctoMap voxel size (m)")
-      ->check(CLI::PositiveNumber);
-  cmd->callback([a] { RunMapBench(*a); });
+void SetOccupancyBench(ExperimentKind* kind) {
+  SetBench<OccupancyBenchOptions>(kind, RunOccupancyBench);
 }
 
-}  // namespace foresight::app
+}  // namespace foresight

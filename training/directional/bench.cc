@@ -1,47 +1,47 @@
-// `foresight bench directional`: query latency of the directional-map engine (Eigen) against
-// LibTorch on the same exported network, side by side in one run, one thread: batch 1 (median of
-// single queries) and batch 1024 (median of repeated batches). Both sides go from (x, y, t) to the
-// mixture parameters; the LibTorch side gets the features from the same feature code.
-// A benchmark that prints figures, not a test.
+// The directional kind's bench (`foresight bench RUN_DIR|ARTIFACT`): query latency of the
+// directional-map engine (Eigen) against LibTorch on the same exported network, side by side in one
+// run, one thread: batch 1 (median of single queries) and batch 1024 (median of repeated batches).
+// Both sides go from (x, y, t) to the mixture parameters; the LibTorch side gets the features from
+// the same feature code. A benchmark that prints figures, not a test.
+
+#include "core/bench.h"
 
 #include <torch/torch.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <iostream>
 #include <random>
 
-#include "apps/commands.h"
 #include "core/error.h"
 #include "inference/directional/directional_map.h"
 #include "training/directional/pipeline.h"
+#include "training/kinds.h"
 
-namespace foresight::app {
+namespace foresight {
 namespace {
 
-using Clock = std::chrono::steady_clock;
+using bench::Clock;
+using bench::Median;
 using RowMatrixF = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
-double Median(std::vector<double> v) {
-  std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
-  return v[v.size() / 2];
-}
+double Us(Clock::time_point a, Clock::time_point b) { return bench::Micros(a, b); }
 
-double Us(Clock::time_point a, Clock::time_point b) {
-  return std::chrono::duration<double, std::micro>(b - a).count();
-}
-
-struct BenchDirectionalArgs {
-  std::string artifact;
+struct DirectionalBenchOptions {
   int calls = 5000;
   int repeats = 15;
-  bool json = false;
+
+  template <class A>
+  void Serialize(A* a) {
+    a->Visit("calls", &calls, config::Range::Closed(100, 10000000), "timed single queries");
+    a->Visit("repeats", &repeats, config::Range::Closed(1, 10000), "timed batches of 1024");
+  }
 };
 
-void RunDirectionalBench(const BenchDirectionalArgs& a) {
+void RunDirectionalBench(const BenchRequest& req, const DirectionalBenchOptions& a) {
   torch::set_num_threads(1);
-  const DirectionalMap map = DirectionalMap::Load(a.artifact);
+  const std::string artifact = BenchArtifact(req, "model.h5");
+  const DirectionalMap map = DirectionalMap::Load(artifact);
   const DirectionalFeatureConfig& fc = map.features().config();
   const int n = 1024;
   std::mt19937_64 rng(1);
@@ -71,7 +71,7 @@ void RunDirectionalBench(const BenchDirectionalArgs& a) {
   }
 
   // LibTorch on the same network: features (same code) -> forward -> decode.
-  LoadedDirectionalNet net = LoadDirectionalNetFromArtifact(a.artifact);
+  LoadedDirectionalNet net = LoadDirectionalNetFromArtifact(artifact);
   const DirectionalFeatures& feats = map.features();
   c10::InferenceMode guard;
   auto torch_query = [&](int begin, int len, std::vector<double>* forward_only) {
@@ -128,8 +128,8 @@ void RunDirectionalBench(const BenchDirectionalArgs& a) {
 
   const double engine1 = Median(e1), engine_b = Median(eb), torch1 = Median(l1),
                torch_b = Median(lb);
-  if (a.json) {
-    std::cout << "{\"artifact\": \"" << a.artifact << "\", \"variant\": \""
+  if (req.json) {
+    std::cout << "{\"artifact\": \"" << artifact << "\", \"variant\": \""
               << VariantName(map.variant()) << "\", \"inducing_points\": " << feats.spatial_size()
               << ", \"time_points\": " << feats.time_size()
               << ", \"threads\": 1, \"engine_batch1_us\": " << engine1
@@ -162,16 +162,8 @@ void RunDirectionalBench(const BenchDirectionalArgs& a) {
 
 }  // namespace
 
-void AddBenchDirectionalCommand(CLI::App* bench) {
-  auto a = std::make_shared<BenchDirectionalArgs>();
-  auto* cmd = bench->add_subcommand(
-      "directional", "directional map: engine vs LibTorch query latency (batch 1, 1024)");
-  cmd->add_option("--artifact", a->artifact, "exported directional model .h5 (RUN_DIR/model.h5)")
-      ->required();
-  cmd->add_option("--calls", a->calls, "timed single queries")->check(CLI::Range(100, 10000000));
-  cmd->add_option("--repeats", a->repeats, "timed batches of 1024")->check(CLI::Range(1, 10000));
-  cmd->add_flag("--json", a->json, "print one JSON object");
-  cmd->callback([a] { RunDirectionalBench(*a); });
+void SetDirectionalBench(ExperimentKind* kind) {
+  SetBench<DirectionalBenchOptions>(kind, RunDirectionalBench);
 }
 
-}  // namespace foresight::app
+}  // namespace foresight

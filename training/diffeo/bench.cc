@@ -1,20 +1,20 @@
-// `foresight bench diffeo --artifact FILE [--json]`: time of one velocity evaluation (one rollout
-// step) of diffeomorphic templates, measured side by side in one run on one thread, medians of
-// repeated runs: the imitation system alone (engine vs LibTorch on the same weights), composed
-// with an obstacle transform (2-D artifacts), and the JACO arm's C-space system with and without
-// the C-space obstacle transform (3-D artifacts; needs kinova_jaco_j2n6s300 in the data root).
-// A benchmark that prints figures, not a test.
+// The diffeo kind's bench (`foresight bench RUN_DIR|ARTIFACT`): time of one velocity evaluation
+// (one rollout step) of diffeomorphic templates, measured side by side in one run on one thread,
+// medians of repeated runs: the imitation system alone (engine vs LibTorch on the same weights),
+// composed with an obstacle transform (2-D artifacts), and the JACO arm's C-space system with and
+// without the C-space obstacle transform (3-D artifacts; needs kinova_jaco_j2n6s300 in the data
+// root). A benchmark that prints figures, not a test.
+
+#include "core/bench.h"
 
 #include <torch/torch.h>
 
 #include <algorithm>
-#include <chrono>
 #include <filesystem>
 #include <iostream>
 #include <random>
 #include <sstream>
 
-#include "apps/commands.h"
 #include "core/error.h"
 #include "datasets/data_root.h"
 #include "inference/imitation/cspace.h"
@@ -23,37 +23,33 @@
 #include "models/imitation/flow_net.h"
 #include "models/imitation/occupancy_fit.h"
 #include "training/diffeo/config.h"
+#include "training/kinds.h"
 
-namespace foresight::app {
+namespace foresight {
 namespace {
 
 using namespace imitation;  // NOLINT: a benchmark of the imitation engine
-using Clock = std::chrono::steady_clock;
 
-struct BenchDiffeoArgs {
-  std::string artifact;
+struct DiffeoBenchOptions {
   std::string data_root;
   int calls = 2000;
   int repeats = 7;
-  bool json = false;
+
+  template <class A>
+  void Serialize(A* a) {
+    a->Visit("data_root", &data_root, config::Range::Any(),
+             "data root for the JACO URDF of 3-D artifacts (empty: $FORESIGHT_DATA, else "
+             "../shared/data)");
+    a->Visit("calls", &calls, config::Range::Closed(10, 10000000), "calls per timed run");
+    a->Visit("repeats", &repeats, config::Range::Closed(1, 100), "timed runs (median reported)");
+  }
 };
 
-double Median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
-
-/// Median over `repeats` of the mean time (us) of `calls` calls of f(i).
+/// Median over `repeats` of the mean time (us) of `calls` calls of f(i), after a warm-up.
 template <class F>
-double MicrosPerCall(const BenchDiffeoArgs& a, F&& f) {
-  for (int i = 0; i < std::min(200, a.calls); ++i) f(i);  // warm up
-  std::vector<double> t;
-  for (int r = 0; r < a.repeats; ++r) {
-    const auto s = Clock::now();
-    for (int i = 0; i < a.calls; ++i) f(i);
-    t.push_back(std::chrono::duration<double, std::micro>(Clock::now() - s).count() / a.calls);
-  }
-  return Median(t);
+double MicrosPerCall(const DiffeoBenchOptions& a, F&& f) {
+  for (int i = 0; i < std::min(200, a.calls); ++i) f(i);
+  return 1e6 * bench::SecondsPerCall(a.repeats, a.calls, f);
 }
 
 /// Points spread over the grid's box (the region the template was trained on).
@@ -97,7 +93,7 @@ struct Row {
 };
 
 template <int D>
-std::vector<Row> Imitation(const BenchDiffeoArgs& a, const ImitationSystem<D>& s) {
+std::vector<Row> Imitation(const DiffeoBenchOptions& a, const ImitationSystem<D>& s) {
   const auto pts = Points<D>(s.flow().grid(), 256);
   FlowWorkspace<D> ws = s.flow().MakeWorkspace();
   Vec<D> sink = Vec<D>::Zero();
@@ -111,7 +107,7 @@ std::vector<Row> Imitation(const BenchDiffeoArgs& a, const ImitationSystem<D>& s
     xs.push_back(t);
   }
   const torch::Tensor goal = torch::zeros({D}, torch::kFloat64);
-  BenchDiffeoArgs fewer = a;
+  DiffeoBenchOptions fewer = a;
   fewer.calls = std::max(50, a.calls / 10);
   const double libtorch = MicrosPerCall(
       fewer, [&](int i) { (void)net->Velocity(xs[static_cast<std::size_t>(i % 256)], goal); });
@@ -123,7 +119,7 @@ std::vector<Row> Imitation(const BenchDiffeoArgs& a, const ImitationSystem<D>& s
           {"imitation step, LibTorch (batch 1)", libtorch, "same weights, no autograd"}};
 }
 
-Row Composed2d(const BenchDiffeoArgs& a, const ImitationSystem<2>& s) {
+Row Composed2d(const DiffeoBenchOptions& a, const ImitationSystem<2>& s) {
   // A disc between the middle of the grid and the goal, mapped as the evaluation does.
   const DiffeoObstacleConfig o;
   const RbfGrid<2>& g = s.flow().grid();
@@ -160,7 +156,7 @@ Row Composed2d(const BenchDiffeoArgs& a, const ImitationSystem<2>& s) {
           "obstacle flow 16 Euler steps, queries within 3 radii of the disc"};
 }
 
-std::vector<Row> CSpace(const BenchDiffeoArgs& a, const TemplateArtifact<3>& art) {
+std::vector<Row> CSpace(const DiffeoBenchOptions& a, const TemplateArtifact<3>& art) {
   const std::string dir = ResolveDataFile(a.data_root, "kinova_jaco_j2n6s300");
   if (!std::filesystem::exists(dir)) return {{"C-space step", -1, "skipped: no " + dir}};
   const SerialChain chain = SerialChain::LoadJaco(dir);
@@ -196,7 +192,7 @@ std::vector<Row> CSpace(const BenchDiffeoArgs& a, const TemplateArtifact<3>& art
     ArmVector q;
     if (InverseKinematics(chain, tn.ToWorld(t), seed_q, &q, 1e-4, 300)) qs.push_back(q);
   }
-  FS_THROW_UNLESS(!qs.empty(), "bench diffeo: the arm reaches none of the template's region");
+  FS_THROW_UNLESS(!qs.empty(), "bench: the arm reaches none of the template's region");
   auto w1 = plain.MakeWorkspace();
   auto w2 = avoid.MakeWorkspace();
   ArmVector sink = ArmVector::Zero();
@@ -211,22 +207,23 @@ std::vector<Row> CSpace(const BenchDiffeoArgs& a, const TemplateArtifact<3>& art
           {"C-space step (with obstacle transform), engine", t_avoid, note.str()}};
 }
 
-void RunDiffeoBench(const BenchDiffeoArgs& a) {
+void RunDiffeoBench(const BenchRequest& req, const DiffeoBenchOptions& a) {
   torch::set_num_threads(1);
-  const int d = TemplateDimension(a.artifact);
+  const std::string artifact = BenchArtifact(req, "models/");
+  const int d = TemplateDimension(artifact);
   std::vector<Row> rows;
   if (d == 2) {
-    const TemplateArtifact<2> art = LoadTemplate<2>(a.artifact);
+    const TemplateArtifact<2> art = LoadTemplate<2>(artifact);
     rows = Imitation<2>(a, art.system);
     rows.push_back(Composed2d(a, art.system));
   } else {
-    const TemplateArtifact<3> art = LoadTemplate<3>(a.artifact);
+    const TemplateArtifact<3> art = LoadTemplate<3>(artifact);
     rows = Imitation<3>(a, art.system);
     for (const Row& r : CSpace(a, art)) rows.push_back(r);
   }
   const double ratio = rows[1].micros / rows[0].micros;
-  if (a.json) {
-    std::cout << "{\"artifact\": \"" << a.artifact << "\", \"dimension\": " << d
+  if (req.json) {
+    std::cout << "{\"artifact\": \"" << artifact << "\", \"dimension\": " << d
               << ", \"engine_vs_libtorch_speedup\": " << ratio << ", \"steps_us\": {";
     for (std::size_t i = 0; i < rows.size(); ++i)
       std::cout << (i ? ", " : "") << "\"" << rows[i].name << "\": " << rows[i].micros;
@@ -243,18 +240,6 @@ void RunDiffeoBench(const BenchDiffeoArgs& a) {
 
 }  // namespace
 
-void AddBenchDiffeoCommand(CLI::App* bench) {
-  auto a = std::make_shared<BenchDiffeoArgs>();
-  auto* cmd = bench->add_subcommand(
-      "diffeo", "diffeomorphic templates: time per rollout step, engine vs LibTorch");
-  cmd->add_option("--artifact", a->artifact, "exported template (run_dir/models/<shape>.h5)")
-      ->required();
-  cmd->add_option("--data-root", a->data_root, "data root for the JACO URDF (3-D artifacts)");
-  cmd->add_option("--calls", a->calls, "calls per timed run")->check(CLI::Range(10, 10000000));
-  cmd->add_option("--repeats", a->repeats, "timed runs (median reported)")
-      ->check(CLI::Range(1, 100));
-  cmd->add_flag("--json", a->json, "print one JSON object");
-  cmd->callback([a] { RunDiffeoBench(*a); });
-}
+void SetDiffeoBench(ExperimentKind* kind) { SetBench<DiffeoBenchOptions>(kind, RunDiffeoBench); }
 
-}  // namespace foresight::app
+}  // namespace foresight

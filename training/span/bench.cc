@@ -1,31 +1,27 @@
-// `foresight bench engine`: CPU latency of the Eigen engine against LibTorch on the same network,
-// measured side by side in one run (median of many single calls, one thread), plus training
-// throughput. A benchmark that prints figures, not a test.
+// The SPAN kind's bench (`foresight bench RUN_DIR|ARTIFACT`): CPU latency of the Eigen engine
+// against LibTorch on the same network, measured side by side in one run (median of many single
+// calls, one thread), plus training throughput. A benchmark that prints figures, not a test.
+
+#include "core/bench.h"
 
 #include <algorithm>
-#include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <random>
 #include <sstream>
 
-#include "apps/commands.h"
 #include "core/error.h"
 #include "inference/prediction/span_predictor.h"
-#ifdef FORESIGHT_WITH_TORCH
 #include "models/span/span_net.h"
+#include "training/kinds.h"
 #include "training/span/torch_io.h"
-#endif
 
-namespace foresight::app {
+namespace foresight {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double Median(std::vector<double> v) {
-  std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
-  return v[v.size() / 2];
-}
+using bench::Clock;
+using bench::Median;
 
 /// Random observed tracks: straight walks with random heading, speed and noise (world, m).
 Eigen::MatrixXd RandomPasts(int n, int p, double dt, std::uint64_t seed) {
@@ -43,14 +39,19 @@ Eigen::MatrixXd RandomPasts(int n, int p, double dt, std::uint64_t seed) {
   return out;
 }
 
-struct BenchArgs {
-  std::string artifact;
-  bool json = false;
-  int calls = 20000;
+struct SpanBenchOptions {
+  int calls = 20000;  ///< timed single calls of the engine
+
+  template <class A>
+  void Serialize(A* a) {
+    a->Visit("calls", &calls, config::Range::Closed(100, 10000000),
+             "timed single calls of the engine (LibTorch: a quarter, at least 2000)");
+  }
 };
 
-void RunEngineBench(const BenchArgs& a) {
-  const SpanPredictor model = SpanPredictor::Load(a.artifact);
+void RunSpanBench(const BenchRequest& req, const SpanBenchOptions& a) {
+  const std::string artifact = BenchArtifact(req, "model.h5");
+  const SpanPredictor model = SpanPredictor::Load(artifact);
   const int p = model.observed();
   const Eigen::MatrixXd pasts = RandomPasts(256, p, model.seconds_per_step(), 1);
   auto ws = model.MakeWorkspace();
@@ -64,7 +65,7 @@ void RunEngineBench(const BenchArgs& a) {
     const auto t0 = Clock::now();
     model.Predict(past, &ws, &dist);
     const auto t1 = Clock::now();
-    if (i >= 1000) engine.push_back(std::chrono::duration<double, std::micro>(t1 - t0).count());
+    if (i >= 1000) engine.push_back(bench::Micros(t0, t1));
   }
   const double engine_us = Median(engine);
   // Batch of 1024 through PredictBatch: per-window cost.
@@ -74,14 +75,13 @@ void RunEngineBench(const BenchArgs& a) {
   for (int r = 0; r < 15; ++r) {
     const auto t0 = Clock::now();
     model.PredictBatch(batch, &ws, &outs);
-    batch_times.push_back(std::chrono::duration<double, std::micro>(Clock::now() - t0).count());
+    batch_times.push_back(bench::Micros(t0, Clock::now()));
   }
   const double engine_batch1024_us = Median(batch_times);
 
-  double libtorch_us = NAN, train_windows_per_s = NAN;
-#ifdef FORESIGHT_WITH_TORCH
   torch::set_num_threads(1);
-  LoadedSpanNet loaded = LoadSpanNetFromArtifact(a.artifact);
+  LoadedSpanNet loaded = LoadSpanNetFromArtifact(artifact);
+  double libtorch_us = NAN, train_windows_per_s = NAN;
   {
     c10::InferenceMode guard;
     const auto x = torch::randn({256, 2 * p});
@@ -92,8 +92,7 @@ void RunEngineBench(const BenchArgs& a) {
       const auto t0 = Clock::now();
       const auto params = DecodeHead(loaded.net->forward(xi), loaded.layout);
       const auto t1 = Clock::now();
-      if (i >= 200)
-        torch_times.push_back(std::chrono::duration<double, std::micro>(t1 - t0).count());
+      if (i >= 200) torch_times.push_back(bench::Micros(t0, t1));
       (void)params;
     }
     libtorch_us = Median(torch_times);
@@ -115,11 +114,10 @@ void RunEngineBench(const BenchArgs& a) {
       loss.backward();
       opt.step();
       ++steps;
-      elapsed = std::chrono::duration<double>(Clock::now() - t0).count();
+      elapsed = bench::SecondsSince(t0);
     }
     train_windows_per_s = steps * 256.0 / elapsed;
   }
-#endif
   const double ratio = libtorch_us / engine_us;
   auto num = [](double v) {
     std::ostringstream os;
@@ -129,8 +127,8 @@ void RunEngineBench(const BenchArgs& a) {
       os << "null";
     return os.str();
   };
-  if (a.json) {
-    std::cout << "{\"artifact\": \"" << a.artifact
+  if (req.json) {
+    std::cout << "{\"artifact\": \"" << artifact
               << "\", \"batch\": 1, \"threads\": 1, \"calls\": " << a.calls
               << ", \"engine_us\": " << num(engine_us) << ", \"libtorch_us\": " << num(libtorch_us)
               << ", \"ratio\": " << num(ratio)
@@ -149,17 +147,6 @@ void RunEngineBench(const BenchArgs& a) {
 
 }  // namespace
 
-void AddBenchCommands(CLI::App* app) {
-  auto* bench = app->add_subcommand("bench", "benchmarks that print figures");
-  bench->require_subcommand(1);
-  auto args = std::make_shared<BenchArgs>();
-  auto* engine =
-      bench->add_subcommand("engine", "engine vs LibTorch latency of an exported predictor");
-  engine->add_option("--artifact", args->artifact, "exported model .h5")->required();
-  engine->add_flag("--json", args->json, "print one JSON object");
-  engine->add_option("--calls", args->calls, "timed calls")->check(CLI::Range(100, 10000000));
-  engine->callback([args] { RunEngineBench(*args); });
-  AddBenchMapCommand(bench);
-}
+void SetSpanBench(ExperimentKind* kind) { SetBench<SpanBenchOptions>(kind, RunSpanBench); }
 
-}  // namespace foresight::app
+}  // namespace foresight
