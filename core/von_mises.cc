@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "core/error.h"
+#include "core/portable_random.h"
 
 namespace foresight {
 namespace {
@@ -60,9 +61,6 @@ void CheckKappa(double kappa, const char* where) {
   FS_THROW_UNLESS(kappa >= 0 && !std::isnan(kappa), where, ": kappa ", kappa,
                   " must be a non-negative number");
 }
-
-/// Own uniform draw on top of mt19937_64 so samples are the same with every standard library.
-double Uniform01(std::mt19937_64* rng) { return static_cast<double>((*rng)() >> 11) * 0x1.0p-53; }
 
 }  // namespace
 

@@ -115,16 +115,6 @@ Eigen::Vector2d PowerLawInteractionForce(const Eigen::Vector2d& x, const Eigen::
   return -ForceFactor(tau, k, p) * (v + (b * v - a * x) / sd) / a;
 }
 
-double DistanceToSegment(const Eigen::Vector2d& x, const Eigen::Vector2d& p,
-                         const Eigen::Vector2d& q, Eigen::Vector2d* closest) {
-  const Eigen::Vector2d d = q - p;
-  const double l2 = d.squaredNorm();
-  const double t = l2 > 0 ? std::clamp((x - p).dot(d) / l2, 0.0, 1.0) : 0.0;
-  const Eigen::Vector2d c = p + t * d;
-  if (closest) *closest = c;
-  return (x - c).norm();
-}
-
 double WallTimeToCollision(const Eigen::Vector2d& x, const Eigen::Vector2d& v, double r,
                            const SimWall& w) {
   const double radius = r + w.half_thickness;

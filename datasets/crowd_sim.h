@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "core/geometry2d.h"
 #include "datasets/crowd_scenario.h"
 
 namespace foresight {
@@ -53,9 +54,6 @@ double WallTimeToCollision(const Eigen::Vector2d& x, const Eigen::Vector2d& v, d
 /// -grad_x of wall_k tau^-m exp(-tau/tau0) for the wall time to collision (zero without collision).
 Eigen::Vector2d WallInteractionForce(const Eigen::Vector2d& x, const Eigen::Vector2d& v, double r,
                                      const SimWall& w, const PowerLawParams& p);
-/// Distance from x to the segment p-q (m), and the closest point.
-double DistanceToSegment(const Eigen::Vector2d& x, const Eigen::Vector2d& p,
-                         const Eigen::Vector2d& q, Eigen::Vector2d* closest = nullptr);
 
 /// The simulator's walls of a scenario: its wall segments plus the four sides of the extent (zero
 /// thickness).

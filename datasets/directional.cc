@@ -14,6 +14,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "core/parse.h"
+#include "core/portable_random.h"
 #include "core/von_mises.h"
 
 namespace foresight {
@@ -63,13 +64,6 @@ std::vector<std::string> SplitComma(const std::string& text) {
   while (std::getline(in, field, ',')) out.push_back(Trim(field));
   if (!text.empty() && text.back() == ',') out.emplace_back();
   return out;
-}
-
-// Own draws on top of mt19937_64 so generated data are the same with every standard library.
-double Uniform01(std::mt19937_64* rng) { return static_cast<double>((*rng)() >> 11) * 0x1.0p-53; }
-double Gaussian(std::mt19937_64* rng) {
-  const double u1 = 1.0 - Uniform01(rng), u2 = Uniform01(rng);
-  return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
 }
 
 /// One parsed Edinburgh point (pixels, frame number).
@@ -393,7 +387,8 @@ DirectionalSamples GenerateCrossingFlow(const CrossingFlowConfig& c) {
     double x = dir > 0 ? 0.0 : c.size, y = y0, t = t0;
     for (int i = 0; i < max_steps; ++i) {
       // Steer at the goal on the far side, with independent heading noise per step.
-      const double heading = std::atan2(y1 - y, goal_x - x) + c.heading_noise * Gaussian(&rng);
+      const double heading =
+          std::atan2(y1 - y, goal_x - x) + c.heading_noise * StandardNormal(&rng);
       x += step * std::cos(heading);
       y += step * std::sin(heading);
       t += c.sample_period;

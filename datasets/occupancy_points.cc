@@ -5,6 +5,7 @@
 #include <random>
 
 #include "core/error.h"
+#include "core/portable_random.h"
 
 namespace foresight {
 namespace {
@@ -27,9 +28,6 @@ std::mt19937_64 ScanGenerator(std::uint64_t seed, std::size_t scan) {
                     static_cast<std::uint32_t>(s), static_cast<std::uint32_t>(s >> 32)};
   return std::mt19937_64(seq);
 }
-
-/// Uniform on [0, 1) from the top 53 bits (same numbers on every standard library).
-double Uniform01(std::mt19937_64* rng) { return static_cast<double>((*rng)() >> 11) * 0x1.0p-53; }
 
 void CheckScanIndex(const LabelledPoints& points, int s, const char* where) {
   FS_THROW_UNLESS(s >= 0 && s < points.num_scans(), where, ": scan index ", s,

@@ -5,20 +5,12 @@
 #include <random>
 
 #include "core/error.h"
+#include "core/portable_random.h"
 
 namespace foresight {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-
-// Own draws on top of mt19937_64 so the data are the same with every standard library.
-double Uniform01(std::mt19937_64* rng) { return static_cast<double>((*rng)() >> 11) * 0x1.0p-53; }
-double UniformSym(std::mt19937_64* rng) { return 2 * Uniform01(rng) - 1; }
-double Gaussian(std::mt19937_64* rng) {
-  const double u1 = 1.0 - Uniform01(rng);  // (0, 1]
-  const double u2 = Uniform01(rng);
-  return std::sqrt(-2 * std::log(u1)) * std::cos(2 * kPi * u2);
-}
 
 std::string JoinNames(const std::vector<std::string>& names) {
   std::string s;
@@ -133,7 +125,7 @@ DemoSet SyntheticDemos2d(const SyntheticDemoConfig& c) {
   for (int i = 0; i < c.demos; ++i) {
     Eigen::Matrix<double, 2, 3> coeff;
     for (int k = 0; k < 3; ++k)
-      for (int r = 0; r < 2; ++r) coeff(r, k) = c.noise * Gaussian(&rng);
+      for (int r = 0; r < 2; ++r) coeff(r, k) = c.noise * StandardNormal(&rng);
     const double duration = 5.0 * (1 + c.noise * UniformSym(&rng));
     Demonstration d;
     d.position.resize(2, c.points);

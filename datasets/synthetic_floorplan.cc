@@ -6,18 +6,13 @@
 #include <random>
 
 #include "core/error.h"
+#include "core/geometry2d.h"
+#include "core/portable_random.h"
 
 namespace foresight {
 namespace {
 
-// Own draws on top of mt19937_64 so the data are the same with every standard library.
-double Uniform01(std::mt19937_64* rng) { return static_cast<double>((*rng)() >> 11) * 0x1.0p-53; }
 std::size_t UniformIndex(std::mt19937_64* rng, std::size_t n) { return (*rng)() % n; }
-double Gaussian(std::mt19937_64* rng) {
-  const double u1 = 1.0 - Uniform01(rng);  // (0, 1]
-  const double u2 = Uniform01(rng);
-  return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
-}
 
 std::mt19937_64 Generator(std::uint64_t seed, std::uint32_t stream) {
   std::seed_seq seq{static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32),
@@ -27,14 +22,6 @@ std::mt19937_64 Generator(std::uint64_t seed, std::uint32_t stream) {
 
 double Cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
   return a.x() * b.y() - a.y() * b.x();
-}
-
-double DistanceToSegment(const Eigen::Vector2d& p, const Eigen::Vector2d& a,
-                         const Eigen::Vector2d& b) {
-  const Eigen::Vector2d e = b - a;
-  const double len2 = e.squaredNorm();
-  const double u = len2 > 0 ? std::clamp((p - a).dot(e) / len2, 0.0, 1.0) : 0.0;
-  return (a + u * e - p).norm();
 }
 
 void AddWall(std::vector<Eigen::Vector4d>* walls, const Eigen::Vector2d& a,
@@ -281,8 +268,8 @@ std::vector<LaserScan> SimulateRobots(const FloorPlan& plan, const SyntheticFloo
       scan.ranges.resize(static_cast<std::size_t>(c.beams));
       for (int i = 0; i < c.beams; ++i) {
         const double r = plan.Raycast(p_WL, scan.BeamAngle(i), c.max_range);
-        scan.ranges[i] =
-            std::isfinite(r) ? std::max(1e-3, r + c.range_noise * Gaussian(&rng)) : c.max_range;
+        scan.ranges[i] = std::isfinite(r) ? std::max(1e-3, r + c.range_noise * StandardNormal(&rng))
+                                          : c.max_range;
       }
       per_robot[k].push_back(std::move(scan));
     }

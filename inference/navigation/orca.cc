@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/geometry2d.h"
 #include "inference/navigation/span_controller.h"
 
 namespace foresight::nav {
@@ -13,8 +14,6 @@ namespace foresight::nav {
 namespace {
 
 constexpr double kEps = 1e-9;
-
-double WrapToPi(double a) { return std::remainder(a, 2.0 * M_PI); }
 
 /// Direction of the boundary line of a half-plane (the normal turned by -90 degrees).
 Eigen::Vector2d AlongLine(const Eigen::Vector2d& normal) { return {normal.y(), -normal.x()}; }

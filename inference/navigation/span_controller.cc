@@ -8,14 +8,13 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/geometry2d.h"
 
 namespace foresight::nav {
 
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-double WrapToPi(double a) { return std::remainder(a, 2.0 * M_PI); }
 
 /// Starts of the per-cycle COBYLA runs: the previous solution, a goal-directed turn, a fan, then
 /// quasi-random points of the control box (a fixed Halton sequence) up to `initialisations`.
