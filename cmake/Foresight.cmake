@@ -90,3 +90,31 @@ function(foresight_add_test name)
     PROPERTIES ENVIRONMENT "FORESIGHT_SOURCE_DIR=${PROJECT_SOURCE_DIR}"
     DISCOVERY_TIMEOUT 60)
 endfunction()
+
+# foresight_unity_torch_free_libraries(): builds each torch-free library with more than one source
+# as unity translation units (CMake's UNITY_BUILD, batches of 8): its sources share one parse of
+# Eigen and the standard headers. Both builds of scripts/test.sh compile these libraries, so this
+# is where a unity build saves most. LibTorch libraries keep one unit per source (the shared
+# precompiled header is chosen per source) and tests keep theirs (each test file is read on its
+# own). -DFORESIGHT_UNITY_BUILD=OFF builds every source alone (the fuzz build does: it checks that
+# each source includes what it uses). Call once, after every target is defined.
+function(foresight_unity_torch_free_libraries)
+  if(NOT FORESIGHT_UNITY_BUILD)
+    return()
+  endif()
+  _foresight_targets_in("${PROJECT_SOURCE_DIR}" targets)
+  foreach(target IN LISTS targets)
+    get_target_property(type ${target} TYPE)
+    get_target_property(source_dir ${target} SOURCE_DIR)
+    if(NOT type STREQUAL "STATIC_LIBRARY" OR source_dir MATCHES "/tests(/|$)")
+      continue()
+    endif()
+    get_target_property(sources ${target} SOURCES)
+    list(FILTER sources INCLUDE REGEX "\\.(cc|cpp)$")
+    list(LENGTH sources count)
+    foresight_links_torch(${target} uses_torch)
+    if(count GREATER 1 AND NOT uses_torch)
+      set_target_properties(${target} PROPERTIES UNITY_BUILD ON UNITY_BUILD_BATCH_SIZE 8)
+    endif()
+  endforeach()
+endfunction()
