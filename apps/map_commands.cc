@@ -26,7 +26,7 @@ namespace {
 struct FuseArgs {
   std::vector<std::string> inputs;
   std::string output, base;
-  double threshold = FusionOptions{}.variance_threshold;
+  double threshold = occupancy::FusionOptions{}.variance_threshold;
 };
 
 /// Whether two files hold the same bytes (a copied artifact under another name).
@@ -78,15 +78,16 @@ void AddMapCommands(CLI::App* app) {
       FS_THROW_UNLESS(!fs::exists(args->output) || !fs::equivalent(args->output, in), args->output,
                       ": the output is also an input (", in,
                       "); write the fused map to a new file");
-    std::vector<HingeMap> maps;
-    for (const auto& p : args->inputs) maps.push_back(HingeMap::Load(p));
-    std::vector<const HingeMap*> ptrs;
+    std::vector<occupancy::HingeMap> maps;
+    for (const auto& p : args->inputs) maps.push_back(occupancy::HingeMap::Load(p));
+    std::vector<const occupancy::HingeMap*> ptrs;
     for (const auto& m : maps) ptrs.push_back(&m);
-    std::unique_ptr<HingeMap> base;
-    if (!args->base.empty()) base = std::make_unique<HingeMap>(HingeMap::Load(args->base));
-    FusionOptions options;
+    std::unique_ptr<occupancy::HingeMap> base;
+    if (!args->base.empty())
+      base = std::make_unique<occupancy::HingeMap>(occupancy::HingeMap::Load(args->base));
+    occupancy::FusionOptions options;
     options.variance_threshold = args->threshold;
-    const HingeMap fused = FuseMaps(ptrs, args->inputs, options, base.get());
+    const occupancy::HingeMap fused = occupancy::FuseMaps(ptrs, args->inputs, options, base.get());
     // The fused map carries the first input's config (same grid and prior by construction).
     const Artifact first = Artifact::Open(args->inputs[0], "");
     fused.Save(args->output, first.config_yaml(), first.seed());
@@ -99,7 +100,7 @@ void AddMapCommands(CLI::App* app) {
       map->add_subcommand("info", "print an occupancy-map artifact's type, extent and size");
   info->add_option("artifact", *path, "map artifact")->required()->check(CLI::ExistingFile);
   info->callback([path] {
-    const auto m = LoadOccupancyMap(*path);
+    const auto m = occupancy::LoadMap(*path);
     const Eigen::Vector4d e = m->Extent();
     std::cout << "{\"model_type\": \"" << m->model_type() << "\", \"extent\": [" << e[0] << ", "
               << e[1] << ", " << e[2] << ", " << e[3] << "], \"bytes\": " << fs::file_size(*path)

@@ -12,8 +12,8 @@
 namespace foresight {
 namespace {
 
-const SpanPredictor& Model(int components) {
-  static std::map<int, SpanPredictor> models;
+const span::Predictor& Model(int components) {
+  static std::map<int, span::Predictor> models;
   auto it = models.find(components);
   if (it == models.end()) {
     const std::string path = (std::filesystem::temp_directory_path() /
@@ -25,7 +25,7 @@ const SpanPredictor& Model(int components) {
     spec.hidden = {100, 100, 100};
     spec.u_param = components == 1 ? UParam::kCholesky : UParam::kDiagonal;
     testing::WriteRandomSpanArtifact(path, spec);
-    it = models.emplace(components, SpanPredictor::Load(path)).first;
+    it = models.emplace(components, span::Predictor::Load(path)).first;
   }
   return it->second;
 }
@@ -37,7 +37,7 @@ Eigen::Matrix<double, Eigen::Dynamic, 2> Past(int p) {
 }
 
 void BM_Predict(benchmark::State& state) {
-  const SpanPredictor& model = Model(static_cast<int>(state.range(0)));
+  const span::Predictor& model = Model(static_cast<int>(state.range(0)));
   auto ws = model.MakeWorkspace();
   auto dist = model.MakeDistribution();
   const auto past = Past(model.observed());
@@ -49,7 +49,7 @@ void BM_Predict(benchmark::State& state) {
 BENCHMARK(BM_Predict)->Arg(1)->Arg(3);
 
 void BM_PositionQuery(benchmark::State& state) {
-  const SpanPredictor& model = Model(1);
+  const span::Predictor& model = Model(1);
   auto ws = model.MakeWorkspace();
   auto dist = model.MakeDistribution();
   model.Predict(Past(model.observed()), &ws, &dist);
@@ -65,7 +65,7 @@ void BM_PositionQuery(benchmark::State& state) {
 BENCHMARK(BM_PositionQuery);
 
 void BM_SamplePath40(benchmark::State& state) {
-  const SpanPredictor& model = Model(1);
+  const span::Predictor& model = Model(1);
   auto ws = model.MakeWorkspace();
   auto dist = model.MakeDistribution();
   model.Predict(Past(model.observed()), &ws, &dist);

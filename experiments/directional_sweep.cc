@@ -51,23 +51,24 @@ const std::vector<Resolution> kResolutions{{4, 5, 3.0},   {5, 7, 2.2},   {10, 13
 
 struct Row {
   std::string experiment, dataset, setting, method;
-  DirectionalMethodMetrics m;
+  directional::MethodMetrics m;
 };
 
-DirectionalRunResult Run(const Args& a, const std::string& config,
-                         std::vector<std::string> overrides, const std::string& name) {
+directional::RunResult Run(const Args& a, const std::string& config,
+                           std::vector<std::string> overrides, const std::string& name) {
   overrides.push_back("eval.folds=" + std::to_string(a.folds));
   overrides.push_back("eval.max_folds=" + std::to_string(a.max_folds));
   overrides.push_back("eval.plots=false");
   overrides.push_back("train.progress=none");
   if (a.epochs > 0) overrides.push_back("train.epochs=" + std::to_string(a.epochs));
   for (const auto& e : a.extra) overrides.push_back(e);
-  const DirectionalExperimentConfig c = config::LoadExperimentConfig<DirectionalExperimentConfig>(
-      a.configs + "/" + config + ".yaml", overrides);
+  const directional::ExperimentConfig c =
+      config::LoadExperimentConfig<directional::ExperimentConfig>(
+          a.configs + "/" + config + ".yaml", overrides);
   const std::string dir = a.work + "/" + name;
   const bool resume = fs::exists(dir + "/config.yaml");
   std::cerr << "== " << name << (resume ? " (resuming)" : "") << "\n";
-  DirectionalRunResult r = RunDirectionalExperiment(c, dir, resume);
+  directional::RunResult r = directional::RunExperiment(c, dir, resume);
   FS_THROW_UNLESS(!r.interrupted, name, ": interrupted");
   std::cerr << r.report.BriefReport() << "\n";
   return r;
@@ -105,7 +106,7 @@ void Write(const Args& a, const std::string& stem, const std::string& title,
 }
 
 void Collect(const std::string& experiment, const std::string& dataset, const std::string& setting,
-             const DirectionalRunResult& r, std::vector<Row>* rows) {
+             const directional::RunResult& r, std::vector<Row>* rows) {
   for (const auto& m : r.report.methods) {
     std::string method = m.method;
     if (experiment != "temporal" && method == "spatial") method = "continuous spatial";

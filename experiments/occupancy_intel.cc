@@ -39,7 +39,7 @@ struct Row {
   double auc;
 };
 
-OccupancyExperimentConfig WithSpacing(OccupancyExperimentConfig c, double spacing) {
+occupancy::ExperimentConfig WithSpacing(occupancy::ExperimentConfig c, double spacing) {
   const double k = spacing / c.features.spacing;
   c.features.gamma /= k * k;  // keep the overlap of neighbouring features
   c.features.cutoff_radius *= k;
@@ -48,24 +48,24 @@ OccupancyExperimentConfig WithSpacing(OccupancyExperimentConfig c, double spacin
 }
 
 /// A Fast-BHM trained on the listed scans of `points`, in order.
-HingeMap TrainOnScans(const OccupancyExperimentConfig& c, const LabelledPoints& points,
-                      const std::vector<int>& scans) {
-  FastBhmLearner l(HingeGrid(c.features), c.fast_bhm);
-  UpdateOnScans(&l, points, scans);
+occupancy::HingeMap TrainOnScans(const occupancy::ExperimentConfig& c, const LabelledPoints& points,
+                                 const std::vector<int>& scans) {
+  occupancy::FastBhmLearner l(HingeGrid(c.features), c.fast_bhm);
+  occupancy::UpdateOnScans(&l, points, scans);
   return l.ToMap();
 }
 
 /// Log-odds fusion of discretised map outputs (the grid update rule the thesis compares against).
-GridMap FuseDiscretised(const std::vector<const OccupancyMap*>& maps, const GridMapConfig& g,
-                        CellType type) {
-  GridGeometry geo;
+occupancy::GridMap FuseDiscretised(const std::vector<const occupancy::Map*>& maps,
+                                   const occupancy::GridMapConfig& g, occupancy::CellType type) {
+  occupancy::GridGeometry geo;
   geo.x_min = g.x_min;
   geo.y_min = g.y_min;
   geo.resolution = g.resolution;
   geo.nx = static_cast<int>(std::ceil((g.x_max - g.x_min) / g.resolution - 1e-9));
   geo.ny = static_cast<int>(std::ceil((g.y_max - g.y_min) / g.resolution - 1e-9));
   Eigen::MatrixXf p(geo.ny, geo.nx);
-  std::vector<MapWorkspace> ws;
+  std::vector<occupancy::MapWorkspace> ws;
   for (const auto* m : maps) ws.push_back(m->MakeWorkspace());
   const double l_max = std::log(g.p_max / (1 - g.p_max)), l_min = std::log(g.p_min / (1 - g.p_min));
   for (int iy = 0; iy < geo.ny; ++iy)
@@ -80,7 +80,7 @@ GridMap FuseDiscretised(const std::vector<const OccupancyMap*>& maps, const Grid
       l = std::clamp(l, l_min, l_max);
       p(iy, ix) = static_cast<float>(1 / (1 + std::exp(-l)));
     }
-  return GridMap(geo, std::move(p), type);
+  return occupancy::GridMap(geo, std::move(p), type);
 }
 
 void PlotCurves(const std::vector<Row>& rows, const std::string& path) {
@@ -151,8 +151,8 @@ int main(int argc, char** argv) try {
       Fail("unknown option ", k, " (use --config FILE --out DIR)");
   }
   fs::create_directories(out);
-  const OccupancyExperimentConfig base =
-      config::LoadExperimentConfig<OccupancyExperimentConfig>(config_path, {});
+  const occupancy::ExperimentConfig base =
+      config::LoadExperimentConfig<occupancy::ExperimentConfig>(config_path, {});
   std::ostringstream md;
   md << "# Occupancy maps on `" << base.data.file
      << "` (measured by `build/bin/occupancy_experiments --config " << config_path << "`)\n\n";
@@ -161,23 +161,25 @@ int main(int argc, char** argv) try {
   // with spacing and bound updates chosen on validation scans (every 10th training scan held
   // out), never on the test scans; then the chosen settings trained on every training scan.
   {
-    OccupancyExperimentConfig v = base;
+    occupancy::ExperimentConfig v = base;
     v.data.val_every = 10;
-    const OccupancyData vdata = LoadOccupancyData(v);
+    const occupancy::Data vdata = occupancy::LoadData(v);
     md << "## Fast-BHM updates (validation: every 10th training scan held out)\n\n"
        << "| update | spacing (m) | bound updates | val AUC |\n|---|---|---|---|\n";
     double best_auc = -1, best_spacing = 0;
     int best_updates = 0;
     for (const double spacing : {0.4, 0.5, 0.6}) {
-      OccupancyExperimentConfig c = WithSpacing(v, spacing);
-      c.fast_bhm.update = FastBhmUpdate::kPublished;
-      const auto published = TrainOccupancyMap(kFastBhmType, c, vdata);
-      md << "| published | " << spacing << " | (z = 1) | " << EvaluateMap(*published, vdata.val).auc
-         << " |\n";
-      c.fast_bhm.update = FastBhmUpdate::kCoupled;
+      occupancy::ExperimentConfig c = WithSpacing(v, spacing);
+      c.fast_bhm.update = occupancy::FastBhmUpdate::kPublished;
+      const auto published = occupancy::TrainMap(occupancy::kFastBhmType, c, vdata);
+      md << "| published | " << spacing << " | (z = 1) | "
+         << occupancy::EvaluateMap(*published, vdata.val).auc << " |\n";
+      c.fast_bhm.update = occupancy::FastBhmUpdate::kCoupled;
       for (const int updates : {0, 2, 5}) {
         c.fast_bhm.bound_updates = updates;
-        const double auc = EvaluateMap(*TrainOccupancyMap(kFastBhmType, c, vdata), vdata.val).auc;
+        const double auc = occupancy::EvaluateMap(
+                               *occupancy::TrainMap(occupancy::kFastBhmType, c, vdata), vdata.val)
+                               .auc;
         md << "| coupled | " << spacing << " | " << updates << " | " << auc << " |\n";
         if (auc > best_auc) best_auc = auc, best_spacing = spacing, best_updates = updates;
       }
@@ -186,35 +188,38 @@ int main(int argc, char** argv) try {
        << " bound updates.\n\n| training data | model | AUC | bytes | train s "
           "|\n|---|---|---|---|---|\n";
     for (const int stride : {1, 10}) {
-      OccupancyExperimentConfig c = WithSpacing(base, best_spacing);
+      occupancy::ExperimentConfig c = WithSpacing(base, best_spacing);
       c.data.train_scan_stride = stride;
-      const OccupancyData data = LoadOccupancyData(c);
+      const occupancy::Data data = occupancy::LoadData(c);
       const std::string label = stride == 1 ? "all training scans" : "every 10th training scan";
       for (const bool coupled : {false, true}) {
-        c.fast_bhm.update = coupled ? FastBhmUpdate::kCoupled : FastBhmUpdate::kPublished;
+        c.fast_bhm.update =
+            coupled ? occupancy::FastBhmUpdate::kCoupled : occupancy::FastBhmUpdate::kPublished;
         c.fast_bhm.bound_updates = best_updates;
         double secs = 0;
-        const auto map = TrainOccupancyMap(kFastBhmType, c, data, &secs);
+        const auto map = occupancy::TrainMap(occupancy::kFastBhmType, c, data, &secs);
         md << "| " << label << " | Fast-BHM " << (coupled ? "coupled" : "published") << " ("
-           << best_spacing << " m) | " << EvaluateMap(*map, data.test).auc << " | "
-           << ArtifactBytes(*map, c) << " | " << secs << " |\n";
+           << best_spacing << " m) | " << occupancy::EvaluateMap(*map, data.test).auc << " | "
+           << occupancy::ArtifactBytes(*map, c) << " | " << secs << " |\n";
       }
-      const OctomapFigures o = RunOctomapBaseline(data, c.data.points.max_range, 0.1, 3);
+      const occupancy::OctomapFigures o =
+          occupancy::RunOctomapBaseline(data, c.data.points.max_range, 0.1, 3);
       md << "| " << label << " | OctoMap 0.1 m | " << o.auc << " | " << o.bytes << " | "
          << o.insert_s << " |\n";
     }
     // Full BHM against Fast-BHM on a grid where the dense covariance fits (1 m: 1,400 features),
     // both with the coupled posterior and the same learned bound (thesis: 0.96 vs 0.95).
-    OccupancyExperimentConfig c = WithSpacing(base, 1.0);
-    c.fast_bhm.update = FastBhmUpdate::kCoupled;
+    occupancy::ExperimentConfig c = WithSpacing(base, 1.0);
+    c.fast_bhm.update = occupancy::FastBhmUpdate::kCoupled;
     c.fast_bhm.bound_updates = best_updates;
-    const OccupancyData data = LoadOccupancyData(c);
-    for (const std::string& model : {std::string(kBhmType), std::string(kFastBhmType)}) {
+    const occupancy::Data data = occupancy::LoadData(c);
+    for (const std::string& model :
+         {std::string(occupancy::kBhmType), std::string(occupancy::kFastBhmType)}) {
       double secs = 0;
-      const auto map = TrainOccupancyMap(model, c, data, &secs);
+      const auto map = occupancy::TrainMap(model, c, data, &secs);
       md << "| all training scans | " << model << " coupled (1 m) | "
-         << EvaluateMap(*map, data.test).auc << " | " << ArtifactBytes(*map, c) << " | " << secs
-         << " |\n";
+         << occupancy::EvaluateMap(*map, data.test).auc << " | "
+         << occupancy::ArtifactBytes(*map, c) << " | " << secs << " |\n";
     }
     md << "\n";
     std::cout << "done: Fast-BHM updates\n";
@@ -224,62 +229,68 @@ int main(int argc, char** argv) try {
   md << "| training data | model | AUC | precision | recall | bytes | train s "
         "|\n|---|---|---|---|---|---|---|\n";
   for (const int stride : {1, 10}) {
-    OccupancyExperimentConfig c = base;
-    c.fast_bhm.update = FastBhmUpdate::kPublished;  // the rows below are the thesis's Fast-BHM
+    occupancy::ExperimentConfig c = base;
+    c.fast_bhm.update =
+        occupancy::FastBhmUpdate::kPublished;  // the rows below are the thesis's Fast-BHM
     c.data.train_scan_stride = stride;
-    const OccupancyData data = LoadOccupancyData(c);
+    const occupancy::Data data = occupancy::LoadData(c);
     const std::string label =
         stride == 1 ? "all training scans" : "every 10th training scan (sparse)";
-    for (const auto& [model, cell] :
-         std::vector<std::pair<std::string, CellType>>{{kFastBhmType, CellType::kFloat32},
-                                                       {kHilbertMapType, CellType::kFloat32},
-                                                       {kGridMapType, CellType::kFloat32},
-                                                       {kGridMapType, CellType::kUint8}}) {
+    for (const auto& [model, cell] : std::vector<std::pair<std::string, occupancy::CellType>>{
+             {occupancy::kFastBhmType, occupancy::CellType::kFloat32},
+             {occupancy::kHilbertMapType, occupancy::CellType::kFloat32},
+             {occupancy::kGridMapType, occupancy::CellType::kFloat32},
+             {occupancy::kGridMapType, occupancy::CellType::kUint8}}) {
       c.grid.cell_type = cell;
       double secs = 0;
-      const auto map = TrainOccupancyMap(model, c, data, &secs);
-      const BinaryMetrics m = EvaluateMap(*map, data.test);
+      const auto map = occupancy::TrainMap(model, c, data, &secs);
+      const BinaryMetrics m = occupancy::EvaluateMap(*map, data.test);
       const std::string name =
-          model == kGridMapType ? model + (cell == CellType::kUint8 ? " (uint8, " : " (float32, ") +
-                                      std::to_string(c.grid.resolution).substr(0, 4) + " m)"
-                                : model;
+          model == occupancy::kGridMapType
+              ? model + (cell == occupancy::CellType::kUint8 ? " (uint8, " : " (float32, ") +
+                    std::to_string(c.grid.resolution).substr(0, 4) + " m)"
+              : model;
       md << "| " << label << " | " << name << " | " << m.auc << " | " << m.precision << " | "
-         << m.recall << " | " << ArtifactBytes(*map, c) << " | " << secs << " |\n";
+         << m.recall << " | " << occupancy::ArtifactBytes(*map, c) << " | " << secs << " |\n";
     }
     {
       // Fast-BHM at 0.4 m spacing: about twice OctoMap's serialized size.
-      const OccupancyExperimentConfig f = WithSpacing(c, 0.4);
+      const occupancy::ExperimentConfig f = WithSpacing(c, 0.4);
       double secs = 0;
-      const auto map = TrainOccupancyMap(kFastBhmType, f, data, &secs);
-      const BinaryMetrics m = EvaluateMap(*map, data.test);
+      const auto map = occupancy::TrainMap(occupancy::kFastBhmType, f, data, &secs);
+      const BinaryMetrics m = occupancy::EvaluateMap(*map, data.test);
       md << "| " << label << " | occupancy.fast_bhm (0.4 m spacing) | " << m.auc << " | "
-         << m.precision << " | " << m.recall << " | " << ArtifactBytes(*map, f) << " | " << secs
-         << " |\n";
+         << m.precision << " | " << m.recall << " | " << occupancy::ArtifactBytes(*map, f) << " | "
+         << secs << " |\n";
     }
-    const OctomapFigures o = RunOctomapBaseline(data, c.data.points.max_range, 0.1, 3);
+    const occupancy::OctomapFigures o =
+        occupancy::RunOctomapBaseline(data, c.data.points.max_range, 0.1, 3);
     md << "| " << label << " | OctoMap 0.1 m | " << o.auc << " | " << o.precision << " | "
        << o.recall << " | " << o.bytes << " | " << o.insert_s << " |\n";
     std::cout << "done: " << label << "\n";
   }
 
   // 2. Size against quality.
-  const OccupancyData data = LoadOccupancyData(base);
+  const occupancy::Data data = occupancy::LoadData(base);
   std::vector<Row> rows;
   for (const double s : {1.0, 0.75, 0.6, 0.5, 0.4, 0.3, 0.25}) {
-    const OccupancyExperimentConfig c = WithSpacing(base, s);
-    const auto map = TrainOccupancyMap(kFastBhmType, c, data);
-    rows.push_back(
-        {base.fast_bhm.update == FastBhmUpdate::kCoupled ? "Fast-BHM coupled" : "Fast-BHM", s,
-         ArtifactBytes(*map, c), EvaluateMap(*map, data.test).auc});
+    const occupancy::ExperimentConfig c = WithSpacing(base, s);
+    const auto map = occupancy::TrainMap(occupancy::kFastBhmType, c, data);
+    rows.push_back({base.fast_bhm.update == occupancy::FastBhmUpdate::kCoupled ? "Fast-BHM coupled"
+                                                                               : "Fast-BHM",
+                    s, occupancy::ArtifactBytes(*map, c),
+                    occupancy::EvaluateMap(*map, data.test).auc});
   }
   for (const double r : {0.4, 0.3, 0.2, 0.15, 0.1, 0.05}) {
-    for (const CellType t : {CellType::kFloat32, CellType::kUint8}) {
-      OccupancyExperimentConfig c = base;
+    for (const occupancy::CellType t :
+         {occupancy::CellType::kFloat32, occupancy::CellType::kUint8}) {
+      occupancy::ExperimentConfig c = base;
       c.grid.resolution = r;
       c.grid.cell_type = t;
-      const auto map = TrainOccupancyMap(kGridMapType, c, data);
-      rows.push_back({t == CellType::kUint8 ? "grid uint8" : "grid float32", r,
-                      ArtifactBytes(*map, c), EvaluateMap(*map, data.test).auc});
+      const auto map = occupancy::TrainMap(occupancy::kGridMapType, c, data);
+      rows.push_back({t == occupancy::CellType::kUint8 ? "grid uint8" : "grid float32", r,
+                      occupancy::ArtifactBytes(*map, c),
+                      occupancy::EvaluateMap(*map, data.test).auc});
     }
   }
   {
@@ -287,33 +298,35 @@ int main(int argc, char** argv) try {
     // fused.
     const double spacing = std::sqrt((base.features.x_max - base.features.x_min) *
                                      (base.features.y_max - base.features.y_min) / 10000.0);
-    const OccupancyExperimentConfig c = WithSpacing(base, spacing);
-    const auto quadrants =
-        QuadrantSplit(data.train, FirstScans(data.train), c.fusion.centre_x, c.fusion.centre_y);
-    std::vector<HingeMap> locals;
+    const occupancy::ExperimentConfig c = WithSpacing(base, spacing);
+    const auto quadrants = QuadrantSplit(data.train, occupancy::FirstScans(data.train),
+                                         c.fusion.centre_x, c.fusion.centre_y);
+    std::vector<occupancy::HingeMap> locals;
     for (const auto& scans : quadrants) locals.push_back(TrainOnScans(c, data.train, scans));
-    std::vector<const OccupancyMap*> ptrs;
+    std::vector<const occupancy::Map*> ptrs;
     for (const auto& m : locals) ptrs.push_back(&m);
     for (const double r : {0.4, 0.3, 0.2, 0.15, 0.1}) {
-      for (const CellType t : {CellType::kFloat32, CellType::kUint8}) {
-        GridMapConfig g = base.grid;
+      for (const occupancy::CellType t :
+           {occupancy::CellType::kFloat32, occupancy::CellType::kUint8}) {
+        occupancy::GridMapConfig g = base.grid;
         g.resolution = r;
-        const GridMap fused = FuseDiscretised(ptrs, g, t);
-        rows.push_back(
-            {t == CellType::kUint8 ? "discretised fusion uint8" : "discretised fusion float32", r,
-             ArtifactBytes(fused, base), EvaluateMap(fused, data.test).auc});
+        const occupancy::GridMap fused = FuseDiscretised(ptrs, g, t);
+        rows.push_back({t == occupancy::CellType::kUint8 ? "discretised fusion uint8"
+                                                         : "discretised fusion float32",
+                        r, occupancy::ArtifactBytes(fused, base),
+                        occupancy::EvaluateMap(fused, data.test).auc});
       }
     }
     for (const double s : {1.0, 0.5, 0.4, 0.3}) {
-      const OccupancyExperimentConfig cs = WithSpacing(base, s);
-      std::vector<HingeMap> qs;
+      const occupancy::ExperimentConfig cs = WithSpacing(base, s);
+      std::vector<occupancy::HingeMap> qs;
       for (const auto& scans : quadrants) qs.push_back(TrainOnScans(cs, data.train, scans));
-      std::vector<const HingeMap*> qp;
+      std::vector<const occupancy::HingeMap*> qp;
       for (const auto& m : qs) qp.push_back(&m);
-      const HingeMap fused =
-          FuseMaps(qp, std::vector<std::string>(qp.size(), "quadrant"), cs.fusion.options);
-      rows.push_back(
-          {"fused Fast-BHM", s, ArtifactBytes(fused, cs), EvaluateMap(fused, data.test).auc});
+      const occupancy::HingeMap fused = occupancy::FuseMaps(
+          qp, std::vector<std::string>(qp.size(), "quadrant"), cs.fusion.options);
+      rows.push_back({"fused Fast-BHM", s, occupancy::ArtifactBytes(fused, cs),
+                      occupancy::EvaluateMap(fused, data.test).auc});
     }
   }
   std::ofstream csv(out + "/occupancy_size_quality.csv");

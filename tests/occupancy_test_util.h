@@ -77,24 +77,25 @@ inline double ReferenceSigmoid(double a) { return 1.0 / (1.0 + std::exp(-a)); }
 
 /// Random weights of the given kind on `grid`: means N(0, 1.5^2), variances in [0.05, 2], and for
 /// BHMs a dense SPD covariance with correlated neighbours.
-inline HingeMap RandomHingeMap(HingeMapKind kind, const HingeGrid& grid, std::uint64_t seed,
-                               double prior_mean = 0.0, double prior_variance = 10.0) {
+inline occupancy::HingeMap RandomHingeMap(occupancy::HingeMapKind kind, const HingeGrid& grid,
+                                          std::uint64_t seed, double prior_mean = 0.0,
+                                          double prior_variance = 10.0) {
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> n01;
   std::uniform_real_distribution<double> u(0.05, 2.0);
   const int t_size = grid.size();
-  HingeWeights w;
+  occupancy::HingeWeights w;
   w.mean.resize(t_size);
   for (int t = 0; t < t_size; ++t) w.mean[t] = 1.5 * n01(rng);
-  if (kind == HingeMapKind::kFastBhm) {
+  if (kind == occupancy::HingeMapKind::kFastBhm) {
     w.variance.resize(t_size);
     for (int t = 0; t < t_size; ++t) w.variance[t] = u(rng);
-  } else if (kind == HingeMapKind::kBhm) {
+  } else if (kind == occupancy::HingeMapKind::kBhm) {
     Eigen::MatrixXd a(t_size, t_size);
     for (Eigen::Index i = 0; i < a.size(); ++i) a.data()[i] = n01(rng);
     w.covariance = a * a.transpose() / t_size + 0.1 * Eigen::MatrixXd::Identity(t_size, t_size);
   }
-  return HingeMap(kind, grid, std::move(w), prior_mean, prior_variance);
+  return occupancy::HingeMap(kind, grid, std::move(w), prior_mean, prior_variance);
 }
 
 /// Points of one "scan": n points uniform in [x0, x1] x [y0, y1] with random labels.

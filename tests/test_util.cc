@@ -87,7 +87,7 @@ void WriteRandomSpanArtifact(const std::string& path, const RandomSpanSpec& s) {
   HeadLayout layout{s.basis, s.components, s.u_param};
   std::mt19937_64 rng(s.seed);
   std::normal_distribution<float> n01;
-  SpanPredictorWeights w;
+  span::PredictorWeights w;
   w.observed = s.observed;
   w.predicted = s.predicted;
   w.seconds_per_step = s.seconds_per_step;
@@ -115,7 +115,7 @@ void WriteRandomSpanArtifact(const std::string& path, const RandomSpanSpec& s) {
     layers.push_back(std::move(l));
   }
   w.mlp = Mlp(std::move(layers));
-  SpanPredictor::Save(path, w, "model: span_predictor\n", 0);
+  span::Predictor::Save(path, w, "model: span_predictor\n", 0);
 }
 
 }  // namespace foresight::testing

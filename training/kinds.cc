@@ -9,11 +9,11 @@ namespace foresight {
 ExperimentRegistry BuiltinKinds() {
   ExperimentRegistry r;
 #ifdef FORESIGHT_WITH_TORCH
-  r.Add(SpanKind(kEmbeddedDefaultConfig));
+  r.Add(span::Kind(kEmbeddedDefaultConfig));
 #endif
-  r.Add(OccupancyKind());
+  r.Add(occupancy::Kind());
 #ifdef FORESIGHT_WITH_TORCH
-  r.Add(DirectionalKind());
+  r.Add(directional::Kind());
 #endif
   r.Add(NavigationKind());
   r.Add(ManipulationKind());

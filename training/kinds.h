@@ -14,13 +14,24 @@ namespace foresight {
 /// LibTorch; a build without it has no default).
 ExperimentRegistry BuiltinKinds();
 
-// One function per method, each in its <method>_kind.cc.
-ExperimentKind OccupancyKind();
+// One function per method, each in its training/<method>/kind.cc (in the method's namespace where
+// it has one).
+namespace occupancy {
+ExperimentKind Kind();
+void SetBenchStep(ExperimentKind* kind);  // in training/occupancy/bench.cc
+}  // namespace occupancy
+namespace directional {
+ExperimentKind Kind();
+void SetBenchStep(ExperimentKind* kind);
+}  // namespace directional
+namespace span {
+/// `embedded_default`: the config `train default` runs (configs/quickstart.yaml).
+ExperimentKind Kind(const std::string& embedded_default);
+void SetBenchStep(ExperimentKind* kind);
+}  // namespace span
 ExperimentKind NavigationKind();
 ExperimentKind ManipulationKind();
 #ifdef FORESIGHT_WITH_TORCH
-ExperimentKind SpanKind(const std::string& embedded_default);
-ExperimentKind DirectionalKind();
 ExperimentKind GfcsKind();
 ExperimentKind DiffeoKind();
 ExperimentKind OtnetKind();
@@ -29,10 +40,7 @@ ExperimentKind ConstrainedKind();
 
 // Each kind's bench step (SetBench), in its <method>/bench.cc (declared in every build: the
 // LibTorch kinds' libraries are built only with LibTorch).
-void SetOccupancyBench(ExperimentKind* kind);
 void SetManipulationBench(ExperimentKind* kind);
-void SetSpanBench(ExperimentKind* kind);
-void SetDirectionalBench(ExperimentKind* kind);
 void SetDiffeoBench(ExperimentKind* kind);
 void SetOtnetBench(ExperimentKind* kind);
 

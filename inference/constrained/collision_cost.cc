@@ -7,8 +7,8 @@
 
 namespace foresight::constrained {
 
-CollisionCost::CollisionCost(const OccupancyMap* map, const TimeBasis& basis, Eigen::VectorXd times,
-                             int order)
+CollisionCost::CollisionCost(const occupancy::Map* map, const TimeBasis& basis,
+                             Eigen::VectorXd times, int order)
     : map_(map), basis_(basis), times_(std::move(times)), order_(order) {
   FS_THROW_UNLESS(map_ != nullptr, "CollisionCost: map is null");
   FS_THROW_UNLESS(basis_.size() >= 1, "CollisionCost: basis has no centres");

@@ -26,8 +26,8 @@ namespace foresight::constrained {
 class CollisionCost {
  public:
   struct Workspace {
-    MapWorkspace map;
-    MapQueryBatch batch;
+    occupancy::MapWorkspace map;
+    occupancy::MapQueryBatch batch;
     Eigen::Matrix2Xd points;  ///< abscissae of one time step [2 x q]
     /// [2 x K] added to the mean at each time (e.g. origin + v t_k); empty = zero. A predicted
     /// distribution's position mean is origin + v t + M' phi(t): the offset is constant in the
@@ -38,7 +38,8 @@ class CollisionCost {
   /// @param map occupancy map (kept by pointer; must outlive this). @param basis the trajectory
   /// basis phi(t). @param times the K time points of the rectangle rule (>= 1, finite).
   /// @param order Gauss-Hermite points per axis (>= 1). Error naming the bad argument.
-  CollisionCost(const OccupancyMap* map, const TimeBasis& basis, Eigen::VectorXd times, int order);
+  CollisionCost(const occupancy::Map* map, const TimeBasis& basis, Eigen::VectorXd times,
+                int order);
 
   int order() const { return order_; }
   int basis() const { return basis_.size(); }
@@ -58,7 +59,7 @@ class CollisionCost {
                              const Eigen::Matrix2Xd& offset = Eigen::Matrix2Xd()) const;
 
  private:
-  const OccupancyMap* map_ = nullptr;
+  const occupancy::Map* map_ = nullptr;
   TimeBasis basis_;
   Eigen::VectorXd times_;
   Eigen::MatrixXd phi_;  ///< [K x m], phi(t_k)'

@@ -50,7 +50,7 @@ void SetFromComponentParams(const ComponentParams& p, int r, TrajectoryDistribut
   d->SetComponent(r, p.mean, lu, p.chol_v);
 }
 
-DistributionProjector::DistributionProjector(const OccupancyMap* map, const TimeBasis& basis,
+DistributionProjector::DistributionProjector(const occupancy::Map* map, const TimeBasis& basis,
                                              Eigen::VectorXd times, const ProjectorOptions& options)
     : options_(options), cost_(map, basis, std::move(times), options.order) {
   FS_THROW_UNLESS(std::isfinite(options_.epsilon) && options_.epsilon > 0 && options_.epsilon < 1,

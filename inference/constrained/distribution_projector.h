@@ -73,7 +73,7 @@ class DistributionProjector {
   /// trajectory basis phi(t). @param times the K points of the rectangle rule (s after the last
   /// observation, e.g. dt, 2 dt, ..., f dt). Error naming a bad option (epsilon, margin, order,
   /// solver limits).
-  DistributionProjector(const OccupancyMap* map, const TimeBasis& basis, Eigen::VectorXd times,
+  DistributionProjector(const occupancy::Map* map, const TimeBasis& basis, Eigen::VectorXd times,
                         const ProjectorOptions& options);
 
   const ProjectorOptions& options() const { return options_; }

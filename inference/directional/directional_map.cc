@@ -6,14 +6,11 @@
 #include "core/error.h"
 #include "inference/engine/artifact.h"
 
-namespace foresight {
+namespace foresight::directional {
 
-const char* VariantName(DirectionalVariant v) {
-  return v == DirectionalVariant::kSpatial ? "spatial" : "spatiotemporal";
-}
+const char* VariantName(Variant v) { return v == Variant::kSpatial ? "spatial" : "spatiotemporal"; }
 
-DirectionalMap::DirectionalMap(DirectionalVariant variant, const DirectionalFeatureConfig& features,
-                               Lstm lstm, DirectionalHeads heads, double max_kappa)
+Map::Map(Variant variant, const FeatureConfig& features, Lstm lstm, Heads heads, double max_kappa)
     : variant_(variant),
       features_(features),
       lstm_(std::move(lstm)),
@@ -22,10 +19,10 @@ DirectionalMap::DirectionalMap(DirectionalVariant variant, const DirectionalFeat
   Check();
 }
 
-void DirectionalMap::Check() const {
+void Map::Check() const {
   const auto R = heads_.alpha_b.size();
   const Eigen::Index d =
-      variant_ == DirectionalVariant::kSpatial ? features_.spatial_size() : lstm_.hidden_size();
+      variant_ == Variant::kSpatial ? features_.spatial_size() : lstm_.hidden_size();
   FS_THROW_UNLESS(R >= 1 && heads_.mu_b.size() == R && heads_.kappa_b.size() == R,
                   "directional map: heads have ", heads_.alpha_b.size(), ", ", heads_.mu_b.size(),
                   ", ", heads_.kappa_b.size(), " outputs; expected R >= 1 each");
@@ -33,7 +30,7 @@ void DirectionalMap::Check() const {
     FS_THROW_UNLESS(w->rows() == R && w->cols() == d, "directional map: a head weight is ",
                     w->rows(), " x ", w->cols(), ", expected ", R, " x ", d, " (",
                     VariantName(variant_), ")");
-  if (variant_ == DirectionalVariant::kSpatiotemporal)
+  if (variant_ == Variant::kSpatiotemporal)
     FS_THROW_UNLESS(lstm_.input_size() == features_.spatial_size(),
                     "directional map: the LSTM takes ", lstm_.input_size(),
                     " inputs, the features have M_s = ", features_.spatial_size());
@@ -46,16 +43,15 @@ void DirectionalMap::Check() const {
                   "directional map: non-finite head weights");
 }
 
-DirectionalMap DirectionalMap::Load(const std::string& path) {
-  const Artifact art = Artifact::Open(path, kDirectionalModelType);
+Map Map::Load(const std::string& path) {
+  const Artifact art = Artifact::Open(path, kModelType);
   const h5::File& f = art.file();
-  DirectionalMap m;
+  Map m;
   const std::string variant = f.GetStringAttr("/model", "variant");
   FS_THROW_UNLESS(variant == "spatiotemporal" || variant == "spatial", path, ": unknown variant '",
                   variant, "' (expected spatiotemporal or spatial)");
-  m.variant_ =
-      variant == "spatial" ? DirectionalVariant::kSpatial : DirectionalVariant::kSpatiotemporal;
-  DirectionalFeatureConfig fc;
+  m.variant_ = variant == "spatial" ? Variant::kSpatial : Variant::kSpatiotemporal;
+  FeatureConfig fc;
   const std::string g = "/model/features";
   fc.x_min = art.DoubleAttr(g, "x_min", -1e12, 1e12);
   fc.x_max = art.DoubleAttr(g, "x_max", -1e12, 1e12);
@@ -74,7 +70,7 @@ DirectionalMap DirectionalMap::Load(const std::string& path) {
                   path, ": implausible inducing grid ", fc.cells_x, " x ", fc.cells_y, " x ",
                   fc.time_points);
   try {
-    m.features_ = DirectionalFeatures(fc);
+    m.features_ = Features(fc);
   } catch (const Error& e) {
     Fail(path, ": ", e.what());
   }
@@ -88,7 +84,7 @@ DirectionalMap DirectionalMap::Load(const std::string& path) {
   read_head("alpha", &m.heads_.alpha_w, &m.heads_.alpha_b);
   read_head("mu", &m.heads_.mu_w, &m.heads_.mu_b);
   read_head("kappa", &m.heads_.kappa_w, &m.heads_.kappa_b);
-  if (m.variant_ == DirectionalVariant::kSpatiotemporal) m.lstm_ = Lstm::Load(f, "/weights/lstm/");
+  if (m.variant_ == Variant::kSpatiotemporal) m.lstm_ = Lstm::Load(f, "/weights/lstm/");
   try {
     m.Check();
   } catch (const Error& e) {
@@ -104,17 +100,16 @@ void WriteVector(h5::File* f, const std::string& name, const Eigen::VectorXf& v)
 }
 }  // namespace
 
-void DirectionalMap::Save(const std::string& path, const std::string& config_yaml,
-                          std::int64_t seed) const {
+void Map::Save(const std::string& path, const std::string& config_yaml, std::int64_t seed) const {
   h5::WriteAtomically(path, [&](h5::File* f) {
-    Artifact::WriteHeader(f, kDirectionalModelType, config_yaml, seed);
-    const bool temporal = variant_ == DirectionalVariant::kSpatiotemporal;
+    Artifact::WriteHeader(f, kModelType, config_yaml, seed);
+    const bool temporal = variant_ == Variant::kSpatiotemporal;
     f->SetAttr("/model", "variant", std::string(VariantName(variant_)));
     f->SetAttr("/model", "components", static_cast<std::int64_t>(components()));
     f->SetAttr("/model", "hidden", static_cast<std::int64_t>(temporal ? lstm_.hidden_size() : 0));
     f->SetAttr("/model", "log_kappa_min", kDirectionalLogKappaMin);
     f->SetAttr("/model", "log_kappa_max", log_kappa_max_);
-    const DirectionalFeatureConfig& c = features_.config();
+    const FeatureConfig& c = features_.config();
     const std::string g = "/model/features";
     f->SetAttr(g, "x_min", c.x_min);
     f->SetAttr(g, "x_max", c.x_max);
@@ -144,10 +139,10 @@ void DirectionalMap::Save(const std::string& path, const std::string& config_yam
   });
 }
 
-DirectionalMap::Workspace DirectionalMap::MakeWorkspace() const {
+Map::Workspace Map::MakeWorkspace() const {
   Workspace ws;
   const int R = components();
-  if (variant_ == DirectionalVariant::kSpatiotemporal) {
+  if (variant_ == Variant::kSpatiotemporal) {
     ws.lstm = lstm_.MakeWorkspace();
     ws.proj = Eigen::VectorXf::Zero(4 * lstm_.hidden_size());
   }
@@ -160,17 +155,17 @@ DirectionalMap::Workspace DirectionalMap::MakeWorkspace() const {
   return ws;
 }
 
-void DirectionalMap::RawOutput(double x, double y, double t, Workspace* ws) const {
+void Map::RawOutput(double x, double y, double t, Workspace* ws) const {
   FS_THROW_UNLESS(std::isfinite(x) && std::isfinite(y) && std::isfinite(t),
                   "directional map: query (", x, ", ", y, ", ", t, ") is not finite");
   const int R = components();
   const int cx = features_.config().cells_x;
-  const DirectionalFeatures::Window w = features_.SpatialWindow(x, y);
+  const Features::Window w = features_.SpatialWindow(x, y);
   auto head = [&](int r, const Eigen::MatrixXf& W, const Eigen::VectorXf& b, int offset,
                   const Eigen::Ref<const Eigen::VectorXf>& z) {
     ws->raw[offset + r] = W.row(r).dot(z) + b[r];
   };
-  if (variant_ == DirectionalVariant::kSpatial) {
+  if (variant_ == Variant::kSpatial) {
     // Heads on the sparse features: z = b + sum_j phi_j W[:, j].
     for (int r = 0; r < R; ++r) {
       ws->raw[r] = heads_.alpha_b[r];
@@ -209,7 +204,7 @@ void DirectionalMap::RawOutput(double x, double y, double t, Workspace* ws) cons
   }
 }
 
-void DirectionalMap::QueryOne(double x, double y, double t, Workspace* ws) const {
+void Map::QueryOne(double x, double y, double t, Workspace* ws) const {
   RawOutput(x, y, t, ws);
   const int R = components();
   double mx = -INFINITY;
@@ -224,10 +219,10 @@ void DirectionalMap::QueryOne(double x, double y, double t, Workspace* ws) const
   }
 }
 
-void DirectionalMap::Query(const Eigen::Ref<const Eigen::VectorXd>& x,
-                           const Eigen::Ref<const Eigen::VectorXd>& y,
-                           const Eigen::Ref<const Eigen::VectorXd>& t, Workspace* ws,
-                           VonMisesMixtureBatch* out) const {
+void Map::Query(const Eigen::Ref<const Eigen::VectorXd>& x,
+                const Eigen::Ref<const Eigen::VectorXd>& y,
+                const Eigen::Ref<const Eigen::VectorXd>& t, Workspace* ws,
+                VonMisesMixtureBatch* out) const {
   FS_THROW_UNLESS(x.size() == y.size() && x.size() == t.size(), "directional map: query sizes x ",
                   x.size(), ", y ", y.size(), ", t ", t.size(), " differ");
   const int R = components();
@@ -240,11 +235,11 @@ void DirectionalMap::Query(const Eigen::Ref<const Eigen::VectorXd>& x,
   }
 }
 
-void DirectionalMap::Density(const Eigen::Ref<const Eigen::VectorXd>& x,
-                             const Eigen::Ref<const Eigen::VectorXd>& y,
-                             const Eigen::Ref<const Eigen::VectorXd>& t,
-                             const Eigen::Ref<const Eigen::VectorXd>& theta, Workspace* ws,
-                             Eigen::Ref<Eigen::VectorXd> density) const {
+void Map::Density(const Eigen::Ref<const Eigen::VectorXd>& x,
+                  const Eigen::Ref<const Eigen::VectorXd>& y,
+                  const Eigen::Ref<const Eigen::VectorXd>& t,
+                  const Eigen::Ref<const Eigen::VectorXd>& theta, Workspace* ws,
+                  Eigen::Ref<Eigen::VectorXd> density) const {
   FS_THROW_UNLESS(x.size() == y.size() && x.size() == t.size() && x.size() == theta.size() &&
                       density.size() == x.size(),
                   "directional map: density sizes x ", x.size(), ", y ", y.size(), ", t ", t.size(),
@@ -256,4 +251,4 @@ void DirectionalMap::Density(const Eigen::Ref<const Eigen::VectorXd>& x,
   }
 }
 
-}  // namespace foresight
+}  // namespace foresight::directional

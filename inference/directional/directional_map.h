@@ -24,12 +24,12 @@
 #include "inference/directional/features.h"
 #include "inference/engine/lstm.h"
 
-namespace foresight {
+namespace foresight::directional {
 
-inline constexpr const char* kDirectionalModelType = "directional_map";
+inline constexpr const char* kModelType = "directional_map";
 
-enum class DirectionalVariant { kSpatiotemporal, kSpatial };
-const char* VariantName(DirectionalVariant v);
+enum class Variant { kSpatiotemporal, kSpatial };
+const char* VariantName(Variant v);
 
 /// log kappa is clamped to [kDirectionalLogKappaMin, log max_kappa] in the head (training and
 /// engine alike); max_kappa is a model parameter (artifact attribute log_kappa_max), by default the
@@ -38,12 +38,12 @@ const char* VariantName(DirectionalVariant v);
 inline constexpr double kDirectionalLogKappaMin = -10.0;
 inline constexpr double kDirectionalDefaultMaxKappa = 100.0;
 
-struct DirectionalHeads {
+struct Heads {
   Eigen::MatrixXf alpha_w, mu_w, kappa_w;  ///< [R x D] each
   Eigen::VectorXf alpha_b, mu_b, kappa_b;  ///< [R]
 };
 
-class DirectionalMap {
+class Map {
  public:
   struct Workspace {
     Lstm::Workspace lstm;
@@ -56,19 +56,19 @@ class DirectionalMap {
 
   /// Opens and checks an artifact; a missing file, another model type or inconsistent tensors are
   /// Errors naming the file.
-  static DirectionalMap Load(const std::string& path);
+  static Map Load(const std::string& path);
   /// Writes an artifact that Load reads (to path.tmp, then renamed into place); the engine owns
   /// the schema both ways (docs/artifact_schema.md).
   void Save(const std::string& path, const std::string& config_yaml, std::int64_t seed) const;
   /// Builds a map from parts (exporters, tests). `lstm` is ignored for the spatial variant.
-  DirectionalMap(DirectionalVariant variant, const DirectionalFeatureConfig& features, Lstm lstm,
-                 DirectionalHeads heads, double max_kappa = kDirectionalDefaultMaxKappa);
+  Map(Variant variant, const FeatureConfig& features, Lstm lstm, Heads heads,
+      double max_kappa = kDirectionalDefaultMaxKappa);
 
-  DirectionalVariant variant() const { return variant_; }
+  Variant variant() const { return variant_; }
   int components() const { return static_cast<int>(heads_.alpha_b.size()); }
-  const DirectionalFeatures& features() const { return features_; }
+  const Features& features() const { return features_; }
   const Lstm& lstm() const { return lstm_; }
-  const DirectionalHeads& heads() const { return heads_; }
+  const Heads& heads() const { return heads_; }
   double max_kappa() const { return std::exp(log_kappa_max_); }
 
   Workspace MakeWorkspace() const;
@@ -90,13 +90,13 @@ class DirectionalMap {
                Eigen::Ref<Eigen::VectorXd> density) const;
 
  private:
-  DirectionalMap() = default;
+  Map() = default;
   void Check() const;
-  DirectionalVariant variant_ = DirectionalVariant::kSpatiotemporal;
-  DirectionalFeatures features_;
+  Variant variant_ = Variant::kSpatiotemporal;
+  Features features_;
   Lstm lstm_;
-  DirectionalHeads heads_;
+  Heads heads_;
   double log_kappa_max_ = std::log(kDirectionalDefaultMaxKappa);
 };
 
-}  // namespace foresight
+}  // namespace foresight::directional

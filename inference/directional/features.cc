@@ -5,9 +5,9 @@
 
 #include "core/error.h"
 
-namespace foresight {
+namespace foresight::directional {
 
-DirectionalFeatures::DirectionalFeatures(const DirectionalFeatureConfig& c) : config_(c) {
+Features::Features(const FeatureConfig& c) : config_(c) {
   FS_THROW_UNLESS(std::isfinite(c.x_min) && std::isfinite(c.x_max) && c.x_max > c.x_min &&
                       std::isfinite(c.y_min) && std::isfinite(c.y_max) && c.y_max > c.y_min,
                   "directional features: empty spatial extent x [", c.x_min, ", ", c.x_max,
@@ -28,21 +28,19 @@ DirectionalFeatures::DirectionalFeatures(const DirectionalFeatureConfig& c) : co
   cut2_t_ = c.cutoff * c.cutoff * c.time_length_scale * c.time_length_scale;
 }
 
-Eigen::Vector2d DirectionalFeatures::SpatialPoint(int j) const {
+Eigen::Vector2d Features::SpatialPoint(int j) const {
   const int ix = j % config_.cells_x, iy = j / config_.cells_x;
   return {config_.x_min + (ix + 0.5) * dx_, config_.y_min + (iy + 0.5) * dy_};
 }
 
-double DirectionalFeatures::TimePoint(int k) const {
+double Features::TimePoint(int k) const {
   if (config_.time_points == 1) return 0.5 * (config_.t_min + config_.t_max);
   return config_.t_min + (config_.t_max - config_.t_min) * k / (config_.time_points - 1);
 }
 
-double DirectionalFeatures::ClampTime(double t) const {
-  return std::clamp(t, config_.t_min, config_.t_max);
-}
+double Features::ClampTime(double t) const { return std::clamp(t, config_.t_min, config_.t_max); }
 
-DirectionalFeatures::Window DirectionalFeatures::SpatialWindow(double x, double y) const {
+Features::Window Features::SpatialWindow(double x, double y) const {
   const double r = config_.cutoff * config_.length_scale;
   // Centre of cell i is x_min + (i + 0.5) dx; cells with |centre - x| <= r.
   auto range = [r](double v, double lo, double d, int n, int* i0, int* i1) {
@@ -59,14 +57,14 @@ DirectionalFeatures::Window DirectionalFeatures::SpatialWindow(double x, double 
   return w;
 }
 
-double DirectionalFeatures::SpatialKernel(double x, double y, int ix, int iy) const {
+double Features::SpatialKernel(double x, double y, int ix, int iy) const {
   const double ex = x - (config_.x_min + (ix + 0.5) * dx_);
   const double ey = y - (config_.y_min + (iy + 0.5) * dy_);
   const double d2 = ex * ex + ey * ey;
   return d2 > cut2_s_ ? 0.0 : std::exp(-d2 * inv_two_ls2_);
 }
 
-void DirectionalFeatures::Spatial(double x, double y, Eigen::Ref<Eigen::VectorXf> out) const {
+void Features::Spatial(double x, double y, Eigen::Ref<Eigen::VectorXf> out) const {
   FS_THROW_UNLESS(out.size() == spatial_size(), "directional features: output has ", out.size(),
                   " entries, expected ", spatial_size());
   out.setZero();
@@ -76,7 +74,7 @@ void DirectionalFeatures::Spatial(double x, double y, Eigen::Ref<Eigen::VectorXf
       out[iy * config_.cells_x + ix] = static_cast<float>(SpatialKernel(x, y, ix, iy));
 }
 
-void DirectionalFeatures::Temporal(double t, Eigen::Ref<Eigen::VectorXf> out) const {
+void Features::Temporal(double t, Eigen::Ref<Eigen::VectorXf> out) const {
   FS_THROW_UNLESS(out.size() == time_size(), "directional features: output has ", out.size(),
                   " entries, expected ", time_size());
   const double tc = ClampTime(t);
@@ -86,7 +84,7 @@ void DirectionalFeatures::Temporal(double t, Eigen::Ref<Eigen::VectorXf> out) co
   }
 }
 
-void DirectionalFeatures::SpatialBatch(
+void Features::SpatialBatch(
     const Eigen::Ref<const Eigen::VectorXd>& x, const Eigen::Ref<const Eigen::VectorXd>& y,
     Eigen::Ref<Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> out) const {
   FS_THROW_UNLESS(x.size() == y.size() && out.rows() == x.size() && out.cols() == spatial_size(),
@@ -95,7 +93,7 @@ void DirectionalFeatures::SpatialBatch(
   for (Eigen::Index i = 0; i < x.size(); ++i) Spatial(x[i], y[i], out.row(i).transpose());
 }
 
-void DirectionalFeatures::TemporalBatch(
+void Features::TemporalBatch(
     const Eigen::Ref<const Eigen::VectorXd>& t,
     Eigen::Ref<Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> out) const {
   FS_THROW_UNLESS(out.rows() == t.size() && out.cols() == time_size(),
@@ -104,11 +102,10 @@ void DirectionalFeatures::TemporalBatch(
   for (Eigen::Index i = 0; i < t.size(); ++i) Temporal(t[i], out.row(i).transpose());
 }
 
-void DirectionalFeatures::SpatialSparseBatch(const Eigen::Ref<const Eigen::VectorXd>& x,
-                                             const Eigen::Ref<const Eigen::VectorXd>& y,
-                                             std::vector<std::int64_t>* index,
-                                             std::vector<float>* value,
-                                             std::vector<std::int64_t>* offsets) const {
+void Features::SpatialSparseBatch(const Eigen::Ref<const Eigen::VectorXd>& x,
+                                  const Eigen::Ref<const Eigen::VectorXd>& y,
+                                  std::vector<std::int64_t>* index, std::vector<float>* value,
+                                  std::vector<std::int64_t>* offsets) const {
   FS_THROW_UNLESS(x.size() == y.size(), "directional features: batch shapes x ", x.size(), ", y ",
                   y.size());
   index->clear();
@@ -127,11 +124,10 @@ void DirectionalFeatures::SpatialSparseBatch(const Eigen::Ref<const Eigen::Vecto
   }
 }
 
-DirectionalFeatureConfig ResolveExtent(const DirectionalFeatureConfig& config,
-                                       const Eigen::Ref<const Eigen::VectorXd>& x,
-                                       const Eigen::Ref<const Eigen::VectorXd>& y,
-                                       const Eigen::Ref<const Eigen::VectorXd>& t) {
-  DirectionalFeatureConfig c = config;
+FeatureConfig ResolveExtent(const FeatureConfig& config, const Eigen::Ref<const Eigen::VectorXd>& x,
+                            const Eigen::Ref<const Eigen::VectorXd>& y,
+                            const Eigen::Ref<const Eigen::VectorXd>& t) {
+  FeatureConfig c = config;
   if (!c.auto_extent && !c.auto_time_range) return c;
   FS_THROW_UNLESS(x.size() > 0 && x.size() == y.size() && x.size() == t.size() && x.allFinite() &&
                       y.allFinite() && t.allFinite(),
@@ -154,4 +150,4 @@ DirectionalFeatureConfig ResolveExtent(const DirectionalFeatureConfig& config,
   return c;
 }
 
-}  // namespace foresight
+}  // namespace foresight::directional

@@ -26,9 +26,9 @@
 
 #include "core/config.h"
 
-namespace foresight {
+namespace foresight::directional {
 
-struct DirectionalFeatureConfig {
+struct FeatureConfig {
   double x_min = 0, x_max = 10, y_min = 0, y_max = 10;  ///< spatial extent (m)
   int cells_x = 10, cells_y = 10;                       ///< M_s = cells_x * cells_y inducing points
   double length_scale = 1.0;                            ///< l_s (m)
@@ -68,13 +68,13 @@ struct DirectionalFeatureConfig {
 
 /// The inducing points and kernels of a DirectionalFeatureConfig. Immutable; no allocation in
 /// the query functions.
-class DirectionalFeatures {
+class Features {
  public:
-  DirectionalFeatures() = default;
+  Features() = default;
   /// Checks the config (non-empty extent and range, positive scales) with clear Errors.
-  explicit DirectionalFeatures(const DirectionalFeatureConfig& config);
+  explicit Features(const FeatureConfig& config);
 
-  const DirectionalFeatureConfig& config() const { return config_; }
+  const FeatureConfig& config() const { return config_; }
   int spatial_size() const { return config_.cells_x * config_.cells_y; }  ///< M_s
   int time_size() const { return config_.time_points; }                   ///< M_t
   /// Inducing point j (row-major over x then y: j = iy * cells_x + ix).
@@ -112,15 +112,14 @@ class DirectionalFeatures {
                           std::vector<std::int64_t>* offsets) const;
 
  private:
-  DirectionalFeatureConfig config_;
+  FeatureConfig config_;
   double dx_ = 1, dy_ = 1, inv_two_ls2_ = 0.5, inv_two_lt2_ = 0.5, cut2_s_ = 25, cut2_t_ = 25;
 };
 
 /// The config with auto_extent / auto_time_range resolved against data positions and times [n]
 /// (bounding box; a degenerate range is widened). Both flags are false afterwards.
-DirectionalFeatureConfig ResolveExtent(const DirectionalFeatureConfig& config,
-                                       const Eigen::Ref<const Eigen::VectorXd>& x,
-                                       const Eigen::Ref<const Eigen::VectorXd>& y,
-                                       const Eigen::Ref<const Eigen::VectorXd>& t);
+FeatureConfig ResolveExtent(const FeatureConfig& config, const Eigen::Ref<const Eigen::VectorXd>& x,
+                            const Eigen::Ref<const Eigen::VectorXd>& y,
+                            const Eigen::Ref<const Eigen::VectorXd>& t);
 
-}  // namespace foresight
+}  // namespace foresight::directional

@@ -18,7 +18,7 @@ OccupancyField<D>::OccupancyField(RbfGrid<D> grid, Eigen::VectorXd weights, doub
 }
 
 template <int D>
-OccupancyField<D> OccupancyField<D>::FromHingeMap(const HingeMap& map) {
+OccupancyField<D> OccupancyField<D>::FromHingeMap(const occupancy::HingeMap& map) {
   if constexpr (D != 2) {
     Fail("occupancy field: a ", map.model_type(), " map is 2-D; cannot make a ", D, "-D field");
   } else {

@@ -16,7 +16,7 @@
 
 #include "inference/imitation/rbf_grid.h"
 
-namespace foresight {
+namespace foresight::occupancy {
 class HingeMap;
 }
 
@@ -38,7 +38,7 @@ class OccupancyField {
                  const std::string& source = "occupancy field");
   /// The field of a 2-D Hilbert map of the mapping engine (kind occupancy.hilbert; the Bayesian
   /// kinds by their mean weights). D = 2 only.
-  static OccupancyField FromHingeMap(const HingeMap& map);
+  static OccupancyField FromHingeMap(const occupancy::HingeMap& map);
 
   const RbfGrid<D>& grid() const { return grid_; }
   const Eigen::VectorXd& weights() const { return weights_; }

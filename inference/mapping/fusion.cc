@@ -5,7 +5,7 @@
 
 #include "core/error.h"
 
-namespace foresight {
+namespace foresight::occupancy {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -109,4 +109,4 @@ HingeMap FuseMaps(const std::vector<const HingeMap*>& maps, const std::vector<st
                   last_global);
 }
 
-}  // namespace foresight
+}  // namespace foresight::occupancy

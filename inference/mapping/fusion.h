@@ -21,7 +21,7 @@
 
 #include "inference/mapping/hinge_map.h"
 
-namespace foresight {
+namespace foresight::occupancy {
 
 struct FusionOptions {
   double variance_threshold = 1000.0;  ///< local estimates with variance >= this are ignored
@@ -50,4 +50,4 @@ HingeMap Conflate(const HingeGrid& grid, const std::vector<WeightEstimate>& esti
 HingeMap FuseMaps(const std::vector<const HingeMap*>& maps, const std::vector<std::string>& names,
                   const FusionOptions& options, const HingeMap* last_global = nullptr);
 
-}  // namespace foresight
+}  // namespace foresight::occupancy

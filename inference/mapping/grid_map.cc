@@ -8,7 +8,7 @@
 #include "core/error.h"
 #include "inference/engine/artifact.h"
 
-namespace foresight {
+namespace foresight::occupancy {
 
 std::uint8_t EncodeCell(float p) {
   if (!std::isfinite(p)) return 255;
@@ -49,8 +49,8 @@ double GridMap::Probability(double x, double y, MapWorkspace*) const {
   return CellOrHalf(ix, iy);
 }
 
-OccupancyQuery GridMap::Query(double x, double y, MapWorkspace*) const {
-  OccupancyQuery q;
+QueryResult GridMap::Query(double x, double y, MapWorkspace*) const {
+  QueryResult q;
   int ix, iy;
   if (!geometry_.Cell(x, y, &ix, &iy)) return q;
   q.probability = CellOrHalf(ix, iy);
@@ -127,4 +127,4 @@ GridMap GridMap::Load(const std::string& path) {
   }
 }
 
-}  // namespace foresight
+}  // namespace foresight::occupancy

@@ -15,7 +15,7 @@
 #include "core/config.h"
 #include "inference/mapping/occupancy_map.h"
 
-namespace foresight {
+namespace foresight::occupancy {
 
 enum class CellType { kFloat32, kUint8 };
 
@@ -33,7 +33,7 @@ struct GridGeometry {
   }
 };
 
-class GridMap final : public OccupancyMap {
+class GridMap final : public Map {
  public:
   /// @param probability [ny x nx] p(occupied) per cell in [0, 1], NaN = unknown.
   GridMap(GridGeometry geometry, Eigen::MatrixXf probability, CellType cell_type);
@@ -49,7 +49,7 @@ class GridMap final : public OccupancyMap {
 
   std::string model_type() const override { return kGridMapType; }
   MapWorkspace MakeWorkspace() const override { return {}; }
-  OccupancyQuery Query(double x, double y, MapWorkspace* ws) const override;
+  QueryResult Query(double x, double y, MapWorkspace* ws) const override;
   double Probability(double x, double y, MapWorkspace* ws) const override;
   Eigen::Vector4d Extent() const override;
 
@@ -64,4 +64,4 @@ class GridMap final : public OccupancyMap {
 std::uint8_t EncodeCell(float p);
 float DecodeCell(std::uint8_t q);
 
-}  // namespace foresight
+}  // namespace foresight::occupancy

@@ -5,7 +5,7 @@
 #include "core/error.h"
 #include "inference/engine/artifact.h"
 
-namespace foresight {
+namespace foresight::occupancy {
 namespace {
 
 constexpr double kPiOver8 = M_PI / 8.0;
@@ -134,8 +134,8 @@ double HingeMap::Probability(double x, double y, MapWorkspace* ws) const {
 // p = sigmoid(m kappa), kappa = (1 + pi v / 8)^-1/2:
 //   dp = p (1 - p) (kappa dm + m dkappa),  dkappa = -(pi / 16) (1 + pi v / 8)^-3/2 dv,
 //   dm = sum_t mu_t dphi_t,  dv = 2 sum_t s2_t phi_t dphi_t (Fast-BHM), 2 dphi' Sigma phi (BHM).
-OccupancyQuery HingeMap::Query(double x, double y, MapWorkspace* ws) const {
-  OccupancyQuery q;
+QueryResult HingeMap::Query(double x, double y, MapWorkspace* ws) const {
+  QueryResult q;
   int* idx = ws->index.data();
   double* phi = ws->phi.data();
   double* gx = ws->dphi_dx.data();
@@ -267,4 +267,4 @@ HingeMap HingeMap::Load(const std::string& path, const std::string& expected_typ
   }
 }
 
-}  // namespace foresight
+}  // namespace foresight::occupancy

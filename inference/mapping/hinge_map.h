@@ -20,7 +20,7 @@
 #include "core/hinge_grid.h"
 #include "inference/mapping/occupancy_map.h"
 
-namespace foresight {
+namespace foresight::occupancy {
 
 enum class HingeMapKind { kHilbert, kFastBhm, kBhm };
 const char* ModelType(HingeMapKind kind);
@@ -34,7 +34,7 @@ struct HingeWeights {
 
 enum class StoredPrecision { kFloat32, kFloat64 };
 
-class HingeMap final : public OccupancyMap {
+class HingeMap final : public Map {
  public:
   /// @param prior_mean, prior_variance the weight prior, reported where the map has no features.
   HingeMap(HingeMapKind kind, HingeGrid grid, HingeWeights weights, double prior_mean,
@@ -53,7 +53,7 @@ class HingeMap final : public OccupancyMap {
 
   std::string model_type() const override { return ModelType(kind_); }
   MapWorkspace MakeWorkspace() const override;
-  OccupancyQuery Query(double x, double y, MapWorkspace* ws) const override;
+  QueryResult Query(double x, double y, MapWorkspace* ws) const override;
   double Probability(double x, double y, MapWorkspace* ws) const override;
   Eigen::Vector4d Extent() const override;
 
@@ -71,4 +71,4 @@ class HingeMap final : public OccupancyMap {
 /// The probit-approximated predictive probability sigmoid(m / sqrt(1 + pi v / 8)).
 double PredictiveProbability(double latent_mean, double latent_variance);
 
-}  // namespace foresight
+}  // namespace foresight::occupancy

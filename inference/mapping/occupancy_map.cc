@@ -5,13 +5,13 @@
 #include "inference/mapping/grid_map.h"
 #include "inference/mapping/hinge_map.h"
 
-namespace foresight {
+namespace foresight::occupancy {
 
-void OccupancyMap::QueryBatch(const Eigen::Ref<const Eigen::Matrix2Xd>& points, MapWorkspace* ws,
-                              MapQueryBatch* out) const {
+void Map::QueryBatch(const Eigen::Ref<const Eigen::Matrix2Xd>& points, MapWorkspace* ws,
+                     MapQueryBatch* out) const {
   if (out->probability.size() != points.cols()) out->Resize(points.cols());
   for (Eigen::Index i = 0; i < points.cols(); ++i) {
-    const OccupancyQuery q = Query(points(0, i), points(1, i), ws);
+    const QueryResult q = Query(points(0, i), points(1, i), ws);
     out->probability[i] = q.probability;
     out->variance[i] = q.variance;
     out->gradient(0, i) = q.dp_dx;
@@ -19,15 +19,15 @@ void OccupancyMap::QueryBatch(const Eigen::Ref<const Eigen::Matrix2Xd>& points, 
   }
 }
 
-void OccupancyMap::ProbabilityBatch(const Eigen::Ref<const Eigen::Matrix2Xd>& points,
-                                    MapWorkspace* ws, Eigen::Ref<Eigen::VectorXd> out) const {
+void Map::ProbabilityBatch(const Eigen::Ref<const Eigen::Matrix2Xd>& points, MapWorkspace* ws,
+                           Eigen::Ref<Eigen::VectorXd> out) const {
   FS_THROW_UNLESS(out.size() == points.cols(), "ProbabilityBatch: output has ", out.size(),
                   " entries for ", points.cols(), " points");
   for (Eigen::Index i = 0; i < points.cols(); ++i)
     out[i] = Probability(points(0, i), points(1, i), ws);
 }
 
-std::unique_ptr<OccupancyMap> LoadOccupancyMap(const std::string& path) {
+std::unique_ptr<Map> LoadMap(const std::string& path) {
   std::string type;
   {
     const Artifact a = Artifact::Open(path, "");
@@ -40,4 +40,4 @@ std::unique_ptr<OccupancyMap> LoadOccupancyMap(const std::string& path) {
   Fail(path, ": artifact holds a '", type, "' model, not an occupancy map");
 }
 
-}  // namespace foresight
+}  // namespace foresight::occupancy

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-namespace foresight {
+namespace foresight::occupancy {
 
 /// Model types of occupancy-map artifacts (the artifact's root attribute `model_type`).
 inline constexpr const char* kHilbertMapType = "occupancy.hilbert";
@@ -17,7 +17,7 @@ inline constexpr const char* kBhmType = "occupancy.bhm";
 inline constexpr const char* kGridMapType = "occupancy.grid";
 
 /// One point's answer.
-struct OccupancyQuery {
+struct QueryResult {
   double probability = 0.5;     ///< p(occupied | x)
   double dp_dx = 0, dp_dy = 0;  ///< gradient of the probability w.r.t. the query position (1/m)
   /// Posterior variance of the latent logit f(x) = w' phi(x) (Bayesian maps); 0 for maps without
@@ -43,13 +43,13 @@ struct MapQueryBatch {
   }
 };
 
-class OccupancyMap {
+class Map {
  public:
-  virtual ~OccupancyMap() = default;
+  virtual ~Map() = default;
   virtual std::string model_type() const = 0;
   virtual MapWorkspace MakeWorkspace() const = 0;
   /// Probability, gradient and variance at (x, y) in the map frame (m).
-  virtual OccupancyQuery Query(double x, double y, MapWorkspace* ws) const = 0;
+  virtual QueryResult Query(double x, double y, MapWorkspace* ws) const = 0;
   /// Probability only (cheaper where a map can skip the gradient).
   virtual double Probability(double x, double y, MapWorkspace* ws) const {
     return Query(x, y, ws).probability;
@@ -66,6 +66,6 @@ class OccupancyMap {
 
 /// Loads any occupancy-map artifact (model types above). A missing, truncated or non-map artifact
 /// is an Error naming the file and what was found.
-std::unique_ptr<OccupancyMap> LoadOccupancyMap(const std::string& path);
+std::unique_ptr<Map> LoadMap(const std::string& path);
 
-}  // namespace foresight
+}  // namespace foresight::occupancy

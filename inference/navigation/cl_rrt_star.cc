@@ -66,7 +66,7 @@ Control PurePursuit(const UnicycleState& robot, const Eigen::Matrix2Xd& path, do
 struct ClRrtStarController::Impl {
   ClRrtStarOptions options;
   const StaticCollisionField* field = nullptr;
-  MapWorkspace map_ws;
+  occupancy::MapWorkspace map_ws;
   Eigen::Matrix2Xd pedestrians;  ///< current positions [2 x n]
   Eigen::Vector2d start = Eigen::Vector2d::Zero();
   std::shared_ptr<ob::RealVectorStateSpace> space;
@@ -83,7 +83,8 @@ struct ClRrtStarController::Impl {
     if ((Eigen::Vector2d(x, y) - start).squaredNorm() <
         options.start_exemption * options.start_exemption)
       return true;
-    return !(field && field->Collides(x, y, options.epsilon, const_cast<MapWorkspace*>(&map_ws)));
+    return !(field &&
+             field->Collides(x, y, options.epsilon, const_cast<occupancy::MapWorkspace*>(&map_ws)));
   }
 };
 

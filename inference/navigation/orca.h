@@ -131,7 +131,7 @@ class OrcaController final : public NavigationController {
   const StaticCollisionField* field_;
   OrcaControllerOptions options_;
   GoalDistanceField goal_field_;
-  mutable MapWorkspace map_ws_;
+  mutable occupancy::MapWorkspace map_ws_;
   Eigen::MatrixXd clean_rows_;
   Eigen::Matrix2Xd current_;
   std::vector<OrcaNeighbour> neighbours_;

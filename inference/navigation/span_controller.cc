@@ -135,7 +135,7 @@ int CleanObservations(const Eigen::MatrixXd& past_rows, Eigen::MatrixXd* clean,
 
 // ---- SPAN -------------------------------------------------------------------------------------
 
-SpanController::SpanController(const SpanPredictor* predictor, const StaticCollisionField* field,
+SpanController::SpanController(const span::Predictor* predictor, const StaticCollisionField* field,
                                SpanControllerOptions options)
     : predictor_(predictor), field_(field), options_(std::move(options)), threshold_(0.5) {
   const std::string problems = options_.Problems();

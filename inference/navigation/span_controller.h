@@ -45,7 +45,7 @@ class SpanController final : public NavigationController {
   /// @param predictor SPAN engine (null: no pedestrian prediction; pedestrians stand still).
   /// @param field swept static map (null or empty: no static obstacles). Both must outlive the
   /// controller.
-  SpanController(const SpanPredictor* predictor, const StaticCollisionField* field,
+  SpanController(const span::Predictor* predictor, const StaticCollisionField* field,
                  SpanControllerOptions options);
   std::string name() const override { return "span"; }
   void Prepare(const Eigen::Vector2d& goal) override;
@@ -66,15 +66,15 @@ class SpanController final : public NavigationController {
   int steps() const { return steps_; }
 
  private:
-  const SpanPredictor* predictor_;
+  const span::Predictor* predictor_;
   const StaticCollisionField* field_;
   SpanControllerOptions options_;
   ChanceThreshold threshold_;
   int steps_;
   CrowdForecast forecast_;
   std::vector<TrajectoryDistribution> predictions_;
-  SpanPredictor::Workspace predictor_ws_;
-  mutable MapWorkspace map_ws_;
+  span::Predictor::Workspace predictor_ws_;
+  mutable occupancy::MapWorkspace map_ws_;
   Eigen::MatrixXd clean_rows_;
   Eigen::Matrix2Xd current_;
   Control previous_;
@@ -107,7 +107,7 @@ class ReactiveController final : public NavigationController {
   CrowdForecast forecast_;
   GoalDistanceField goal_field_;
   Eigen::Matrix2Xd current_;
-  mutable MapWorkspace map_ws_;
+  mutable occupancy::MapWorkspace map_ws_;
 };
 
 /// Last finite position of each row of `past_rows` into `current` [2 x n]; rows without any finite

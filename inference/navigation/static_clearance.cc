@@ -7,8 +7,8 @@
 
 namespace foresight::nav {
 
-double SweptOccupancy(const OccupancyMap& map, MapWorkspace* ws, double x, double y, double radius,
-                      int num_angles) {
+double SweptOccupancy(const occupancy::Map& map, occupancy::MapWorkspace* ws, double x, double y,
+                      double radius, int num_angles) {
   double best = 0.0;
   for (int i = 0; i < num_angles; ++i) {
     const double phi = -M_PI + 2.0 * M_PI * i / num_angles;
@@ -18,7 +18,7 @@ double SweptOccupancy(const OccupancyMap& map, MapWorkspace* ws, double x, doubl
   return best;
 }
 
-StaticCollisionField::StaticCollisionField(const OccupancyMap& map, double radius,
+StaticCollisionField::StaticCollisionField(const occupancy::Map& map, double radius,
                                            double resolution, int num_angles)
     : map_(&map), radius_(radius), resolution_(resolution) {
   FS_THROW_UNLESS(radius > 0 && std::isfinite(radius), "static collision field: robot radius ",
@@ -38,7 +38,7 @@ StaticCollisionField::StaticCollisionField(const OccupancyMap& map, double radiu
                   cols, " cells at resolution ", resolution,
                   " m is too large; use a coarser resolution");
   raster_.resize(rows, cols);
-  MapWorkspace ws = map.MakeWorkspace();
+  occupancy::MapWorkspace ws = map.MakeWorkspace();
   for (int r = 0; r < rows; ++r)
     for (int c = 0; c < cols; ++c)
       raster_(r, c) =
@@ -46,7 +46,7 @@ StaticCollisionField::StaticCollisionField(const OccupancyMap& map, double radiu
                                             origin_.y() + r * resolution, radius, num_angles_));
 }
 
-double StaticCollisionField::Value(double x, double y, MapWorkspace* ws) const {
+double StaticCollisionField::Value(double x, double y, occupancy::MapWorkspace* ws) const {
   if (map_ == nullptr) return 0.0;
   const double u = (x - origin_.x()) / resolution_, v = (y - origin_.y()) / resolution_;
   if (!(u >= 0 && v >= 0 && u < raster_.cols() - 1 && v < raster_.rows() - 1))

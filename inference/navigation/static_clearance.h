@@ -14,27 +14,29 @@
 namespace foresight::nav {
 
 /// max over `num_angles` evenly spaced phi of f_m(x + r [sin phi, cos phi]) (eq. staticCheck).
-double SweptOccupancy(const OccupancyMap& map, MapWorkspace* ws, double x, double y, double radius,
-                      int num_angles);
+double SweptOccupancy(const occupancy::Map& map, occupancy::MapWorkspace* ws, double x, double y,
+                      double radius, int num_angles);
 
 class StaticCollisionField {
  public:
   StaticCollisionField() = default;
   /// Tabulates the sweep over the map's extent grown by `radius` at `resolution` (m).
   /// @param num_angles sweep angles; 0 picks ceil(2 pi radius / (resolution / 2)).
-  StaticCollisionField(const OccupancyMap& map, double radius, double resolution,
+  StaticCollisionField(const occupancy::Map& map, double radius, double resolution,
                        int num_angles = 0);
 
   bool empty() const { return map_ == nullptr; }
   /// Workspace for Value() (used for queries outside the raster).
-  MapWorkspace MakeWorkspace() const { return map_ ? map_->MakeWorkspace() : MapWorkspace(); }
+  occupancy::MapWorkspace MakeWorkspace() const {
+    return map_ ? map_->MakeWorkspace() : occupancy::MapWorkspace();
+  }
   double radius() const { return radius_; }
   double resolution() const { return resolution_; }
   /// Swept occupancy near (x, y): max of the four surrounding raster values (the exact sweep
   /// outside the raster).
-  double Value(double x, double y, MapWorkspace* ws) const;
+  double Value(double x, double y, occupancy::MapWorkspace* ws) const;
   /// Value(x, y) > epsilon.
-  bool Collides(double x, double y, double epsilon, MapWorkspace* ws) const {
+  bool Collides(double x, double y, double epsilon, occupancy::MapWorkspace* ws) const {
     return Value(x, y, ws) > epsilon;
   }
   const Eigen::MatrixXf& raster() const {
@@ -43,7 +45,7 @@ class StaticCollisionField {
   Eigen::Vector2d origin() const { return origin_; }
 
  private:
-  const OccupancyMap* map_ = nullptr;
+  const occupancy::Map* map_ = nullptr;
   double radius_ = 0, resolution_ = 0.05;
   int num_angles_ = 0;
   Eigen::Vector2d origin_ = Eigen::Vector2d::Zero();  ///< position of raster(0, 0)

@@ -8,7 +8,7 @@
 #include "core/error.h"
 #include "core/log.h"
 
-namespace foresight {
+namespace foresight::directional {
 namespace {
 
 constexpr double kLogTwoPi = 1.8378770664093454836;
@@ -204,8 +204,8 @@ double RefineByEm(const std::vector<double>& theta, int iterations, double max_k
 }
 
 /// Fits one cell's row of `cells` from its headings (see the header for the rules).
-void FitCell(const std::vector<double>& theta, const DirectionalGridConfig& c,
-             std::uint64_t cell_seed, VonMisesMixtureBatch* cells, Eigen::Index row) {
+void FitCell(const std::vector<double>& theta, const GridConfig& c, std::uint64_t cell_seed,
+             VonMisesMixtureBatch* cells, Eigen::Index row) {
   cells->alpha.row(row).setZero();
   cells->mu.row(row).setZero();
   cells->kappa.row(row).setZero();
@@ -214,7 +214,7 @@ void FitCell(const std::vector<double>& theta, const DirectionalGridConfig& c,
     return;
   }
   const auto n = static_cast<Eigen::Index>(theta.size());
-  if (c.kind == GridDirectionalKind::kUnimodal) {
+  if (c.kind == GridKind::kUnimodal) {
     const VonMisesFit fit =
         FitVonMises(Eigen::Map<const Eigen::VectorXd>(theta.data(), n), Eigen::VectorXd::Ones(n));
     cells->alpha(row, 0) = 1.0;
@@ -263,8 +263,7 @@ void FitCell(const std::vector<double>& theta, const DirectionalGridConfig& c,
 
 }  // namespace
 
-DirectionalGridMap DirectionalGridMap::Fit(const DirectionalSamples& train,
-                                           const DirectionalGridConfig& config) {
+GridMap GridMap::Fit(const DirectionalSamples& train, const GridConfig& config) {
   const auto& c = config;
   FS_THROW_UNLESS(
       c.cells_x >= 1 && c.cells_y >= 1 && static_cast<double>(c.cells_x) * c.cells_y <= 16777216.0,
@@ -286,7 +285,7 @@ DirectionalGridMap DirectionalGridMap::Fit(const DirectionalSamples& train,
                   " must be positive and dbscan_min_samples ", c.dbscan_min_samples, " >= 1");
   train.Validate("directional grid map training data");
 
-  DirectionalGridMap map;
+  GridMap map;
   map.config_ = c;
   map.cell_w_ = (c.extent[1] - c.extent[0]) / c.cells_x;
   map.cell_h_ = (c.extent[3] - c.extent[2]) / c.cells_y;
@@ -300,7 +299,7 @@ DirectionalGridMap DirectionalGridMap::Fit(const DirectionalSamples& train,
     map.window_y_ = std::min(map.window_y_, c.cells_y - 1);
   }
   map.window_cells_ = (2 * map.window_x_ + 1) * (2 * map.window_y_ + 1);
-  const int r = c.kind == GridDirectionalKind::kUnimodal ? 1 : c.components;
+  const int r = c.kind == GridKind::kUnimodal ? 1 : c.components;
   const int cells = map.num_cells();
   map.cells_.Resize(cells, r);
   map.counts_.assign(static_cast<std::size_t>(cells), 0);
@@ -339,12 +338,12 @@ DirectionalGridMap DirectionalGridMap::Fit(const DirectionalSamples& train,
             &map.cells_, cell);
   }
   log::Debug("directional grid map: ", c.cells_x, " x ", c.cells_y, " cells (", empty, " empty), ",
-             c.kind == GridDirectionalKind::kUnimodal ? "UM" : "MM", c.dense ? " dense" : "",
-             " from ", train.size(), " samples");
+             c.kind == GridKind::kUnimodal ? "UM" : "MM", c.dense ? " dense" : "", " from ",
+             train.size(), " samples");
   return map;
 }
 
-int DirectionalGridMap::CellIndex(double x, double y) const {
+int GridMap::CellIndex(double x, double y) const {
   const auto& c = config_;
   const double fx = std::floor((x - c.extent[0]) / cell_w_),
                fy = std::floor((y - c.extent[2]) / cell_h_);
@@ -353,14 +352,13 @@ int DirectionalGridMap::CellIndex(double x, double y) const {
   return iy * c.cells_x + ix;
 }
 
-Eigen::Vector2d DirectionalGridMap::CellCentre(int cell) const {
+Eigen::Vector2d GridMap::CellCentre(int cell) const {
   const int ix = cell % config_.cells_x, iy = cell / config_.cells_x;
   return {config_.extent[0] + (ix + 0.5) * cell_w_, config_.extent[2] + (iy + 0.5) * cell_h_};
 }
 
-void DirectionalGridMap::Query(const Eigen::Ref<const Eigen::VectorXd>& x,
-                               const Eigen::Ref<const Eigen::VectorXd>& y,
-                               VonMisesMixtureBatch* out) const {
+void GridMap::Query(const Eigen::Ref<const Eigen::VectorXd>& x,
+                    const Eigen::Ref<const Eigen::VectorXd>& y, VonMisesMixtureBatch* out) const {
   FS_THROW_UNLESS(x.size() == y.size(), "directional grid map query: x [", x.size(), "] and y [",
                   y.size(), "] differ in size");
   const Eigen::Index n = x.size();
@@ -430,4 +428,4 @@ void DirectionalGridMap::Query(const Eigen::Ref<const Eigen::VectorXd>& x,
   }
 }
 
-}  // namespace foresight
+}  // namespace foresight::directional

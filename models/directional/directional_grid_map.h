@@ -43,14 +43,14 @@
 #include "core/von_mises.h"
 #include "datasets/directional.h"
 
-namespace foresight {
+namespace foresight::directional {
 
-enum class GridDirectionalKind { kUnimodal, kMultimodal };
+enum class GridKind { kUnimodal, kMultimodal };
 /// How MM cells find their initial mixture (see above).
 enum class GridMixtureInit { kDbscan, kKMeansBic, kKMeansFixed };
 
-struct DirectionalGridConfig {
-  GridDirectionalKind kind = GridDirectionalKind::kUnimodal;
+struct GridConfig {
+  GridKind kind = GridKind::kUnimodal;
   int cells_x = 10, cells_y = 10;
   Eigen::Vector4d extent = Eigen::Vector4d(0, 10, 0, 10);  ///< x_min, x_max, y_min, y_max (m)
   int components = 5;                                      ///< MM only
@@ -64,12 +64,11 @@ struct DirectionalGridConfig {
   int em_iterations = 20;      ///< MM: EM iterations (the reference code's max_iter)
 };
 
-class DirectionalGridMap {
+class GridMap {
  public:
   /// Fits every cell; cells without data answer the uniform distribution on the circle (kappa 0).
-  static DirectionalGridMap Fit(const DirectionalSamples& train,
-                                const DirectionalGridConfig& config);
-  const DirectionalGridConfig& config() const { return config_; }
+  static GridMap Fit(const DirectionalSamples& train, const GridConfig& config);
+  const GridConfig& config() const { return config_; }
   /// Mixture at each (x, y) [n]: fills `out` (Resize'd to n x components; unused components alpha
   /// 0). Queries outside the extent use the nearest cell. The number of columns is
   /// output_components(). Does not allocate when `out` already has that shape. Sizes of x and y
@@ -92,7 +91,7 @@ class DirectionalGridMap {
   const VonMisesMixtureBatch& cells() const { return cells_; }
 
  private:
-  DirectionalGridConfig config_;
+  GridConfig config_;
   VonMisesMixtureBatch cells_;  ///< row = cell (row-major over x then y), R columns
   std::vector<int> counts_;     ///< training samples per cell
   double cell_w_ = 1, cell_h_ = 1, radius_ = 1;  ///< m; radius_: dense disc radius
@@ -100,4 +99,4 @@ class DirectionalGridMap {
   int window_cells_ = 1;             ///< cells per blending window (1 unless dense)
 };
 
-}  // namespace foresight
+}  // namespace foresight::directional

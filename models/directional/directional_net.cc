@@ -4,19 +4,18 @@
 
 #include "core/error.h"
 
-namespace foresight {
+namespace foresight::directional {
 
-DirectionalNetImpl::DirectionalNetImpl(DirectionalVariant variant, int spatial_size, int components,
-                                       int hidden, double max_kappa)
+NetImpl::NetImpl(Variant variant, int spatial_size, int components, int hidden, double max_kappa)
     : variant_(variant), components_(components), hidden_(hidden), max_kappa_(max_kappa) {
   FS_THROW_UNLESS(std::isfinite(max_kappa) && max_kappa > std::exp(kDirectionalLogKappaMin),
                   "DirectionalNet: max_kappa ", max_kappa);
-  FS_THROW_UNLESS(spatial_size >= 1 && components >= 1 &&
-                      (variant == DirectionalVariant::kSpatial || hidden >= 1),
-                  "DirectionalNet: spatial_size ", spatial_size, ", components ", components,
-                  ", hidden ", hidden);
+  FS_THROW_UNLESS(
+      spatial_size >= 1 && components >= 1 && (variant == Variant::kSpatial || hidden >= 1),
+      "DirectionalNet: spatial_size ", spatial_size, ", components ", components, ", hidden ",
+      hidden);
   int width = spatial_size;
-  if (variant == DirectionalVariant::kSpatiotemporal) {
+  if (variant == Variant::kSpatiotemporal) {
     // PyTorch's LSTM parameters and initialisation: U(-1/sqrt(H), 1/sqrt(H)).
     lstm_ = register_module("lstm", std::make_shared<torch::nn::Module>("LSTM"));
     const double k = 1.0 / std::sqrt(static_cast<double>(hidden));
@@ -39,11 +38,11 @@ DirectionalNetImpl::DirectionalNetImpl(DirectionalVariant variant, int spatial_s
   kappa_->bias.zero_();
 }
 
-torch::Tensor DirectionalNetImpl::Heads(const torch::Tensor& z) {
+torch::Tensor NetImpl::Heads(const torch::Tensor& z) {
   return torch::cat({alpha_->forward(z), mu_->forward(z), kappa_->forward(z)}, 1);
 }
 
-torch::Tensor DirectionalNetImpl::Recur(const torch::Tensor& proj, const torch::Tensor& phi_t) {
+torch::Tensor NetImpl::Recur(const torch::Tensor& proj, const torch::Tensor& phi_t) {
   const auto bias = bias_ih_ + bias_hh_;
   torch::Tensor h, c;
   for (int64_t k = 0; k < phi_t.size(1); ++k) {
@@ -58,15 +57,13 @@ torch::Tensor DirectionalNetImpl::Recur(const torch::Tensor& proj, const torch::
   return h;
 }
 
-torch::Tensor DirectionalNetImpl::forward(const torch::Tensor& phi_s, const torch::Tensor& phi_t) {
-  if (variant_ == DirectionalVariant::kSpatial) return Heads(phi_s);
+torch::Tensor NetImpl::forward(const torch::Tensor& phi_s, const torch::Tensor& phi_t) {
+  if (variant_ == Variant::kSpatial) return Heads(phi_s);
   return Heads(Recur(torch::matmul(phi_s, weight_ih_.t()), phi_t));
 }
 
-torch::Tensor DirectionalNetImpl::forward_sparse(const torch::Tensor& index,
-                                                 const torch::Tensor& value,
-                                                 const torch::Tensor& offsets,
-                                                 const torch::Tensor& phi_t) {
+torch::Tensor NetImpl::forward_sparse(const torch::Tensor& index, const torch::Tensor& value,
+                                      const torch::Tensor& offsets, const torch::Tensor& phi_t) {
   namespace F = torch::nn::functional;
   auto bag = [&](const torch::Tensor& weight_t) {  // sum_j value_j weight_t[index_j] per sample
     return F::embedding_bag(index, weight_t,
@@ -76,14 +73,14 @@ torch::Tensor DirectionalNetImpl::forward_sparse(const torch::Tensor& index,
                                 .per_sample_weights(value)
                                 .include_last_offset(true));
   };
-  if (variant_ == DirectionalVariant::kSpatial) {
+  if (variant_ == Variant::kSpatial) {
     const auto w = torch::cat({alpha_->weight, mu_->weight, kappa_->weight}, 0).t().contiguous();
     return bag(w) + torch::cat({alpha_->bias, mu_->bias, kappa_->bias}, 0);
   }
   return Heads(Recur(bag(weight_ih_.t().contiguous()), phi_t));
 }
 
-VonMisesMixtureTensors DecodeDirectionalHead(const torch::Tensor& raw, int R, double max_kappa) {
+VonMisesMixtureTensors DecodeVonMisesHead(const torch::Tensor& raw, int R, double max_kappa) {
   VonMisesMixtureTensors p;
   p.log_alpha = torch::log_softmax(raw.narrow(1, 0, R), 1);
   p.mu = raw.narrow(1, R, R);
@@ -102,24 +99,22 @@ torch::Tensor VonMisesMixtureNll(const VonMisesMixtureTensors& p, const torch::T
   return -torch::logsumexp(p.log_alpha + log_vm, 1);
 }
 
-torch::Tensor HeadPenalty(DirectionalNetImpl& net, const DirectionalPenalty& c) {
+torch::Tensor HeadPenalty(NetImpl& net, const Penalty& c) {
   return c.lambda_alpha * net.alpha_head()->weight.square().sum() +
          c.lambda_mu * net.mu_head()->weight.square().sum() +
          c.lambda_kappa * net.kappa_head()->weight.square().sum();
 }
 
-torch::Tensor DirectionalLossFromRaw(DirectionalNetImpl& net, const torch::Tensor& raw,
-                                     const torch::Tensor& theta,
-                                     const DirectionalPenalty& penalty) {
-  return VonMisesMixtureNll(DecodeDirectionalHead(raw, net.components(), net.max_kappa()), theta)
+torch::Tensor LossFromRaw(NetImpl& net, const torch::Tensor& raw, const torch::Tensor& theta,
+                          const Penalty& penalty) {
+  return VonMisesMixtureNll(DecodeVonMisesHead(raw, net.components(), net.max_kappa()), theta)
              .mean() +
          HeadPenalty(net, penalty);
 }
 
-torch::Tensor DirectionalLoss(DirectionalNetImpl& net, const torch::Tensor& phi_s,
-                              const torch::Tensor& phi_t, const torch::Tensor& theta,
-                              const DirectionalPenalty& penalty) {
-  return DirectionalLossFromRaw(net, net.forward(phi_s, phi_t), theta, penalty);
+torch::Tensor Loss(NetImpl& net, const torch::Tensor& phi_s, const torch::Tensor& phi_t,
+                   const torch::Tensor& theta, const Penalty& penalty) {
+  return LossFromRaw(net, net.forward(phi_s, phi_t), theta, penalty);
 }
 
-}  // namespace foresight
+}  // namespace foresight::directional

@@ -14,14 +14,14 @@
 
 #include "inference/directional/directional_map.h"
 
-namespace foresight {
+namespace foresight::directional {
 
-class DirectionalNetImpl : public torch::nn::Module {
+class NetImpl : public torch::nn::Module {
  public:
   /// @param spatial_size M_s; @param components R; @param hidden LSTM width (spatiotemporal only).
   /// @param max_kappa cap of the concentrations (log-kappa head clamp).
-  DirectionalNetImpl(DirectionalVariant variant, int spatial_size, int components, int hidden,
-                     double max_kappa = kDirectionalDefaultMaxKappa);
+  NetImpl(Variant variant, int spatial_size, int components, int hidden,
+          double max_kappa = kDirectionalDefaultMaxKappa);
   /// @param phi_s [B, M_s] spatial features; @param phi_t [B, M_t] temporal features (ignored by
   /// the spatial variant). @return raw head outputs [B, 3R]: alpha logits, means, log kappa.
   torch::Tensor forward(const torch::Tensor& phi_s, const torch::Tensor& phi_t);
@@ -30,7 +30,7 @@ class DirectionalNetImpl : public torch::nn::Module {
   torch::Tensor forward_sparse(const torch::Tensor& index, const torch::Tensor& value,
                                const torch::Tensor& offsets, const torch::Tensor& phi_t);
 
-  DirectionalVariant variant() const { return variant_; }
+  Variant variant() const { return variant_; }
   int components() const { return components_; }
   int hidden() const { return hidden_; }
   double max_kappa() const { return max_kappa_; }
@@ -43,22 +43,22 @@ class DirectionalNetImpl : public torch::nn::Module {
   /// LSTM over the M_t steps from the input projection proj = W_ih phi_s [B, 4H]: last h [B, H].
   torch::Tensor Recur(const torch::Tensor& proj, const torch::Tensor& phi_t);
 
-  DirectionalVariant variant_;
+  Variant variant_;
   int components_ = 5, hidden_ = 0;
   double max_kappa_ = kDirectionalDefaultMaxKappa;
   std::shared_ptr<torch::nn::Module> lstm_;
   torch::Tensor weight_ih_, weight_hh_, bias_ih_, bias_hh_;
   torch::nn::Linear alpha_{nullptr}, mu_{nullptr}, kappa_{nullptr};
 };
-TORCH_MODULE(DirectionalNet);
+TORCH_MODULE(Net);
 
 /// Decoded mixture for B queries: log alpha, mu (unwrapped), kappa, each [B, R].
 struct VonMisesMixtureTensors {
   torch::Tensor log_alpha, mu, kappa;
 };
 /// softmax / identity / exp(clamp(., kDirectionalLogKappaMin, log max_kappa)).
-VonMisesMixtureTensors DecodeDirectionalHead(const torch::Tensor& raw, int components,
-                                             double max_kappa = kDirectionalDefaultMaxKappa);
+VonMisesMixtureTensors DecodeVonMisesHead(const torch::Tensor& raw, int components,
+                                          double max_kappa = kDirectionalDefaultMaxKappa);
 
 /// log I0(kappa), finite for any kappa >= 0: log(i0e(kappa)) + kappa (spec/errata.md ch 4).
 torch::Tensor LogBesselI0(const torch::Tensor& kappa);
@@ -67,18 +67,17 @@ torch::Tensor LogBesselI0(const torch::Tensor& kappa);
 torch::Tensor VonMisesMixtureNll(const VonMisesMixtureTensors& p, const torch::Tensor& theta);
 
 /// L2 penalties on the head weights (biases excluded).
-struct DirectionalPenalty {
+struct Penalty {
   double lambda_alpha = 0.001, lambda_mu = 0.0, lambda_kappa = 0.001;
 };
 /// lambda_a ||W_a||^2 + lambda_m ||W_m||^2 + lambda_k ||W_k||^2 (added to the loss,
 /// spec/errata.md).
-torch::Tensor HeadPenalty(DirectionalNetImpl& net, const DirectionalPenalty& penalty);
+torch::Tensor HeadPenalty(NetImpl& net, const Penalty& penalty);
 /// Thesis L_reg = mean NLL + HeadPenalty (the penalty added; spec/errata.md ch 4).
-torch::Tensor DirectionalLoss(DirectionalNetImpl& net, const torch::Tensor& phi_s,
-                              const torch::Tensor& phi_t, const torch::Tensor& theta,
-                              const DirectionalPenalty& penalty);
+torch::Tensor Loss(NetImpl& net, const torch::Tensor& phi_s, const torch::Tensor& phi_t,
+                   const torch::Tensor& theta, const Penalty& penalty);
 /// The same from raw head outputs [B, 3R] of `net`.
-torch::Tensor DirectionalLossFromRaw(DirectionalNetImpl& net, const torch::Tensor& raw,
-                                     const torch::Tensor& theta, const DirectionalPenalty& penalty);
+torch::Tensor LossFromRaw(NetImpl& net, const torch::Tensor& raw, const torch::Tensor& theta,
+                          const Penalty& penalty);
 
-}  // namespace foresight
+}  // namespace foresight::directional

@@ -6,7 +6,7 @@
 
 #include "core/error.h"
 
-namespace foresight {
+namespace foresight::directional {
 namespace {
 
 /// Leaves hold at most this many points.
@@ -16,7 +16,7 @@ constexpr Eigen::Index kLeafSize = 8;
 
 /// The k best (squared distance, training index) pairs so far, sorted ascending, stored with a
 /// stride in caller memory (a row of the output batch, or a small vector).
-struct KnnDirectionalMap::Candidates {
+struct KnnMap::Candidates {
   double* d2 = nullptr;     ///< [k] squared distances
   double* index = nullptr;  ///< [k] training indices (exact as doubles below 2^53)
   Eigen::Index stride = 1;
@@ -46,8 +46,7 @@ struct KnnDirectionalMap::Candidates {
   }
 };
 
-KnnDirectionalMap KnnDirectionalMap::Fit(const DirectionalSamples& train,
-                                         const KnnDirectionalConfig& config) {
+KnnMap KnnMap::Fit(const DirectionalSamples& train, const KnnConfig& config) {
   train.Validate("knn directional map: training samples");
   const Eigen::Index n = train.size();
   FS_THROW_UNLESS(config.k >= 1, "knn directional map: k ", config.k, " must be >= 1");
@@ -58,7 +57,7 @@ KnnDirectionalMap KnnDirectionalMap::Fit(const DirectionalSamples& train,
   FS_THROW_UNLESS(config.time_scale > 0 && std::isfinite(config.time_scale),
                   "knn directional map: time_scale ", config.time_scale,
                   " must be finite and > 0 (m per s)");
-  KnnDirectionalMap map;
+  KnnMap map;
   map.config_ = config;
   map.dims_ = config.use_time ? 3 : 2;
   map.theta_ = train.theta;
@@ -78,7 +77,7 @@ KnnDirectionalMap KnnDirectionalMap::Fit(const DirectionalSamples& train,
   return map;
 }
 
-int KnnDirectionalMap::Build(Eigen::Index begin, Eigen::Index end) {
+int KnnMap::Build(Eigen::Index begin, Eigen::Index end) {
   const int id = static_cast<int>(nodes_.size());
   nodes_.push_back(Node{begin, end, -1, 0.0, -1, -1});
   if (end - begin <= kLeafSize) return id;
@@ -116,7 +115,7 @@ int KnnDirectionalMap::Build(Eigen::Index begin, Eigen::Index end) {
   return id;
 }
 
-void KnnDirectionalMap::Search(int id, const double* q, Candidates* c) const {
+void KnnMap::Search(int id, const double* q, Candidates* c) const {
   const Node& node = nodes_[static_cast<std::size_t>(id)];
   if (node.dim < 0) {
     for (Eigen::Index p = node.begin; p < node.end; ++p) {
@@ -138,12 +137,11 @@ void KnnDirectionalMap::Search(int id, const double* q, Candidates* c) const {
   if (!c->full() || diff * diff <= c->worst()) Search(far_side, q, c);
 }
 
-void KnnDirectionalMap::FindNearest(const double* q, Candidates* c) const { Search(0, q, c); }
+void KnnMap::FindNearest(const double* q, Candidates* c) const { Search(0, q, c); }
 
-void KnnDirectionalMap::Query(const Eigen::Ref<const Eigen::VectorXd>& x,
-                              const Eigen::Ref<const Eigen::VectorXd>& y,
-                              const Eigen::Ref<const Eigen::VectorXd>& t,
-                              VonMisesMixtureBatch* out) const {
+void KnnMap::Query(const Eigen::Ref<const Eigen::VectorXd>& x,
+                   const Eigen::Ref<const Eigen::VectorXd>& y,
+                   const Eigen::Ref<const Eigen::VectorXd>& t, VonMisesMixtureBatch* out) const {
   FS_THROW_UNLESS(out != nullptr, "KnnDirectionalMap::Query: no output batch");
   const Eigen::Index n = x.size();
   FS_THROW_UNLESS(y.size() == n && (!config_.use_time || t.size() == n),
@@ -175,7 +173,7 @@ void KnnDirectionalMap::Query(const Eigen::Ref<const Eigen::VectorXd>& x,
   }
 }
 
-std::vector<Eigen::Index> KnnDirectionalMap::Neighbours(double x, double y, double t) const {
+std::vector<Eigen::Index> KnnMap::Neighbours(double x, double y, double t) const {
   const double ti = config_.use_time ? t : 0.0;
   FS_THROW_UNLESS(std::isfinite(x) && std::isfinite(y) && std::isfinite(ti),
                   "KnnDirectionalMap::Neighbours: query (x ", x, ", y ", y, ", t ", t,
@@ -193,4 +191,4 @@ std::vector<Eigen::Index> KnnDirectionalMap::Neighbours(double x, double y, doub
   return out;
 }
 
-}  // namespace foresight
+}  // namespace foresight::directional

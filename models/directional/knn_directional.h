@@ -19,20 +19,20 @@
 #include "core/von_mises.h"
 #include "datasets/directional.h"
 
-namespace foresight {
+namespace foresight::directional {
 
-struct KnnDirectionalConfig {
+struct KnnConfig {
   int k = 1;                ///< neighbours per query (1 <= k <= training samples)
   double kappa = 100;       ///< concentration of every component (> 0); the AL cap
   bool use_time = false;    ///< neighbours in (x, y, time_scale * t) instead of (x, y)
   double time_scale = 1.0;  ///< m per s when use_time (> 0)
 };
 
-class KnnDirectionalMap {
+class KnnMap {
  public:
   /// Stores the training samples (validated: finite, theta in [-pi, pi)) and builds the tree.
   /// Bad config (k < 1, k > n, kappa <= 0, time_scale <= 0): Error naming the field and value.
-  static KnnDirectionalMap Fit(const DirectionalSamples& train, const KnnDirectionalConfig& config);
+  static KnnMap Fit(const DirectionalSamples& train, const KnnConfig& config);
 
   /// Mixture at each query (x, y, t) [n each; t is ignored, and may be empty, unless use_time]:
   /// k components of weight 1/k, mean = the neighbours' headings (nearest first; equal distances
@@ -46,7 +46,7 @@ class KnnDirectionalMap {
   /// plots; allocates). `t` is ignored unless use_time.
   std::vector<Eigen::Index> Neighbours(double x, double y, double t) const;
 
-  const KnnDirectionalConfig& config() const { return config_; }
+  const KnnConfig& config() const { return config_; }
   /// Training samples in the map.
   Eigen::Index size() const { return theta_.size(); }
 
@@ -64,7 +64,7 @@ class KnnDirectionalMap {
   void Search(int node, const double* q, Candidates* c) const;
   void FindNearest(const double* q, Candidates* c) const;
 
-  KnnDirectionalConfig config_;
+  KnnConfig config_;
   int dims_ = 2;
   Eigen::MatrixXd points_;           ///< [dims x n] coordinates in tree order
   std::vector<Eigen::Index> order_;  ///< tree position -> training index
@@ -72,4 +72,4 @@ class KnnDirectionalMap {
   std::vector<Node> nodes_;          ///< nodes_[0] is the root
 };
 
-}  // namespace foresight
+}  // namespace foresight::directional

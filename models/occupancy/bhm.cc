@@ -5,7 +5,7 @@
 
 #include "core/error.h"
 
-namespace foresight {
+namespace foresight::occupancy {
 
 BhmLearner::BhmLearner(HingeGrid grid, const FastBhmConfig& config)
     : grid_(std::move(grid)), config_(config) {
@@ -76,4 +76,4 @@ HingeMap BhmLearner::ToMap() const {
                   config_.prior_variance);
 }
 
-}  // namespace foresight
+}  // namespace foresight::occupancy

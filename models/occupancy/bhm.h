@@ -10,7 +10,7 @@
 
 #include "models/occupancy/fast_bhm.h"
 
-namespace foresight {
+namespace foresight::occupancy {
 
 class BhmLearner {
  public:
@@ -31,4 +31,4 @@ class BhmLearner {
   std::vector<double> z_;
 };
 
-}  // namespace foresight
+}  // namespace foresight::occupancy

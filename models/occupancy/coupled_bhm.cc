@@ -9,7 +9,7 @@
 #include "core/error.h"
 #include "models/occupancy/fast_bhm.h"
 
-namespace foresight {
+namespace foresight::occupancy {
 namespace {
 
 double LogSigmoid(double z) {
@@ -325,4 +325,4 @@ HingeMap CoupledBhmLearner::FuseInformation(const HingeGrid& grid, const Coupled
                   options.prior_variance);
 }
 
-}  // namespace foresight
+}  // namespace foresight::occupancy

@@ -27,7 +27,7 @@
 #include "core/selected_inverse.h"
 #include "inference/mapping/hinge_map.h"
 
-namespace foresight {
+namespace foresight::occupancy {
 
 struct CoupledBhmOptions {
   double prior_mean = 0;         ///< m0 of the weight prior
@@ -125,4 +125,4 @@ class CoupledBhmLearner {
   bool fitted_ = false;
 };
 
-}  // namespace foresight
+}  // namespace foresight::occupancy

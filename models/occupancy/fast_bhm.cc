@@ -4,7 +4,7 @@
 
 #include "core/error.h"
 
-namespace foresight {
+namespace foresight::occupancy {
 
 double JaakkolaLambda(double z) {
   const double a = std::abs(z);
@@ -121,4 +121,4 @@ HingeMap FastBhmLearner::ToMap() const {
                   config_.prior_variance);
 }
 
-}  // namespace foresight
+}  // namespace foresight::occupancy

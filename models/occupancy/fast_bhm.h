@@ -20,7 +20,7 @@
 #include "core/hinge_grid.h"
 #include "inference/mapping/hinge_map.h"
 
-namespace foresight {
+namespace foresight::occupancy {
 
 /// How z_n starts in each scan before the first E-step.
 /// Validation on Intel (every 10th training scan held out, configs/occupancy/intel.yaml) chose
@@ -112,4 +112,4 @@ class FastBhmLearner {
   std::vector<std::uint8_t> is_touched_;
 };
 
-}  // namespace foresight
+}  // namespace foresight::occupancy

@@ -7,7 +7,7 @@
 
 #include "core/error.h"
 
-namespace foresight {
+namespace foresight::occupancy {
 namespace {
 double Logit(double p) { return std::log(p / (1.0 - p)); }
 }  // namespace
@@ -102,4 +102,4 @@ GridMap BuildGridMap(const GridMapConfig& c, const std::vector<LaserScan>& scans
   return GridMap(g, std::move(p), c.cell_type);
 }
 
-}  // namespace foresight
+}  // namespace foresight::occupancy

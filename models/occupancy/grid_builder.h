@@ -12,7 +12,7 @@
 #include "datasets/laser_scan.h"
 #include "inference/mapping/grid_map.h"
 
-namespace foresight {
+namespace foresight::occupancy {
 
 struct GridMapConfig {
   double x_min = -20, x_max = 20, y_min = -25, y_max = 10;  ///< m, extent of the grid
@@ -52,4 +52,4 @@ GridMap BuildGridMap(const GridMapConfig& config, const std::vector<LaserScan>& 
 void TraverseCells(double x0, double y0, double x1, double y1,
                    std::vector<std::pair<int, int>>* cells);
 
-}  // namespace foresight
+}  // namespace foresight::occupancy

@@ -8,7 +8,7 @@
 
 #include "core/error.h"
 
-namespace foresight {
+namespace foresight::occupancy {
 
 HingeMap TrainHilbertMap(const HingeGrid& grid, const HilbertMapConfig& config,
                          const Eigen::Ref<const Eigen::Matrix2Xd>& xy, const std::uint8_t* occupied,
@@ -66,4 +66,4 @@ HingeMap TrainHilbertMap(const HingeGrid& grid, const HilbertMapConfig& config,
   return HingeMap(HingeMapKind::kHilbert, grid, std::move(weights), 0.0, 1.0);
 }
 
-}  // namespace foresight
+}  // namespace foresight::occupancy

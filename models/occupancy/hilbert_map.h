@@ -14,7 +14,7 @@
 #include "core/hinge_grid.h"
 #include "inference/mapping/hinge_map.h"
 
-namespace foresight {
+namespace foresight::occupancy {
 
 struct HilbertMapConfig {
   double alpha = 1e-5;         ///< regularisation strength
@@ -36,4 +36,4 @@ HingeMap TrainHilbertMap(const HingeGrid& grid, const HilbertMapConfig& config,
                          const Eigen::Ref<const Eigen::Matrix2Xd>& xy, const std::uint8_t* occupied,
                          std::uint64_t seed);
 
-}  // namespace foresight
+}  // namespace foresight::occupancy

@@ -8,7 +8,7 @@
 #include "inference/mapping/grid_map.h"
 #include "models/occupancy/fast_bhm.h"
 
-namespace foresight {
+namespace foresight::occupancy {
 
 void WriteRasterMap(const OccupancyRaster& raster, const RasterMapOptions& o,
                     const std::string& path, const std::string& config_yaml, std::int64_t seed) {
@@ -64,4 +64,4 @@ void WriteRasterMap(const OccupancyRaster& raster, const RasterMapOptions& o,
   learner.ToMap().Save(path, config_yaml, seed);
 }
 
-}  // namespace foresight
+}  // namespace foresight::occupancy

@@ -8,7 +8,7 @@
 
 #include "datasets/crowd_scenario.h"
 
-namespace foresight {
+namespace foresight::occupancy {
 
 enum class RasterMapKind { kFastBhm, kGrid };
 
@@ -31,4 +31,4 @@ struct RasterMapOptions {
 void WriteRasterMap(const OccupancyRaster& raster, const RasterMapOptions& options,
                     const std::string& path, const std::string& config_yaml, std::int64_t seed);
 
-}  // namespace foresight
+}  // namespace foresight::occupancy

@@ -6,7 +6,7 @@
 
 #include "datasets/occupancy_points.h"
 
-namespace foresight {
+namespace foresight::occupancy {
 
 /// Feeds the listed scans of `points` to `learner->Update(xy, occupied)`, in the given order.
 template <class Learner>
@@ -25,4 +25,4 @@ inline std::vector<int> FirstScans(const LabelledPoints& points, int count = -1)
   return s;
 }
 
-}  // namespace foresight
+}  // namespace foresight::occupancy

@@ -7,7 +7,7 @@
 #include "core/config.h"
 #include "core/matrix_normal_head.h"
 
-namespace foresight {
+namespace foresight::span {
 
 /// Continuous trajectory representation of the futures: o(t) = W' phi(t), t from the present.
 struct TrajectoryBasisConfig {
@@ -33,7 +33,7 @@ struct TrajectoryBasisConfig {
   }
 };
 
-struct SpanNetConfig {
+struct NetConfig {
   std::vector<int> hidden = {100, 100, 100};  ///< widths of the ReLU layers (thesis: 3 x 100)
   int components = 1;                         ///< R; 1 is SPAN, > 1 the mixture of ch 7
   UParam u_param = UParam::kCholesky;
@@ -58,4 +58,4 @@ struct SpanNetConfig {
   }
 };
 
-}  // namespace foresight
+}  // namespace foresight::span

@@ -2,7 +2,7 @@
 
 #include "core/ego_frame.h"
 
-namespace foresight {
+namespace foresight::span {
 
 TimeBasis MakeFutureBasis(const TrajectoryBasisConfig& c, int predicted, double dt) {
   // Gaussian bumps centred only on [0, T] cannot follow a walk's linear growth near the ends
@@ -10,15 +10,15 @@ TimeBasis MakeFutureBasis(const TrajectoryBasisConfig& c, int predicted, double 
   return TimeBasis(c.num_centres, -c.margin, predicted * dt + c.margin, c.gamma);
 }
 
-SpanSamples MakeSpanSamples(const WindowSet& w, const TimeBasis& basis,
-                            const TrajectoryBasisConfig& c, bool rotate, bool residual) {
+Samples MakeSamples(const WindowSet& w, const TimeBasis& basis, const TrajectoryBasisConfig& c,
+                    bool rotate, bool residual) {
   const int p = w.observed, f = w.predicted, m = basis.size();
   const int first = c.anchor_at_origin ? 0 : 1;
   Eigen::VectorXd times(f + 1 - first);
   for (int k = first; k <= f; ++k) times[k - first] = k * w.seconds_per_step;
   const RidgeProjector ridge(basis, times, c.ridge_lambda);
 
-  SpanSamples s;
+  Samples s;
   s.inputs.resize(w.size(), 2 * p);
   s.targets.resize(w.size(), 2 * m);
   Eigen::MatrixXd points(times.size(), 2);
@@ -42,4 +42,4 @@ SpanSamples MakeSpanSamples(const WindowSet& w, const TimeBasis& basis,
   return s;
 }
 
-}  // namespace foresight
+}  // namespace foresight::span

@@ -7,14 +7,14 @@
 #include "datasets/windows.h"
 #include "models/span/span_config.h"
 
-namespace foresight {
+namespace foresight::span {
 
 /// Basis over the prediction horizon [0, f dt] (s), t = 0 at the last observed point; centres on
 /// [-margin, f dt + margin].
 TimeBasis MakeFutureBasis(const TrajectoryBasisConfig& config, int predicted,
                           double seconds_per_step);
 
-struct SpanSamples {
+struct Samples {
   Eigen::MatrixXd inputs;   ///< [N x 2p] past points in the ego frame (x_1, y_1, ...)
   Eigen::MatrixXd targets;  ///< [N x 2m] W (m x 2) row-major, ego frame (m)
 };
@@ -22,8 +22,8 @@ struct SpanSamples {
 /// Ego-frame inputs and ridge-fitted future weights (thesis eq. lsuqares) for every window.
 /// With `residual_to_constant_velocity`, the fitted futures are y(t) - v t (v: last step's
 /// velocity).
-SpanSamples MakeSpanSamples(const WindowSet& windows, const TimeBasis& basis,
-                            const TrajectoryBasisConfig& config, bool rotate,
-                            bool residual_to_constant_velocity = false);
+Samples MakeSamples(const WindowSet& windows, const TimeBasis& basis,
+                    const TrajectoryBasisConfig& config, bool rotate,
+                    bool residual_to_constant_velocity = false);
 
-}  // namespace foresight
+}  // namespace foresight::span

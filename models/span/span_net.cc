@@ -2,9 +2,9 @@
 
 #include <cmath>
 
-namespace foresight {
+namespace foresight::span {
 
-SpanNetImpl::SpanNetImpl(int input_dim, const SpanNetConfig& config, const HeadLayout& layout)
+NetImpl::NetImpl(int input_dim, const NetConfig& config, const HeadLayout& layout)
     : layout_(layout) {
   mlp_ = torch::nn::Sequential();
   int width = input_dim;
@@ -22,11 +22,9 @@ SpanNetImpl::SpanNetImpl(int input_dim, const SpanNetConfig& config, const HeadL
   head_->bias.zero_();
 }
 
-torch::Tensor SpanNetImpl::forward(const torch::Tensor& x) {
-  return head_->forward(mlp_->forward(x));
-}
+torch::Tensor NetImpl::forward(const torch::Tensor& x) { return head_->forward(mlp_->forward(x)); }
 
-std::vector<std::string> SpanNetImpl::DenseLayerNames() const {
+std::vector<std::string> NetImpl::DenseLayerNames() const {
   std::vector<std::string> names;
   for (int i = 0; i < num_hidden_; ++i) names.push_back("mlp." + std::to_string(2 * i));
   names.push_back("head");
@@ -85,4 +83,4 @@ torch::Tensor MixtureNll(const MatrixNormalParams& p, const torch::Tensor& w, co
   return -torch::logsumexp(p.log_alpha + log_comp, 1);
 }
 
-}  // namespace foresight
+}  // namespace foresight::span

@@ -7,7 +7,7 @@
 #include "core/matrix_normal_head.h"
 #include "models/span/span_config.h"
 
-namespace foresight {
+namespace foresight::span {
 
 /// Decoded head outputs for a batch of B windows and R components.
 struct MatrixNormalParams {
@@ -17,9 +17,9 @@ struct MatrixNormalParams {
   torch::Tensor chol_v;     ///< [B, R, 3]: a, b, c of L_V = [[a, 0], [b, c]]
 };
 
-class SpanNetImpl : public torch::nn::Module {
+class NetImpl : public torch::nn::Module {
  public:
-  SpanNetImpl(int input_dim, const SpanNetConfig& config, const HeadLayout& layout);
+  NetImpl(int input_dim, const NetConfig& config, const HeadLayout& layout);
   /// @param x [B, input_dim] normalised inputs. @return raw head outputs [B, layout.Total()].
   torch::Tensor forward(const torch::Tensor& x);
   const HeadLayout& layout() const { return layout_; }
@@ -32,7 +32,7 @@ class SpanNetImpl : public torch::nn::Module {
   torch::nn::Linear head_{nullptr};
   int num_hidden_ = 0;
 };
-TORCH_MODULE(SpanNet);
+TORCH_MODULE(Net);
 
 /// Applies the activations of core/matrix_normal_head.h.
 MatrixNormalParams DecodeHead(const torch::Tensor& raw, const HeadLayout& layout);
@@ -43,4 +43,4 @@ MatrixNormalParams DecodeHead(const torch::Tensor& raw, const HeadLayout& layout
 torch::Tensor MixtureNll(const MatrixNormalParams& params, const torch::Tensor& w,
                          const HeadLayout& layout);
 
-}  // namespace foresight
+}  // namespace foresight::span

@@ -26,13 +26,13 @@ namespace foresight::constrained {
 namespace {
 
 // p = 1[a'x > b], gradient 0.
-class HardHalfPlane final : public OccupancyMap {
+class HardHalfPlane final : public occupancy::Map {
  public:
   HardHalfPlane(Eigen::Vector2d a, double b) : a_(a), b_(b) {}
   std::string model_type() const override { return "test.hard_half_plane"; }
-  MapWorkspace MakeWorkspace() const override { return {}; }
-  OccupancyQuery Query(double x, double y, MapWorkspace*) const override {
-    OccupancyQuery q;
+  occupancy::MapWorkspace MakeWorkspace() const override { return {}; }
+  occupancy::QueryResult Query(double x, double y, occupancy::MapWorkspace*) const override {
+    occupancy::QueryResult q;
     q.probability = a_.x() * x + a_.y() * y > b_ ? 1.0 : 0.0;
     return q;
   }
@@ -80,12 +80,12 @@ MatrixNormal AsMatrixNormal(const ComponentParams& c) {
 struct McEstimate {
   double mean = 0, standard_error = 0;
 };
-McEstimate MonteCarloCost(const OccupancyMap& map, const TimeBasis& basis,
+McEstimate MonteCarloCost(const occupancy::Map& map, const TimeBasis& basis,
                           const Eigen::VectorXd& times, const ComponentParams& c, int samples,
                           std::uint64_t seed) {
   const MatrixNormal mn = AsMatrixNormal(c);
   const Eigen::MatrixXd phi = basis.Design(times);  // [K x m]
-  MapWorkspace ws = map.MakeWorkspace();
+  occupancy::MapWorkspace ws = map.MakeWorkspace();
   std::mt19937_64 rng(seed);
   double sum = 0, sum2 = 0;
   for (int i = 0; i < samples; ++i) {
@@ -211,7 +211,8 @@ TEST(CollisionCost, MatchesMonteCarloOnSmoothHalfPlane) {
 
 TEST(CollisionCost, MatchesMonteCarloOnHilbertMap) {
   const HingeGrid grid(testing::SmallGrid(8, 8, 1.0, 3.5));  // cut-off jump exp(-12.25) ~ 5e-6
-  const HingeMap map = testing::RandomHingeMap(HingeMapKind::kHilbert, grid, 7);
+  const occupancy::HingeMap map =
+      testing::RandomHingeMap(occupancy::HingeMapKind::kHilbert, grid, 7);
   const TimeBasis basis = Basis(8);
   const Eigen::VectorXd times = CostTimes(10);
   const ComponentParams c = RandomComponent(basis, 3, {2.5, 3}, {5.5, 5}, -3.0);

@@ -16,12 +16,12 @@
 namespace foresight::constrained {
 namespace {
 
-class SmoothHalfPlane final : public OccupancyMap {
+class SmoothHalfPlane final : public occupancy::Map {
  public:
   std::string model_type() const override { return "test.smooth_half_plane"; }
-  MapWorkspace MakeWorkspace() const override { return {}; }
-  OccupancyQuery Query(double x, double y, MapWorkspace*) const override {
-    OccupancyQuery q;
+  occupancy::MapWorkspace MakeWorkspace() const override { return {}; }
+  occupancy::QueryResult Query(double x, double y, occupancy::MapWorkspace*) const override {
+    occupancy::QueryResult q;
     q.probability = 1 / (1 + std::exp(-3 * (0.6 * x + 0.8 * y - 0.2)));
     q.dp_dx = 3 * q.probability * (1 - q.probability) * 0.6;
     q.dp_dy = 3 * q.probability * (1 - q.probability) * 0.8;
@@ -41,7 +41,7 @@ ComponentParams Component(const TimeBasis& basis, double x0, double y0) {
   return c;
 }
 
-void ExpectNoAllocation(const OccupancyMap& map, const ComponentParams& c0,
+void ExpectNoAllocation(const occupancy::Map& map, const ComponentParams& c0,
                         const ComponentParams& c1, const TimeBasis& basis) {
   const CollisionCost cost(&map, basis, Eigen::VectorXd::LinSpaced(12, 0.2, 4.6), 8);
   CollisionCost::Workspace ws = cost.MakeWorkspace();
@@ -72,7 +72,8 @@ TEST(CollisionCostHotPath, ComponentAllocatesNothingAfterWarmUp) {
   const SmoothHalfPlane plane;
   ExpectNoAllocation(plane, Component(basis, -1.5, -1.0), Component(basis, 0.0, -2.0), basis);
   const HingeGrid grid(testing::SmallGrid(8, 8, 1.0, 3.5));
-  const HingeMap hilbert = testing::RandomHingeMap(HingeMapKind::kHilbert, grid, 7);
+  const occupancy::HingeMap hilbert =
+      testing::RandomHingeMap(occupancy::HingeMapKind::kHilbert, grid, 7);
   ExpectNoAllocation(hilbert, Component(basis, 2.5, 3.0), Component(basis, 3.0, 2.0), basis);
 }
 

@@ -25,12 +25,12 @@ namespace {
 using foresight::testing::ExpectErrorContains;
 
 // p = 0.9 everywhere: no distribution can meet C <= 0.05.
-class FullyOccupied final : public OccupancyMap {
+class FullyOccupied final : public occupancy::Map {
  public:
   std::string model_type() const override { return "test.fully_occupied"; }
-  MapWorkspace MakeWorkspace() const override { return {}; }
-  OccupancyQuery Query(double, double, MapWorkspace*) const override {
-    OccupancyQuery q;
+  occupancy::MapWorkspace MakeWorkspace() const override { return {}; }
+  occupancy::QueryResult Query(double, double, occupancy::MapWorkspace*) const override {
+    occupancy::QueryResult q;
     q.probability = 0.9;
     return q;
   }

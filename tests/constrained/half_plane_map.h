@@ -9,13 +9,13 @@
 namespace foresight::constrained {
 
 // p = sigmoid(k (a'x - b)) with its exact gradient k p (1 - p) a.
-class SmoothHalfPlane final : public OccupancyMap {
+class SmoothHalfPlane final : public occupancy::Map {
  public:
   SmoothHalfPlane(Eigen::Vector2d a, double b, double k) : a_(a), b_(b), k_(k) {}
   std::string model_type() const override { return "test.smooth_half_plane"; }
-  MapWorkspace MakeWorkspace() const override { return {}; }
-  OccupancyQuery Query(double x, double y, MapWorkspace*) const override {
-    OccupancyQuery q;
+  occupancy::MapWorkspace MakeWorkspace() const override { return {}; }
+  occupancy::QueryResult Query(double x, double y, occupancy::MapWorkspace*) const override {
+    occupancy::QueryResult q;
     q.probability = 1 / (1 + std::exp(-k_ * (a_.x() * x + a_.y() * y - b_)));
     const double d = k_ * q.probability * (1 - q.probability);
     q.dp_dx = d * a_.x();

@@ -172,11 +172,11 @@ TEST(Learners, PriorTrainsExportsAndLoads) {
   const std::string art = dir.File("prior.h5");
   ASSERT_TRUE(TrainPrior(spec, TinyData().train, TinyData().val, dir.File("prior"), false, {}, art,
                          "model: test\n"));
-  const SpanPredictor engine = SpanPredictor::Load(art);
+  const span::Predictor engine = span::Predictor::Load(art);
   EXPECT_EQ(engine.layout().components, 2);
   EXPECT_EQ(engine.layout().u_param, UParam::kDiagonal);
   EXPECT_EQ(engine.ktm_references().size(), 0);
-  EXPECT_EQ(Artifact::Open(art, kSpanModelType).config_yaml(), "model: test\n");
+  EXPECT_EQ(Artifact::Open(art, span::kModelType).config_yaml(), "model: test\n");
   const std::vector<double> val = ValLosses(dir.File("prior"));
   ASSERT_EQ(val.size(), 3u);
   for (double v : val) EXPECT_TRUE(std::isfinite(v));
@@ -202,7 +202,7 @@ TEST(Learners, KtmEngineFeaturesAndParityWithLibTorch) {
   ktm.lengthscale = 0.8;
   const std::string art = dir.File("ktm.h5"), run = dir.File("ktm");
   ASSERT_TRUE(TrainKtm(spec, ktm, TinyData().train, TinyData().val, run, false, {}, art, ""));
-  const SpanPredictor engine = SpanPredictor::Load(art);
+  const span::Predictor engine = span::Predictor::Load(art);
   ASSERT_EQ(engine.ktm_references().rows(), 20);
   EXPECT_EQ(engine.ktm_lengthscale(), 0.8);
   EXPECT_EQ(engine.mlp().input_size(), 20);
@@ -212,12 +212,12 @@ TEST(Learners, KtmEngineFeaturesAndParityWithLibTorch) {
   const Eigen::MatrixXd& refs = engine.ktm_references();
 
   // The LibTorch net of the best checkpoint.
-  SpanModelSpec s;
+  span::ModelSpec s;
   s.observed = spec.observed;
   s.predicted = spec.predicted;
   s.basis = spec.basis;
   s.network = spec.network;
-  SpanNet net(20, spec.network, LayoutOf(s));
+  span::Net net(20, spec.network, span::LayoutOf(s));
   LoadCheckpointModel(RunPaths{run}.BestCheckpoint(), net.ptr().get());
   net->eval();
 
@@ -328,8 +328,8 @@ TEST(Learners, KtmResumeAfterInterruptEqualsUninterruptedRun) {
   ASSERT_EQ(a.size(), b.size());
   ASSERT_GT(a.size(), 0);
   EXPECT_EQ((a - b).cwiseAbs().maxCoeff(), 0.0f) << "resumed run differs";
-  EXPECT_EQ(SpanPredictor::Load(dir.File("a.h5")).ktm_references(),
-            SpanPredictor::Load(dir.File("b.h5")).ktm_references());
+  EXPECT_EQ(span::Predictor::Load(dir.File("a.h5")).ktm_references(),
+            span::Predictor::Load(dir.File("b.h5")).ktm_references());
 }
 
 }  // namespace

@@ -10,10 +10,10 @@
 
 namespace {
 
-std::vector<std::uint8_t> Base(foresight::DirectionalVariant v) {
+std::vector<std::uint8_t> Base(foresight::directional::Variant v) {
   using namespace foresight;
-  const bool st = v == DirectionalVariant::kSpatiotemporal;
-  const DirectionalMap map =
+  const bool st = v == directional::Variant::kSpatiotemporal;
+  const directional::Map map =
       testing::RandomDirectionalMap(v, testing::SmallFeatureConfig(), 3, 2, st ? 1 : 2);
   const std::string path = fuzz::ScratchPath(st ? "base_dir_st.h5" : "base_dir_s.h5");
   map.Save(path, "model: directional\n", 0);
@@ -24,14 +24,14 @@ std::vector<std::uint8_t> Base(foresight::DirectionalVariant v) {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace foresight;
-  static const std::vector<std::uint8_t> bases[] = {Base(DirectionalVariant::kSpatiotemporal),
-                                                    Base(DirectionalVariant::kSpatial)};
+  static const std::vector<std::uint8_t> bases[] = {Base(directional::Variant::kSpatiotemporal),
+                                                    Base(directional::Variant::kSpatial)};
   fuzz::ByteReader in(data, size);
   const int kind = in.Byte() % 2;
   const std::string path = fuzz::WriteScratch("dir.h5", bases[kind].data(), bases[kind].size());
   fuzz::MutateH5(path, &in);
   fuzz::ExpectCleanError(path, [&] {
-    const DirectionalMap map = DirectionalMap::Load(path);
+    const directional::Map map = directional::Map::Load(path);
     auto ws = map.MakeWorkspace();
     map.QueryOne(4.2, 1.3, 20.0, &ws);
     fuzz::ExpectFiniteAnswer(ws.alpha.allFinite() && ws.mu.allFinite() && ws.kappa.allFinite(),

@@ -32,7 +32,7 @@ Mlp RandomMlp(const std::vector<int>& widths, std::mt19937_64* rng) {
 std::vector<std::uint8_t> SpanBase(bool ktm) {
   using namespace foresight;
   std::mt19937_64 rng(ktm ? 2 : 1);
-  SpanPredictorWeights w;
+  span::PredictorWeights w;
   w.observed = kObserved;
   w.predicted = kPredicted;
   w.seconds_per_step = 0.4;
@@ -51,7 +51,7 @@ std::vector<std::uint8_t> SpanBase(bool ktm) {
   w.layer_names = {"mlp.0", "head"};
   w.mlp = RandomMlp({in, 5, w.layout.Total()}, &rng);
   const std::string path = fuzz::ScratchPath(ktm ? "base_span_ktm.h5" : "base_span.h5");
-  SpanPredictor::Save(path, w, "model: span_predictor\n", 0);
+  span::Predictor::Save(path, w, "model: span_predictor\n", 0);
   return fuzz::ReadFileBytes(path);
 }
 
@@ -88,7 +88,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   fuzz::MutateH5(path, &in);
   fuzz::ExpectCleanError(path, [&] {
     if (kind < 2) {
-      const SpanPredictor model = SpanPredictor::Load(path);
+      const span::Predictor model = span::Predictor::Load(path);
       auto ws = model.MakeWorkspace();
       auto out = model.MakeDistribution();
       model.Predict(Past(model.observed()), &ws, &out);

@@ -74,9 +74,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
   const std::string path = foresight::fuzz::WriteScratch(
       "config.yaml", reinterpret_cast<const std::uint8_t*>(text.data()), text.size());
-  LoadBoth<foresight::SpanExperimentConfig>(text, path, overrides);
-  LoadBoth<foresight::OccupancyExperimentConfig>(text, path, overrides);
-  LoadBoth<foresight::DirectionalExperimentConfig>(text, path, overrides);
+  LoadBoth<foresight::span::ExperimentConfig>(text, path, overrides);
+  LoadBoth<foresight::occupancy::ExperimentConfig>(text, path, overrides);
+  LoadBoth<foresight::directional::ExperimentConfig>(text, path, overrides);
   LoadBoth<foresight::NavigationExperimentConfig>(text, path, overrides);
   return 0;
 }

@@ -91,16 +91,17 @@ TEST(OccupancyField, FromHingeMapEqualsHingeMapQuery) {
   c.gamma = 12;
   c.cutoff_radius = 0.8;
   const HingeGrid grid(c);
-  const HingeMap map = testing::RandomHingeMap(HingeMapKind::kHilbert, grid, 3);
+  const occupancy::HingeMap map =
+      testing::RandomHingeMap(occupancy::HingeMapKind::kHilbert, grid, 3);
   const OccupancyField<2> field = OccupancyField<2>::FromHingeMap(map);
   EXPECT_EQ(field.grid().size(), grid.size());
-  MapWorkspace mws = map.MakeWorkspace();
+  occupancy::MapWorkspace mws = map.MakeWorkspace();
   auto ws = field.MakeWorkspace();
   std::mt19937_64 rng(3);
   std::uniform_real_distribution<double> ux(-1, 3.75), uy(0.5, 4.25);
   for (int n = 0; n < 300; ++n) {
     const Vec<2> s(ux(rng), uy(rng));
-    const OccupancyQuery q = map.Query(s[0], s[1], &mws);
+    const occupancy::QueryResult q = map.Query(s[0], s[1], &mws);
     OccupancyValue<2> v;
     field.Evaluate(s, ws.get(), false, &v);
     EXPECT_NEAR(v.p, q.probability, 1e-12) << s.transpose();

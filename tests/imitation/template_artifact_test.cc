@@ -124,7 +124,7 @@ TEST_F(BadTemplate, WrongModelType) {
   c.x_max = 2;
   c.y_min = 0;
   c.y_max = 2;
-  testing::RandomHingeMap(HingeMapKind::kHilbert, HingeGrid(c), 1).Save(path_, "", 1);
+  testing::RandomHingeMap(occupancy::HingeMapKind::kHilbert, HingeGrid(c), 1).Save(path_, "", 1);
   ExpectErrorContains([&] { LoadTemplate<2>(path_); },
                       {path_, "occupancy.hilbert", "diffeo_template"});
 }

@@ -9,14 +9,12 @@
 #include "tests/alloc_counter.h"  // replaces operator new: one per binary
 #include "tests/inference/directional_test_util.h"
 
-namespace foresight {
+namespace foresight::directional {
 namespace {
 
 TEST(DirectionalMapQueries, AllocateNothingWhenSized) {
-  for (const DirectionalVariant v :
-       {DirectionalVariant::kSpatiotemporal, DirectionalVariant::kSpatial}) {
-    const DirectionalMap m =
-        testing::RandomDirectionalMap(v, testing::SmallFeatureConfig(), 16, 5, 1);
+  for (const Variant v : {Variant::kSpatiotemporal, Variant::kSpatial}) {
+    const Map m = testing::RandomDirectionalMap(v, testing::SmallFeatureConfig(), 16, 5, 1);
     auto ws = m.MakeWorkspace();
     const int n = 300;
     // Inside, outside the extent, outside the time range.
@@ -41,4 +39,4 @@ TEST(DirectionalMapQueries, AllocateNothingWhenSized) {
 }
 
 }  // namespace
-}  // namespace foresight
+}  // namespace foresight::directional

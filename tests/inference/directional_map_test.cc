@@ -13,14 +13,14 @@
 #include "tests/inference/directional_test_util.h"
 #include "tests/test_util.h"
 
-namespace foresight {
+namespace foresight::directional {
 namespace {
 
 using testing::SmallFeatureConfig;
 
 TEST(DirectionalFeatures, KernelsMatchClosedFormAndCutoff) {
-  const DirectionalFeatureConfig c = SmallFeatureConfig();
-  const DirectionalFeatures f(c);
+  const FeatureConfig c = SmallFeatureConfig();
+  const Features f(c);
   EXPECT_EQ(f.spatial_size(), 20);
   // Inducing points at cell centres, row-major over x then y.
   EXPECT_TRUE(f.SpatialPoint(0).isApprox(Eigen::Vector2d(1.0, -1.0)));
@@ -46,19 +46,19 @@ TEST(DirectionalFeatures, KernelsMatchClosedFormAndCutoff) {
       EXPECT_NEAR(phit[k], std::exp(-std::pow(tc - f.TimePoint(k), 2) / (2 * 400.0)), 1e-7);
   }
   // One temporal inducing point sits at the middle of the range.
-  DirectionalFeatureConfig one = c;
+  FeatureConfig one = c;
   one.time_points = 1;
-  EXPECT_DOUBLE_EQ(DirectionalFeatures(one).TimePoint(0), 30.0);
+  EXPECT_DOUBLE_EQ(Features(one).TimePoint(0), 30.0);
 }
 
 TEST(DirectionalFeatures, ResolveExtentAndBadConfigs) {
-  DirectionalFeatureConfig c = SmallFeatureConfig();
+  FeatureConfig c = SmallFeatureConfig();
   c.auto_extent = true;
   Eigen::VectorXd x(3), y(3), t(3);
   x << 1, 4, 2;
   y << -1, 0, 5;
   t << 10, 3, 7;
-  DirectionalFeatureConfig r = ResolveExtent(c, x, y, t);
+  FeatureConfig r = ResolveExtent(c, x, y, t);
   EXPECT_FALSE(r.auto_extent);
   EXPECT_EQ(r.x_min, 1);
   EXPECT_EQ(r.y_max, 5);
@@ -67,23 +67,23 @@ TEST(DirectionalFeatures, ResolveExtentAndBadConfigs) {
   r = ResolveExtent(c, x, y, t);
   EXPECT_EQ(r.t_min, 3);
   EXPECT_EQ(r.t_max, 10);
-  DirectionalFeatureConfig bad = SmallFeatureConfig();
+  FeatureConfig bad = SmallFeatureConfig();
   bad.x_max = bad.x_min;
-  testing::ExpectErrorContains([&] { DirectionalFeatures{bad}; }, {"empty spatial extent"});
+  testing::ExpectErrorContains([&] { Features{bad}; }, {"empty spatial extent"});
   bad = SmallFeatureConfig();
   bad.length_scale = 0;
-  testing::ExpectErrorContains([&] { DirectionalFeatures{bad}; }, {"length scales"});
+  testing::ExpectErrorContains([&] { Features{bad}; }, {"length scales"});
 }
 
 /// Independent forward pass: dense features, the sequence phi_s * phi_t[k] through Lstm::Forward,
 /// heads by matrix products.
-Eigen::VectorXf ReferenceRaw(const DirectionalMap& m, double x, double y, double t) {
-  const DirectionalFeatures& f = m.features();
+Eigen::VectorXf ReferenceRaw(const Map& m, double x, double y, double t) {
+  const Features& f = m.features();
   Eigen::VectorXf phis(f.spatial_size()), phit(f.time_size());
   f.Spatial(x, y, phis);
   f.Temporal(t, phit);
   Eigen::VectorXf z;
-  if (m.variant() == DirectionalVariant::kSpatial) {
+  if (m.variant() == Variant::kSpatial) {
     z = phis;
   } else {
     Eigen::MatrixXf seq(f.time_size(), f.spatial_size());
@@ -91,17 +91,16 @@ Eigen::VectorXf ReferenceRaw(const DirectionalMap& m, double x, double y, double
     auto ws = m.lstm().MakeWorkspace();
     z = m.lstm().Forward(seq, &ws);
   }
-  const DirectionalHeads& h = m.heads();
+  const Heads& h = m.heads();
   Eigen::VectorXf raw(3 * m.components());
   raw << h.alpha_w * z + h.alpha_b, h.mu_w * z + h.mu_b, h.kappa_w * z + h.kappa_b;
   return raw;
 }
 
-class EngineVariants : public ::testing::TestWithParam<DirectionalVariant> {};
+class EngineVariants : public ::testing::TestWithParam<Variant> {};
 
 TEST_P(EngineVariants, MatchesDenseReferenceAndIsAProperMixture) {
-  const DirectionalMap m =
-      testing::RandomDirectionalMap(GetParam(), SmallFeatureConfig(), 12, 5, 4);
+  const Map m = testing::RandomDirectionalMap(GetParam(), SmallFeatureConfig(), 12, 5, 4);
   auto ws = m.MakeWorkspace();
   std::mt19937_64 rng(8);
   std::uniform_real_distribution<double> ux(-3, 13), uy(-5, 9), ut(-10, 70);
@@ -131,8 +130,7 @@ TEST_P(EngineVariants, MatchesDenseReferenceAndIsAProperMixture) {
 }
 
 TEST_P(EngineVariants, QueriesOutsideTheGridAndTimeRange) {
-  const DirectionalMap m =
-      testing::RandomDirectionalMap(GetParam(), SmallFeatureConfig(), 12, 5, 6);
+  const Map m = testing::RandomDirectionalMap(GetParam(), SmallFeatureConfig(), 12, 5, 6);
   auto ws = m.MakeWorkspace();
   // t is clamped to [t_min, t_max] = [0, 60].
   m.QueryOne(4.0, 2.0, 60.0, &ws);
@@ -170,21 +168,18 @@ TEST_P(EngineVariants, QueriesOutsideTheGridAndTimeRange) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Directional, EngineVariants,
-                         ::testing::Values(DirectionalVariant::kSpatiotemporal,
-                                           DirectionalVariant::kSpatial),
-                         [](const ::testing::TestParamInfo<DirectionalVariant>& p) {
+                         ::testing::Values(Variant::kSpatiotemporal, Variant::kSpatial),
+                         [](const ::testing::TestParamInfo<Variant>& p) {
                            return std::string(VariantName(p.param));
                          });
 
 TEST(DirectionalArtifact, RoundTripAndWrongKinds) {
   testing::TempDir dir;
-  for (const DirectionalVariant v :
-       {DirectionalVariant::kSpatiotemporal, DirectionalVariant::kSpatial}) {
-    const DirectionalMap m =
-        testing::RandomDirectionalMap(v, SmallFeatureConfig(), 8, 3, 2, 2.0f, 50.0);
+  for (const Variant v : {Variant::kSpatiotemporal, Variant::kSpatial}) {
+    const Map m = testing::RandomDirectionalMap(v, SmallFeatureConfig(), 8, 3, 2, 2.0f, 50.0);
     const std::string path = dir.File(std::string(VariantName(v)) + ".h5");
     m.Save(path, "model: directional\n", 0);
-    const DirectionalMap loaded = DirectionalMap::Load(path);
+    const Map loaded = Map::Load(path);
     EXPECT_EQ(loaded.variant(), v);
     EXPECT_EQ(loaded.components(), 3);
     EXPECT_NEAR(loaded.max_kappa(), 50.0, 1e-9);
@@ -193,30 +188,25 @@ TEST(DirectionalArtifact, RoundTripAndWrongKinds) {
     loaded.RawOutput(3.3, 1.1, 20, &w2);
     EXPECT_TRUE(w1.raw.isApprox(w2.raw));
     // A directional artifact is not a SPAN predictor, and vice versa.
-    testing::ExpectErrorContains([&] { SpanPredictor::Load(path); },
+    testing::ExpectErrorContains([&] { span::Predictor::Load(path); },
                                  {path, "'directional_map'", "expected 'span_predictor'"});
   }
   const std::string span = dir.File("span.h5");
   testing::WriteRandomSpanArtifact(span, {});
-  testing::ExpectErrorContains([&] { DirectionalMap::Load(span); },
+  testing::ExpectErrorContains([&] { Map::Load(span); },
                                {span, "'span_predictor'", "expected 'directional_map'"});
-  testing::ExpectErrorContains([&] { DirectionalMap::Load(dir.File("missing.h5")); },
-                               {"missing.h5"});
+  testing::ExpectErrorContains([&] { Map::Load(dir.File("missing.h5")); }, {"missing.h5"});
   // Inconsistent tensors: an LSTM that does not take M_s inputs.
-  DirectionalFeatureConfig other = SmallFeatureConfig();
+  FeatureConfig other = SmallFeatureConfig();
   other.cells_x = 6;
-  const DirectionalMap good =
-      testing::RandomDirectionalMap(DirectionalVariant::kSpatiotemporal, other, 8, 3, 2);
+  const Map good = testing::RandomDirectionalMap(Variant::kSpatiotemporal, other, 8, 3, 2);
   // The features of the 5 x 4 grid with the LSTM of the 6 x 4 grid.
-  const DirectionalMap small = testing::RandomDirectionalMap(DirectionalVariant::kSpatiotemporal,
-                                                             SmallFeatureConfig(), 8, 3, 2);
+  const Map small =
+      testing::RandomDirectionalMap(Variant::kSpatiotemporal, SmallFeatureConfig(), 8, 3, 2);
   testing::ExpectErrorContains(
-      [&] {
-        DirectionalMap(DirectionalVariant::kSpatiotemporal, SmallFeatureConfig(), good.lstm(),
-                       small.heads());
-      },
+      [&] { Map(Variant::kSpatiotemporal, SmallFeatureConfig(), good.lstm(), small.heads()); },
       {"LSTM takes 24 inputs", "M_s = 20"});
 }
 
 }  // namespace
-}  // namespace foresight
+}  // namespace foresight::directional

@@ -10,8 +10,8 @@
 
 namespace foresight::testing {
 
-inline DirectionalFeatureConfig SmallFeatureConfig() {
-  DirectionalFeatureConfig f;
+inline directional::FeatureConfig SmallFeatureConfig() {
+  directional::FeatureConfig f;
   f.x_min = 0;
   f.x_max = 10;
   f.y_min = -2;
@@ -28,10 +28,10 @@ inline DirectionalFeatureConfig SmallFeatureConfig() {
 }
 
 /// Random LSTM and heads; weights ~ N(0, scale^2).
-inline DirectionalMap RandomDirectionalMap(DirectionalVariant v, const DirectionalFeatureConfig& f,
-                                           int hidden, int components, std::uint64_t seed,
-                                           float scale = 0.5f,
-                                           double max_kappa = kDirectionalDefaultMaxKappa) {
+inline directional::Map RandomDirectionalMap(
+    directional::Variant v, const directional::FeatureConfig& f, int hidden, int components,
+    std::uint64_t seed, float scale = 0.5f,
+    double max_kappa = directional::kDirectionalDefaultMaxKappa) {
   std::mt19937_64 rng(seed);
   std::normal_distribution<float> n(0.0f, scale);
   auto mat = [&](long r, long c) {
@@ -43,14 +43,14 @@ inline DirectionalMap RandomDirectionalMap(DirectionalVariant v, const Direction
   const int ms = f.cells_x * f.cells_y;
   Lstm lstm;
   int d = ms;
-  if (v == DirectionalVariant::kSpatiotemporal) {
+  if (v == directional::Variant::kSpatiotemporal) {
     lstm = Lstm(LstmWeights{mat(4 * hidden, ms), mat(4 * hidden, hidden), vec(4 * hidden),
                             vec(4 * hidden)});
     d = hidden;
   }
-  DirectionalHeads h{mat(components, d), mat(components, d), mat(components, d),
-                     vec(components),    vec(components),    vec(components)};
-  return DirectionalMap(v, f, std::move(lstm), std::move(h), max_kappa);
+  directional::Heads h{mat(components, d), mat(components, d), mat(components, d),
+                       vec(components),    vec(components),    vec(components)};
+  return directional::Map(v, f, std::move(lstm), std::move(h), max_kappa);
 }
 
 }  // namespace foresight::testing

@@ -18,7 +18,7 @@
 #include "tests/occupancy_test_util.h"
 #include "tests/test_util.h"
 
-namespace foresight {
+namespace foresight::occupancy {
 namespace {
 
 using testing::ExpectErrorContains;
@@ -329,4 +329,4 @@ TEST(FuseMaps, MismatchedMapsAreRefusedNamingThem) {
 }
 
 }  // namespace
-}  // namespace foresight
+}  // namespace foresight::occupancy

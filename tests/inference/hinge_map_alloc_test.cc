@@ -12,14 +12,14 @@
 #include "tests/alloc_counter.h"  // replaces operator new: one per binary
 #include "tests/occupancy_test_util.h"
 
-namespace foresight {
+namespace foresight::occupancy {
 namespace {
 
-double Exercise(const OccupancyMap& map, MapWorkspace* ws, const Eigen::Matrix2Xd& pts,
-                MapQueryBatch* batch, Eigen::VectorXd* probabilities) {
+double Exercise(const Map& map, MapWorkspace* ws, const Eigen::Matrix2Xd& pts, MapQueryBatch* batch,
+                Eigen::VectorXd* probabilities) {
   double sink = 0;
   for (Eigen::Index i = 0; i < pts.cols(); ++i) {
-    const OccupancyQuery q = map.Query(pts(0, i), pts(1, i), ws);
+    const QueryResult q = map.Query(pts(0, i), pts(1, i), ws);
     sink +=
         q.probability + q.dp_dx + q.dp_dy + q.variance + map.Probability(pts(0, i), pts(1, i), ws);
   }
@@ -35,7 +35,7 @@ TEST(OccupancyMapQueries, AllocateNothingAfterSetUp) {
   c.y_min = 0;
   c.y_max = 4;
   const HingeGrid grid(c);
-  std::vector<std::unique_ptr<OccupancyMap>> maps;
+  std::vector<std::unique_ptr<Map>> maps;
   for (const HingeMapKind kind :
        {HingeMapKind::kHilbert, HingeMapKind::kFastBhm, HingeMapKind::kBhm})
     maps.push_back(std::make_unique<HingeMap>(testing::RandomHingeMap(kind, grid, 1)));
@@ -63,4 +63,4 @@ TEST(OccupancyMapQueries, AllocateNothingAfterSetUp) {
 }
 
 }  // namespace
-}  // namespace foresight
+}  // namespace foresight::occupancy

@@ -17,7 +17,7 @@
 #include "tests/occupancy_test_util.h"
 #include "tests/test_util.h"
 
-namespace foresight {
+namespace foresight::occupancy {
 namespace {
 
 using testing::ExpectErrorContains;
@@ -93,7 +93,7 @@ TEST_P(HingeMapKinds, QueryEqualsTheDenseComputation) {
     const Eigen::VectorXd phi = testing::DenseFeatures(c, x, y);
     const double m = phi.dot(map.weights().mean), v = phi.dot(sigma * phi);
     const double want = bayesian() ? PredictiveProbability(m, v) : testing::ReferenceSigmoid(m);
-    const OccupancyQuery q = map.Query(x, y, &ws);
+    const QueryResult q = map.Query(x, y, &ws);
     EXPECT_NEAR(q.probability, want, 1e-12);
     EXPECT_NEAR(q.variance, v, 1e-12 * (1 + v));
     EXPECT_NEAR(map.Probability(x, y, &ws), q.probability, 1e-15);
@@ -116,7 +116,7 @@ TEST_P(HingeMapKinds, GradientMatchesCentralFiniteDifferencesOfTheProbability) {
   while (checked < 300) {
     const double x = ux(rng), y = uy(rng);
     if (testing::DistanceToCutoff(c, x, y) < 1e-4) continue;  // features are cut off nearby
-    const OccupancyQuery q = map.Query(x, y, &ws);
+    const QueryResult q = map.Query(x, y, &ws);
     const double fd_x = (map.Probability(x + h, y, &ws) - map.Probability(x - h, y, &ws)) / (2 * h);
     const double fd_y = (map.Probability(x, y + h, &ws) - map.Probability(x, y - h, &ws)) / (2 * h);
     EXPECT_NEAR(q.dp_dx, fd_x, 1e-7 + 1e-5 * std::abs(fd_x)) << x << ", " << y;
@@ -137,7 +137,7 @@ TEST_P(HingeMapKinds, OutsideTheGridAndAtNaNTheAnswerIsThePrior) {
       {e[0] - 1e-9, 2.0}, {e[1] + 1e-9, 2.0}, {2.0, e[2] - 0.01}, {2.0, e[3] + 3}, {100, -100},
       {nan, 1.0},         {1.0, nan},         {HUGE_VAL, 1.0},    {1e11, 1e11}};
   for (const auto& [x, y] : outside) {
-    const OccupancyQuery q = map.Query(x, y, &ws);
+    const QueryResult q = map.Query(x, y, &ws);
     EXPECT_EQ(q.probability, testing::ReferenceSigmoid(0.7)) << x << ", " << y;
     EXPECT_EQ(q.variance, bayesian() ? 10.0 : 0.0);
     EXPECT_EQ(q.dp_dx, 0.0);
@@ -162,7 +162,7 @@ TEST_P(HingeMapKinds, BatchQueriesEqualSingleQueries) {
   Eigen::VectorXd p(50);
   map.ProbabilityBatch(pts, &ws, p);
   for (int i = 0; i < 50; ++i) {
-    const OccupancyQuery q = map.Query(pts(0, i), pts(1, i), &ws);
+    const QueryResult q = map.Query(pts(0, i), pts(1, i), &ws);
     EXPECT_EQ(out.probability[i], q.probability);
     EXPECT_EQ(out.variance[i], q.variance);
     EXPECT_EQ(out.gradient(0, i), q.dp_dx);
@@ -213,7 +213,7 @@ TEST_P(HingeMapKinds, SaveLoadRoundTripsExactlyInFloat64AndToFloatPrecisionInFlo
 TEST_P(HingeMapKinds, LoadOccupancyMapDispatchesOnTheModelType) {
   testing::TempDir dir;
   Map().Save(dir.File("m.h5"), "", 0);
-  const auto loaded = LoadOccupancyMap(dir.File("m.h5"));
+  const auto loaded = LoadMap(dir.File("m.h5"));
   ASSERT_NE(dynamic_cast<const HingeMap*>(loaded.get()), nullptr);
   EXPECT_EQ(loaded->model_type(), ModelType(GetParam()));
   EXPECT_EQ(static_cast<const HingeMap&>(*loaded).kind(), GetParam());
@@ -237,15 +237,14 @@ TEST(HingeMap, BadFilesAreErrorsNamingTheFile) {
   std::filesystem::copy_file(dir.File("good.h5"), dir.File("trunc.h5"));
   testing::Truncate(dir.File("trunc.h5"), std::filesystem::file_size(dir.File("good.h5")) / 2);
   ExpectErrorContains([&] { HingeMap::Load(dir.File("trunc.h5")); }, {"trunc.h5"});
-  ExpectErrorContains([&] { LoadOccupancyMap(dir.File("trunc.h5")); }, {"trunc.h5"});
+  ExpectErrorContains([&] { LoadMap(dir.File("trunc.h5")); }, {"trunc.h5"});
   testing::WriteText(dir.File("notes.h5"), "this is not HDF5\n");
   ExpectErrorContains([&] { HingeMap::Load(dir.File("notes.h5")); }, {"notes.h5"});
   ExpectErrorContains([&] { HingeMap::Load(dir.File("none.h5")); }, {"none.h5", "not found"});
   testing::WriteRandomSpanArtifact(dir.File("span.h5"), testing::RandomSpanSpec{});
   ExpectErrorContains([&] { HingeMap::Load(dir.File("span.h5")); },
                       {"span.h5", "not a hinge-feature occupancy map"});
-  ExpectErrorContains([&] { LoadOccupancyMap(dir.File("span.h5")); },
-                      {"span.h5", "not an occupancy map"});
+  ExpectErrorContains([&] { LoadMap(dir.File("span.h5")); }, {"span.h5", "not an occupancy map"});
   const GridMap grid(GridGeometry{0, 0, 0.5, 4, 3}, Eigen::MatrixXf::Constant(3, 4, 0.2f),
                      CellType::kFloat32);
   grid.Save(dir.File("grid.h5"), "", 0);
@@ -333,17 +332,17 @@ TEST(GridMap, QueriesReadTheCellUnderThePoint) {
   EXPECT_FLOAT_EQ(g.Query(0.75, 2.25, &ws).probability, 0.3f);   // cell (3, 0)
   EXPECT_FLOAT_EQ(g.Query(-0.75, 3.25, &ws).probability, 0.8f);  // cell (0, 2)
   EXPECT_FLOAT_EQ(g.Query(-0.25, 2.75, &ws).probability, 0.5f);  // unknown cell (1, 1)
-  const OccupancyQuery q = g.Query(0.25, 2.75, &ws);             // cell (2, 1)
+  const QueryResult q = g.Query(0.25, 2.75, &ws);                // cell (2, 1)
   EXPECT_FLOAT_EQ(q.probability, 0.6f);
   EXPECT_NEAR(q.dp_dx, (0.7 - 0.5) / 1.0, 1e-6);  // neighbours (3, 1) and unknown (1, 1)
   EXPECT_NEAR(q.dp_dy, (1.0 - 0.2) / 1.0, 1e-6);
   EXPECT_EQ(q.variance, 0.0);
-  const OccupancyQuery edge = g.Query(-0.75, 2.25, &ws);  // neighbours outside count as 0.5
+  const QueryResult edge = g.Query(-0.75, 2.25, &ws);  // neighbours outside count as 0.5
   EXPECT_NEAR(edge.dp_dx, (0.1 - 0.5) / 1.0, 1e-6);
   EXPECT_NEAR(edge.dp_dy, (0.4 - 0.5) / 1.0, 1e-6);
   for (const auto& [x, y] : std::vector<std::pair<double, double>>{
            {-1.01, 2.5}, {1.0, 2.5}, {0, 1.99}, {0, 3.5}, {std::nan(""), 2.5}}) {
-    const OccupancyQuery o = g.Query(x, y, &ws);
+    const QueryResult o = g.Query(x, y, &ws);
     EXPECT_EQ(o.probability, 0.5);
     EXPECT_EQ(o.dp_dx, 0.0);
     EXPECT_EQ(g.Probability(x, y, &ws), 0.5);
@@ -370,7 +369,7 @@ TEST(GridMap, RoundTripsAsFloat32ExactlyAndAsUint8Quantised) {
       const float a = back.cells().data()[i], b = g.cells().data()[i];
       EXPECT_TRUE(a == b || (std::isnan(a) && std::isnan(b))) << i;
     }
-    const auto loaded = LoadOccupancyMap(path);
+    const auto loaded = LoadMap(path);
     EXPECT_EQ(loaded->model_type(), kGridMapType);
     ASSERT_NE(dynamic_cast<const GridMap*>(loaded.get()), nullptr);
     const Eigen::MatrixXf& c = back.cells();
@@ -421,4 +420,4 @@ TEST(HingeMapErrors, NonFiniteBhmCovarianceIsRefused) {
 }
 
 }  // namespace
-}  // namespace foresight
+}  // namespace foresight::occupancy

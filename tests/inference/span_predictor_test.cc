@@ -16,7 +16,7 @@
 // Counts heap allocations while armed (the no-allocation proof).
 #include "tests/alloc_counter.h"  // replaces operator new: one per binary
 
-namespace foresight {
+namespace foresight::span {
 namespace {
 
 Eigen::Matrix<double, Eigen::Dynamic, 2> Walk(int p, double heading, double speed,
@@ -40,7 +40,7 @@ class SpanEngine : public ::testing::TestWithParam<testing::RandomSpanSpec> {
 };
 
 TEST_P(SpanEngine, EvaluationAllocatesNothingAfterSetUp) {
-  const SpanPredictor model = SpanPredictor::Load(path_);
+  const Predictor model = Predictor::Load(path_);
   auto ws = model.MakeWorkspace();
   auto dist = model.MakeDistribution();
   const auto past = Walk(model.observed(), 0.7, 1.2, {1, 2});
@@ -72,7 +72,7 @@ TEST_P(SpanEngine, EvaluationAllocatesNothingAfterSetUp) {
 
 TEST_P(SpanEngine, PredictionsAreRotationAndTranslationEquivariant) {
   if (!GetParam().rotate) GTEST_SKIP() << "model is not in the ego frame";
-  const SpanPredictor model = SpanPredictor::Load(path_);
+  const Predictor model = Predictor::Load(path_);
   auto ws = model.MakeWorkspace();
   auto a = model.MakeDistribution(), b = model.MakeDistribution();
   const auto past = Walk(model.observed(), 0.3, 1.1, {0, 0});
@@ -98,7 +98,7 @@ TEST_P(SpanEngine, PredictionsAreRotationAndTranslationEquivariant) {
 }
 
 TEST_P(SpanEngine, PositionAndSamplesAgreeWithTheMatrixNormal) {
-  const SpanPredictor model = SpanPredictor::Load(path_);
+  const Predictor model = Predictor::Load(path_);
   auto ws = model.MakeWorkspace();
   auto dist = model.MakeDistribution();
   model.Predict(Walk(model.observed(), -2.0, 0.9, {3, 3}), &ws, &dist);
@@ -149,7 +149,7 @@ TEST_P(SpanEngine, PositionAndSamplesAgreeWithTheMatrixNormal) {
 }
 
 TEST_P(SpanEngine, BatchEqualsSingleCalls) {
-  const SpanPredictor model = SpanPredictor::Load(path_);
+  const Predictor model = Predictor::Load(path_);
   auto ws = model.MakeWorkspace();
   const int p = model.observed();
   Eigen::MatrixXd batch(3, 2 * p);
@@ -182,7 +182,7 @@ TEST(SpanEngineErrors, BadInputIsAClearError) {
   testing::TempDir dir;
   const std::string path = dir.File("model.h5");
   testing::WriteRandomSpanArtifact(path, {});
-  const SpanPredictor model = SpanPredictor::Load(path);
+  const Predictor model = Predictor::Load(path);
   auto ws = model.MakeWorkspace();
   auto dist = model.MakeDistribution();
   Eigen::Matrix<double, Eigen::Dynamic, 2> past = Walk(8, 0, 1, {0, 0});
@@ -200,11 +200,11 @@ TEST(SpanEngineErrors, OutputOfAnotherLayoutIsAnError) {
   testing::WriteRandomSpanArtifact(dir.File("a.h5"), {8, 12, 6, 1});
   testing::WriteRandomSpanArtifact(dir.File("b.h5"), {8, 12, 6, 3});
   testing::WriteRandomSpanArtifact(dir.File("c.h5"), {8, 12, 4, 1});
-  const SpanPredictor a = SpanPredictor::Load(dir.File("a.h5"));
+  const Predictor a = Predictor::Load(dir.File("a.h5"));
   auto ws = a.MakeWorkspace();
   const auto past = Walk(8, 0, 1, {0, 0});
   for (const char* other : {"b.h5", "c.h5"}) {
-    auto dist = SpanPredictor::Load(dir.File(other)).MakeDistribution();
+    auto dist = Predictor::Load(dir.File(other)).MakeDistribution();
     testing::ExpectErrorContains([&] { a.Predict(past, &ws, &dist); },
                                  {"output distribution has", "the model predicts 1 over 6"});
     std::vector<TrajectoryDistribution> outs{a.MakeDistribution(), dist};
@@ -228,22 +228,22 @@ TEST(SpanEngineErrors, TruncatedForeignAndWrongTypeArtifacts) {
     std::string copy = dir.File("copy.h5");
     std::filesystem::copy_file(path, copy);
     testing::Truncate(copy, std::filesystem::file_size(copy) / 2);
-    EXPECT_THROW(SpanPredictor::Load(copy), Error);
+    EXPECT_THROW(Predictor::Load(copy), Error);
   }
   testing::WriteText(dir.File("text.h5"), "not an artifact");
-  testing::ExpectErrorContains([&] { SpanPredictor::Load(dir.File("text.h5")); }, {"text.h5"});
+  testing::ExpectErrorContains([&] { Predictor::Load(dir.File("text.h5")); }, {"text.h5"});
   {
     h5::File f = h5::File::Create(dir.File("map.h5"));
     Artifact::WriteHeader(&f, "fast_bhm", "model: fast_bhm\n", 0);
   }
-  testing::ExpectErrorContains([&] { SpanPredictor::Load(dir.File("map.h5")); },
+  testing::ExpectErrorContains([&] { Predictor::Load(dir.File("map.h5")); },
                                {"map.h5", "'fast_bhm'", "expected 'span_predictor'"});
   {
     h5::File f = h5::File::Create(dir.File("future.h5"));
-    Artifact::WriteHeader(&f, kSpanModelType, "", 0);
+    Artifact::WriteHeader(&f, kModelType, "", 0);
     f.SetAttr("/", "format_version", std::int64_t{99});
   }
-  testing::ExpectErrorContains([&] { SpanPredictor::Load(dir.File("future.h5")); },
+  testing::ExpectErrorContains([&] { Predictor::Load(dir.File("future.h5")); },
                                {"format_version 99"});
 }
 
@@ -260,15 +260,14 @@ TEST(SpanEngineErrors, EditedAttributesAreRefusedWithFileAndValue) {
     return path;
   };
   const std::string wide = edited("observed", (std::int64_t{1} << 32) + 8);
-  testing::ExpectErrorContains([&] { SpanPredictor::Load(wide); },
+  testing::ExpectErrorContains([&] { Predictor::Load(wide); },
                                {wide, "/model/observed", "4294967304"});
   const std::string step = edited("seconds_per_step", std::nan(""));
-  testing::ExpectErrorContains([&] { SpanPredictor::Load(step); },
-                               {step, "seconds_per_step", "nan"});
+  testing::ExpectErrorContains([&] { Predictor::Load(step); }, {step, "seconds_per_step", "nan"});
   const std::string gamma = edited("basis_gamma", -1.0);
-  testing::ExpectErrorContains([&] { SpanPredictor::Load(gamma); }, {gamma, "basis_gamma", "-1"});
+  testing::ExpectErrorContains([&] { Predictor::Load(gamma); }, {gamma, "basis_gamma", "-1"});
   const std::string many = edited("components", std::int64_t{1} << 40);
-  testing::ExpectErrorContains([&] { SpanPredictor::Load(many); }, {many, "components"});
+  testing::ExpectErrorContains([&] { Predictor::Load(many); }, {many, "components"});
 }
 
 // Fuzz finding (tests/fuzz/corpus/span_artifact/regress_subnormal_input_std): a subnormal
@@ -287,7 +286,7 @@ TEST(SpanEngineErrors, SubnormalInputStdIsRefused) {
     H5Dclose(ds);
     H5Fclose(file);
   }
-  testing::ExpectErrorContains([&] { SpanPredictor::Load(path); },
+  testing::ExpectErrorContains([&] { Predictor::Load(path); },
                                {path, "/normalisation/input_std[5]", ">= 1e-6"});
 }
 
@@ -308,9 +307,9 @@ TEST(SpanEngineErrors, HugeInputMeanIsRefused) {
     H5Dclose(ds);
     H5Fclose(file);
   }
-  testing::ExpectErrorContains([&] { SpanPredictor::Load(path); },
+  testing::ExpectErrorContains([&] { Predictor::Load(path); },
                                {path, "/normalisation/input_mean[3]", "1.76e+162"});
 }
 
 }  // namespace
-}  // namespace foresight
+}  // namespace foresight::span

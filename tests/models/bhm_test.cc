@@ -11,7 +11,7 @@
 #include "tests/occupancy_test_util.h"
 #include "tests/test_util.h"
 
-namespace foresight {
+namespace foresight::occupancy {
 namespace {
 
 using testing::PointSet;
@@ -113,4 +113,4 @@ TEST(Bhm, RefusesGridsTooLargeForADenseCovariance) {
 }
 
 }  // namespace
-}  // namespace foresight
+}  // namespace foresight::occupancy

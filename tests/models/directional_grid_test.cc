@@ -8,7 +8,7 @@
 #include "tests/alloc_counter.h"  // replaces operator new: one per binary
 #include "tests/test_util.h"
 
-namespace foresight {
+namespace foresight::directional {
 namespace {
 
 /// n samples uniform in the box [x0, x1] x [y0, y1] with headings from the mixture (alpha, mu,
@@ -41,8 +41,8 @@ DirectionalSamples ToSamples(const std::vector<std::array<double, 3>>& rows) {
   return s;
 }
 
-DirectionalGridConfig TwoByTwo(GridDirectionalKind kind) {
-  DirectionalGridConfig c;
+GridConfig TwoByTwo(GridKind kind) {
+  GridConfig c;
   c.kind = kind;
   c.cells_x = 2;
   c.cells_y = 2;
@@ -54,8 +54,7 @@ DirectionalGridConfig TwoByTwo(GridDirectionalKind kind) {
 
 TEST(DirectionalGridMap, CellLayoutIsRowMajorOverXThenY) {
   DirectionalSamples s = ToSamples({{0.5, 0.5, 0.0}});
-  const DirectionalGridMap map =
-      DirectionalGridMap::Fit(s, TwoByTwo(GridDirectionalKind::kUnimodal));
+  const GridMap map = GridMap::Fit(s, TwoByTwo(GridKind::kUnimodal));
   EXPECT_EQ(map.num_cells(), 4);
   EXPECT_EQ(map.CellIndex(0.5, 1.0), 0);
   EXPECT_EQ(map.CellIndex(1.5, 1.0), 1);
@@ -74,8 +73,7 @@ TEST(DirectionalGridMap, UnimodalRecoversEachCellAndEmptyCellsAreUniform) {
   AddSamples(4000, 0, 1, 0, 2, {1.0}, {mus[0]}, {kappas[0]}, &rng, &rows);  // cell 0
   AddSamples(4000, 1, 2, 0, 2, {1.0}, {mus[1]}, {kappas[1]}, &rng, &rows);  // cell 1
   AddSamples(4000, 0, 1, 2, 4, {1.0}, {mus[2]}, {kappas[2]}, &rng, &rows);  // cell 2; cell 3 empty
-  const DirectionalGridMap map =
-      DirectionalGridMap::Fit(ToSamples(rows), TwoByTwo(GridDirectionalKind::kUnimodal));
+  const GridMap map = GridMap::Fit(ToSamples(rows), TwoByTwo(GridKind::kUnimodal));
   Eigen::VectorXd qx(5), qy(5);
   qx << 0.5, 1.5, 0.5, 1.5, 7.0;
   qy << 1.0, 1.0, 3.0, 3.0, -5.0;  // the last one is outside: nearest cell is cell 1
@@ -112,10 +110,10 @@ TEST(DirectionalGridMap, UnimodalRecoversEachCellAndEmptyCellsAreUniform) {
 }
 
 TEST(DirectionalGridMap, KappaIsCappedWhenHeadingsCoincide) {
-  DirectionalGridConfig c = TwoByTwo(GridDirectionalKind::kUnimodal);
+  GridConfig c = TwoByTwo(GridKind::kUnimodal);
   c.max_kappa = 30;
-  const DirectionalGridMap map =
-      DirectionalGridMap::Fit(ToSamples({{0.5, 0.5, 1.0}, {0.6, 0.5, 1.0}, {0.7, 0.5, 1.0}}), c);
+  const GridMap map =
+      GridMap::Fit(ToSamples({{0.5, 0.5, 1.0}, {0.6, 0.5, 1.0}, {0.7, 0.5, 1.0}}), c);
   EXPECT_EQ(map.cells().kappa(0, 0), 30.0);
   EXPECT_NEAR(map.cells().mu(0, 0), 1.0, 1e-12);
 }
@@ -129,10 +127,8 @@ TEST(DirectionalGridMap, MultimodalRecoversABimodalCellAndBeatsUnimodalOnAl) {
   AddSamples(2000, 0, 1, 0, 2, alpha, mu, kappa, &rng, &test_rows);
   const DirectionalSamples train = ToSamples(train_rows), test = ToSamples(test_rows);
 
-  const DirectionalGridMap mm =
-      DirectionalGridMap::Fit(train, TwoByTwo(GridDirectionalKind::kMultimodal));
-  const DirectionalGridMap um =
-      DirectionalGridMap::Fit(train, TwoByTwo(GridDirectionalKind::kUnimodal));
+  const GridMap mm = GridMap::Fit(train, TwoByTwo(GridKind::kMultimodal));
+  const GridMap um = GridMap::Fit(train, TwoByTwo(GridKind::kUnimodal));
   ASSERT_EQ(mm.output_components(), 3);
   // BIC picks two components in the bimodal cell, one in the unimodal cell.
   const auto& cells = mm.cells();
@@ -172,14 +168,14 @@ TEST(DirectionalGridMap, MultimodalRecoversABimodalCellAndBeatsUnimodalOnAl) {
   EXPECT_NEAR(al_mm, al_true, 0.03 * al_true);
   EXPECT_LT(MinimumRotationError(out_mm, test.theta), MinimumRotationError(out_um, test.theta));
   // The k-means + BIC initialisation finds the same two modes; it is seeded.
-  DirectionalGridConfig bic = TwoByTwo(GridDirectionalKind::kMultimodal);
+  GridConfig bic = TwoByTwo(GridKind::kMultimodal);
   bic.mixture_init = GridMixtureInit::kKMeansBic;
-  const DirectionalGridMap mm_bic = DirectionalGridMap::Fit(train, bic);
+  const GridMap mm_bic = GridMap::Fit(train, bic);
   EXPECT_EQ((mm_bic.cells().alpha.row(0).array() > 0).count(), 2);
   VonMisesMixtureBatch out_bic;
   mm_bic.Query(test.x, test.y, &out_bic);
   EXPECT_NEAR(AverageLikelihood(out_bic, test.theta), al_mm, 0.01 * al_mm);
-  const DirectionalGridMap again = DirectionalGridMap::Fit(train, bic);
+  const GridMap again = GridMap::Fit(train, bic);
   EXPECT_EQ(again.cells().mu, mm_bic.cells().mu);
   EXPECT_EQ(again.cells().kappa, mm_bic.cells().kappa);
 }
@@ -193,25 +189,23 @@ TEST(DirectionalGridMap, DbscanCountsModesAndKMeansRulesAreSelectable) {
   for (int i = 0; i < 6; ++i) rows.push_back({0.5, 0.5, 2.0 + 0.004 * i});
   for (double t : {-1.2, -0.4, 1.3, 3.0}) rows.push_back({0.5, 0.5, t});
   const DirectionalSamples s = ToSamples(rows);
-  DirectionalGridConfig c = TwoByTwo(GridDirectionalKind::kMultimodal);
+  GridConfig c = TwoByTwo(GridKind::kMultimodal);
   c.components = 5;
-  auto active = [](const DirectionalGridMap& m) {
-    return (m.cells().alpha.row(0).array() > 0).count();
-  };
-  EXPECT_EQ(active(DirectionalGridMap::Fit(s, c)), 3);
+  auto active = [](const GridMap& m) { return (m.cells().alpha.row(0).array() > 0).count(); };
+  EXPECT_EQ(active(GridMap::Fit(s, c)), 3);
   c.components = 2;  // keeps the two largest clusters
-  const DirectionalGridMap two = DirectionalGridMap::Fit(s, c);
+  const GridMap two = GridMap::Fit(s, c);
   EXPECT_EQ(active(two), 2);
   c.components = 5;
   c.dbscan_min_samples = 7;  // the clump of 6 becomes noise
-  EXPECT_EQ(active(DirectionalGridMap::Fit(s, c)), 2);
+  EXPECT_EQ(active(GridMap::Fit(s, c)), 2);
   c.dbscan_min_samples = 50;  // everything is noise: one component from all headings
-  EXPECT_EQ(active(DirectionalGridMap::Fit(s, c)), 1);
+  EXPECT_EQ(active(GridMap::Fit(s, c)), 1);
   c.dbscan_min_samples = 5;
   c.mixture_init = GridMixtureInit::kKMeansFixed;
-  EXPECT_EQ(active(DirectionalGridMap::Fit(s, c)), 5);
+  EXPECT_EQ(active(GridMap::Fit(s, c)), 5);
   c.mixture_init = GridMixtureInit::kKMeansBic;
-  const auto bic = active(DirectionalGridMap::Fit(s, c));
+  const auto bic = active(GridMap::Fit(s, c));
   EXPECT_GE(bic, 3);
   EXPECT_LE(bic, 5);
 }
@@ -226,13 +220,13 @@ TEST(DirectionalGridMap, DenseBlendsNearbyDiscsWithRbfWeights) {
     AddSamples(200, x0, x0 + 1, y0, y0 + 1, {1.0}, {-3.0 + 0.7 * cell}, {4.0 + cell}, &rng, &rows);
   }
   const DirectionalSamples train = ToSamples(rows);
-  DirectionalGridConfig c;
-  c.kind = GridDirectionalKind::kUnimodal;
+  GridConfig c;
+  c.kind = GridKind::kUnimodal;
   c.cells_x = c.cells_y = 3;
   c.extent = Eigen::Vector4d(0, 3, 0, 3);
   c.dense = true;
   c.length_scale = 0.7;
-  const DirectionalGridMap map = DirectionalGridMap::Fit(train, c);
+  const GridMap map = GridMap::Fit(train, c);
   EXPECT_EQ(map.output_components(), 9);
 
   // Independent reference: each disc's ML fit from the raw points, then the blending rule.
@@ -283,14 +277,13 @@ TEST(DirectionalGridMap, DenseBlendsNearbyDiscsWithRbfWeights) {
 }
 
 TEST(DirectionalGridMap, DenseAnswersUniformFarFromData) {
-  DirectionalGridConfig c;
+  GridConfig c;
   c.cells_x = c.cells_y = 5;
   c.extent = Eigen::Vector4d(0, 5, 0, 5);
   c.dense = true;
-  c.kind = GridDirectionalKind::kMultimodal;
+  c.kind = GridKind::kMultimodal;
   c.components = 2;
-  const DirectionalGridMap map =
-      DirectionalGridMap::Fit(ToSamples({{0.5, 0.5, 1.0}, {0.6, 0.4, 1.2}}), c);
+  const GridMap map = GridMap::Fit(ToSamples({{0.5, 0.5, 1.0}, {0.6, 0.4, 1.2}}), c);
   Eigen::VectorXd qx(2), qy(2);
   qx << 4.5, 0.5;
   qy << 4.5, 0.5;
@@ -310,12 +303,12 @@ TEST(DirectionalGridMap, QueryDoesNotAllocateWhenOutIsSized) {
   Eigen::VectorXd qx = Eigen::VectorXd::LinSpaced(300, -1, 5),
                   qy = Eigen::VectorXd::LinSpaced(300, 5, -1);
   for (bool dense : {false, true}) {
-    DirectionalGridConfig c;
-    c.kind = GridDirectionalKind::kMultimodal;
+    GridConfig c;
+    c.kind = GridKind::kMultimodal;
     c.cells_x = c.cells_y = 4;
     c.extent = Eigen::Vector4d(0, 4, 0, 4);
     c.dense = dense;
-    const DirectionalGridMap map = DirectionalGridMap::Fit(ToSamples(rows), c);
+    const GridMap map = GridMap::Fit(ToSamples(rows), c);
     VonMisesMixtureBatch out;
     map.Query(qx, qy, &out);
     const double* alpha = out.alpha.data();
@@ -332,30 +325,26 @@ TEST(DirectionalGridMap, QueryDoesNotAllocateWhenOutIsSized) {
 
 TEST(DirectionalGridMap, BadInputIsAnError) {
   const DirectionalSamples s = ToSamples({{0.5, 0.5, 0.0}});
-  DirectionalGridConfig c = TwoByTwo(GridDirectionalKind::kUnimodal);
+  GridConfig c = TwoByTwo(GridKind::kUnimodal);
   c.cells_x = 0;
-  testing::ExpectErrorContains([&] { DirectionalGridMap::Fit(s, c); }, {"cells_x 0"});
-  c = TwoByTwo(GridDirectionalKind::kUnimodal);
+  testing::ExpectErrorContains([&] { GridMap::Fit(s, c); }, {"cells_x 0"});
+  c = TwoByTwo(GridKind::kUnimodal);
   c.extent = Eigen::Vector4d(0, 0, 0, 1);
-  testing::ExpectErrorContains([&] { DirectionalGridMap::Fit(s, c); }, {"extent", "(0, 0, 0, 1)"});
-  c = TwoByTwo(GridDirectionalKind::kUnimodal);
+  testing::ExpectErrorContains([&] { GridMap::Fit(s, c); }, {"extent", "(0, 0, 0, 1)"});
+  c = TwoByTwo(GridKind::kUnimodal);
   c.length_scale = 0;
-  testing::ExpectErrorContains([&] { DirectionalGridMap::Fit(s, c); }, {"length_scale 0"});
-  c = TwoByTwo(GridDirectionalKind::kMultimodal);
+  testing::ExpectErrorContains([&] { GridMap::Fit(s, c); }, {"length_scale 0"});
+  c = TwoByTwo(GridKind::kMultimodal);
   c.components = 0;
-  testing::ExpectErrorContains([&] { DirectionalGridMap::Fit(s, c); }, {"components 0"});
+  testing::ExpectErrorContains([&] { GridMap::Fit(s, c); }, {"components 0"});
   testing::ExpectErrorContains(
-      [&] {
-        DirectionalGridMap::Fit(DirectionalSamples(), TwoByTwo(GridDirectionalKind::kUnimodal));
-      },
+      [&] { GridMap::Fit(DirectionalSamples(), TwoByTwo(GridKind::kUnimodal)); },
       {"training data", "no direction samples"});
   DirectionalSamples nan = s;
   nan.x[0] = std::nan("");
-  testing::ExpectErrorContains(
-      [&] { DirectionalGridMap::Fit(nan, TwoByTwo(GridDirectionalKind::kUnimodal)); },
-      {"training data", "not finite"});
-  const DirectionalGridMap map =
-      DirectionalGridMap::Fit(s, TwoByTwo(GridDirectionalKind::kUnimodal));
+  testing::ExpectErrorContains([&] { GridMap::Fit(nan, TwoByTwo(GridKind::kUnimodal)); },
+                               {"training data", "not finite"});
+  const GridMap map = GridMap::Fit(s, TwoByTwo(GridKind::kUnimodal));
   VonMisesMixtureBatch out;
   Eigen::VectorXd x(2), y(1);
   x << 0.5, std::nan("");
@@ -367,4 +356,4 @@ TEST(DirectionalGridMap, BadInputIsAnError) {
 }
 
 }  // namespace
-}  // namespace foresight
+}  // namespace foresight::directional

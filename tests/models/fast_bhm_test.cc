@@ -11,7 +11,7 @@
 #include "tests/occupancy_test_util.h"
 #include "tests/test_util.h"
 
-namespace foresight {
+namespace foresight::occupancy {
 namespace {
 
 using testing::PointSet;
@@ -212,4 +212,4 @@ TEST(FastBhm, EmptyScanChangesNothingAndOtherKindsCannotBeContinued) {
 }
 
 }  // namespace
-}  // namespace foresight
+}  // namespace foresight::occupancy

@@ -11,7 +11,7 @@
 
 #include "tests/test_util.h"
 
-namespace foresight {
+namespace foresight::occupancy {
 namespace {
 
 using Cell = std::pair<int, int>;
@@ -231,4 +231,4 @@ TEST(GridBuilder, UnknownCellsAreOneHalfAfterLoadAndBeamsLeavingTheGridAreCut) {
 }
 
 }  // namespace
-}  // namespace foresight
+}  // namespace foresight::occupancy

@@ -10,7 +10,7 @@
 #include "tests/occupancy_test_util.h"
 #include "tests/test_util.h"
 
-namespace foresight {
+namespace foresight::occupancy {
 namespace {
 
 /// Hits on the walls of the room [0, 8] x [0, 6] (with 2 cm noise), free points inside, 0.5 m
@@ -97,4 +97,4 @@ TEST(HilbertMap, PureL1PenaltyZeroesWeightsAndNoPointsIsAnError) {
 }
 
 }  // namespace
-}  // namespace foresight
+}  // namespace foresight::occupancy

@@ -14,7 +14,7 @@
 #include "models/directional/knn_directional.h"
 #include "tests/test_util.h"
 
-namespace foresight {
+namespace foresight::directional {
 namespace {
 
 double Uniform(std::mt19937_64* rng, double lo, double hi) {
@@ -39,9 +39,8 @@ DirectionalSamples RandomSamples(Eigen::Index n, std::uint64_t seed, double exte
 }
 
 /// Brute force: the k training indices nearest to q, by (squared distance, index).
-std::vector<Eigen::Index> BruteNeighbours(const DirectionalSamples& train,
-                                          const KnnDirectionalConfig& c, double x, double y,
-                                          double t) {
+std::vector<Eigen::Index> BruteNeighbours(const DirectionalSamples& train, const KnnConfig& c,
+                                          double x, double y, double t) {
   std::vector<std::pair<double, Eigen::Index>> all;
   for (Eigen::Index j = 0; j < train.size(); ++j) {
     const double dx = x - train.x[j], dy = y - train.y[j];
@@ -59,8 +58,8 @@ std::vector<Eigen::Index> BruteNeighbours(const DirectionalSamples& train,
 }
 
 void ExpectMatchesBruteForce(const DirectionalSamples& train, const DirectionalSamples& query,
-                             const KnnDirectionalConfig& c) {
-  const KnnDirectionalMap map = KnnDirectionalMap::Fit(train, c);
+                             const KnnConfig& c) {
+  const KnnMap map = KnnMap::Fit(train, c);
   VonMisesMixtureBatch out;
   map.Query(query.x, query.y, query.t, &out);
   ASSERT_EQ(out.alpha.rows(), query.size());
@@ -82,7 +81,7 @@ TEST(KnnDirectional, MatchesBruteForceInSpaceAndSpaceTime) {
   const DirectionalSamples query = RandomSamples(200, 2, 22.0, 110.0);  // some outside
   for (const int k : {1, 3}) {
     for (const bool use_time : {false, true}) {
-      KnnDirectionalConfig c;
+      KnnConfig c;
       c.k = k;
       c.kappa = 30;
       c.use_time = use_time;
@@ -119,16 +118,15 @@ TEST(KnnDirectional, TiesGoToTheLowerTrainingIndex) {
     query.y[i] = 0.5 * static_cast<double>(rng() % (2 * side));
   }
   for (const int k : {1, 3, 8}) {
-    KnnDirectionalConfig c;
+    KnnConfig c;
     c.k = k;
     SCOPED_TRACE(::testing::Message() << "k " << k);
     ExpectMatchesBruteForce(train, query, c);
   }
   // By hand: at (0, 0) the two copies of grid point 0 are at distance 0: indices 0 and 144.
-  KnnDirectionalConfig c;
+  KnnConfig c;
   c.k = 2;
-  EXPECT_EQ(KnnDirectionalMap::Fit(train, c).Neighbours(0, 0, 0),
-            (std::vector<Eigen::Index>{0, side * side}));
+  EXPECT_EQ(KnnMap::Fit(train, c).Neighbours(0, 0, 0), (std::vector<Eigen::Index>{0, side * side}));
 }
 
 TEST(KnnDirectional, TimeSelectsTheNeighbourThatWasThereThen) {
@@ -139,25 +137,25 @@ TEST(KnnDirectional, TimeSelectsTheNeighbourThatWasThereThen) {
   train.y = Eigen::Vector3d(1, 1, 9);
   train.t = Eigen::Vector3d(0, 50, 25);
   train.theta = Eigen::Vector3d(0, M_PI / 2, -M_PI);
-  KnnDirectionalConfig c;
+  KnnConfig c;
   VonMisesMixtureBatch out;
   const Eigen::VectorXd x = Eigen::Vector2d(1.1, 1.1), y = Eigen::Vector2d(1, 1),
                         t = Eigen::Vector2d(45, 5);
-  KnnDirectionalMap::Fit(train, c).Query(x, y, Eigen::VectorXd(), &out);  // t may be empty
+  KnnMap::Fit(train, c).Query(x, y, Eigen::VectorXd(), &out);  // t may be empty
   EXPECT_EQ(out.mu(0, 0), 0.0);
   EXPECT_EQ(out.mu(1, 0), 0.0);
   c.use_time = true;
   c.time_scale = 1.0;
-  KnnDirectionalMap::Fit(train, c).Query(x, y, t, &out);
+  KnnMap::Fit(train, c).Query(x, y, t, &out);
   EXPECT_EQ(out.mu(0, 0), M_PI / 2);
   EXPECT_EQ(out.mu(1, 0), 0.0);
   // A tiny time scale makes time irrelevant again; a huge one makes place irrelevant: at t = 25
   // the far sample (9, 9) is nearest.
   c.time_scale = 1e-12;
-  KnnDirectionalMap::Fit(train, c).Query(x, y, t, &out);
+  KnnMap::Fit(train, c).Query(x, y, t, &out);
   EXPECT_EQ(out.mu(0, 0), 0.0);
   c.time_scale = 1e3;
-  KnnDirectionalMap::Fit(train, c).Query(x, y, Eigen::Vector2d(25, 25), &out);
+  KnnMap::Fit(train, c).Query(x, y, Eigen::Vector2d(25, 25), &out);
   EXPECT_EQ(out.mu(0, 0), -M_PI);
 }
 
@@ -165,9 +163,9 @@ TEST(KnnDirectional, AverageLikelihoodOfOneNnIsTheMeanDensityAtTheNeighbours) {
   const DirectionalSamples train = RandomSamples(800, 11, 10.0, 50.0);
   const DirectionalSamples test = RandomSamples(300, 12, 10.0, 50.0);
   for (const double kappa : {10.0, 100.0}) {
-    KnnDirectionalConfig c;
+    KnnConfig c;
     c.kappa = kappa;
-    const KnnDirectionalMap map = KnnDirectionalMap::Fit(train, c);
+    const KnnMap map = KnnMap::Fit(train, c);
     VonMisesMixtureBatch out;
     map.Query(test.x, test.y, test.t, &out);
     // Independent: nearest by brute force, density from std::cyl_bessel_i.
@@ -186,11 +184,11 @@ TEST(KnnDirectional, LargeProblemMatchesBruteForceOnASubset) {
   // ~50k training points and 50k queries (the Edinburgh scale); checked on every 500th query.
   const DirectionalSamples train = RandomSamples(50000, 21, 15.0, 1000.0);
   const DirectionalSamples query = RandomSamples(50000, 22, 15.0, 1000.0);
-  KnnDirectionalConfig c;
+  KnnConfig c;
   c.k = 3;
   c.use_time = true;
   c.time_scale = 0.05;
-  const KnnDirectionalMap map = KnnDirectionalMap::Fit(train, c);
+  const KnnMap map = KnnMap::Fit(train, c);
   EXPECT_EQ(map.size(), 50000);
   VonMisesMixtureBatch out;
   map.Query(query.x, query.y, query.t, &out);
@@ -204,10 +202,10 @@ TEST(KnnDirectional, LargeProblemMatchesBruteForceOnASubset) {
 TEST(KnnDirectional, QueryDoesNotAllocateWhenTheOutputHasItsShape) {
   const DirectionalSamples train = RandomSamples(500, 31, 10.0, 10.0);
   const DirectionalSamples query = RandomSamples(64, 32, 10.0, 10.0);
-  KnnDirectionalConfig c;
+  KnnConfig c;
   c.k = 4;
   c.use_time = true;
-  const KnnDirectionalMap map = KnnDirectionalMap::Fit(train, c);
+  const KnnMap map = KnnMap::Fit(train, c);
   VonMisesMixtureBatch out;
   out.Resize(query.size(), c.k);
   g_allocations = 0;
@@ -221,24 +219,23 @@ TEST(KnnDirectional, QueryDoesNotAllocateWhenTheOutputHasItsShape) {
 TEST(KnnDirectional, BadConfigAndQueriesAreErrors) {
   const DirectionalSamples train = RandomSamples(5, 41, 1.0, 1.0);
   auto fit = [&](auto edit) {
-    KnnDirectionalConfig c;
+    KnnConfig c;
     edit(&c);
-    return KnnDirectionalMap::Fit(train, c);
+    return KnnMap::Fit(train, c);
   };
-  testing::ExpectErrorContains([&] { fit([](KnnDirectionalConfig* c) { c->k = 0; }); },
-                               {"k 0", ">= 1"});
-  testing::ExpectErrorContains([&] { fit([](KnnDirectionalConfig* c) { c->k = 6; }); },
+  testing::ExpectErrorContains([&] { fit([](KnnConfig* c) { c->k = 0; }); }, {"k 0", ">= 1"});
+  testing::ExpectErrorContains([&] { fit([](KnnConfig* c) { c->k = 6; }); },
                                {"k 6", "5 training samples"});
-  testing::ExpectErrorContains([&] { fit([](KnnDirectionalConfig* c) { c->kappa = 0; }); },
+  testing::ExpectErrorContains([&] { fit([](KnnConfig* c) { c->kappa = 0; }); },
                                {"kappa 0", "> 0"});
-  testing::ExpectErrorContains([&] { fit([](KnnDirectionalConfig* c) { c->time_scale = -1; }); },
+  testing::ExpectErrorContains([&] { fit([](KnnConfig* c) { c->time_scale = -1; }); },
                                {"time_scale -1", "> 0"});
   DirectionalSamples bad = train;
   bad.theta[1] = 4.0;
-  testing::ExpectErrorContains([&] { KnnDirectionalMap::Fit(bad, KnnDirectionalConfig{}); },
+  testing::ExpectErrorContains([&] { KnnMap::Fit(bad, KnnConfig{}); },
                                {"training samples", "sample 1", "outside [-pi, pi)"});
 
-  const KnnDirectionalMap map = fit([](KnnDirectionalConfig* c) { c->use_time = true; });
+  const KnnMap map = fit([](KnnConfig* c) { c->use_time = true; });
   VonMisesMixtureBatch out;
   const Eigen::VectorXd two = Eigen::Vector2d(0.5, 0.5), three = Eigen::Vector3d(0.5, 0.5, 0.5);
   testing::ExpectErrorContains([&] { map.Query(two, three, two, &out); },
@@ -252,4 +249,4 @@ TEST(KnnDirectional, BadConfigAndQueriesAreErrors) {
 }
 
 }  // namespace
-}  // namespace foresight
+}  // namespace foresight::directional

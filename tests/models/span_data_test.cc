@@ -2,7 +2,7 @@
 
 #include <gtest/gtest.h>
 
-namespace foresight {
+namespace foresight::span {
 namespace {
 
 WindowSet StraightWalk(double vx, double vy) {
@@ -21,7 +21,7 @@ TEST(SpanSamples, EgoFrameInputsAndTargetsOfAStraightWalk) {
   const WindowSet w = StraightWalk(0.6, 0.8);  // 1 m/s at 53 degrees
   TrajectoryBasisConfig c;
   const TimeBasis basis = MakeFutureBasis(c, 12, 0.4);
-  const SpanSamples s = MakeSpanSamples(w, basis, c, true);
+  const Samples s = MakeSamples(w, basis, c, true);
   ASSERT_EQ(s.inputs.rows(), 1);
   // Ego frame: the last point is the origin, the walk lies on the -x axis.
   for (int i = 0; i < 8; ++i) {
@@ -37,9 +37,9 @@ TEST(SpanSamples, EgoFrameInputsAndTargetsOfAStraightWalk) {
     EXPECT_NEAR(o.y(), 0.0, 1e-9);
   }
   // Relative to constant velocity the residual of a straight walk is zero.
-  const SpanSamples r = MakeSpanSamples(w, basis, c, true, /*residual_to_constant_velocity=*/true);
+  const Samples r = MakeSamples(w, basis, c, true, /*residual_to_constant_velocity=*/true);
   EXPECT_LT(r.targets.cwiseAbs().maxCoeff(), 1e-9);
 }
 
 }  // namespace
-}  // namespace foresight
+}  // namespace foresight::span

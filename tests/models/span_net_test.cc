@@ -4,7 +4,7 @@
 
 #include "core/matrix_normal.h"
 
-namespace foresight {
+namespace foresight::span {
 namespace {
 
 /// Builds the core (Eigen, double) mixture of sample b from decoded torch parameters.
@@ -87,9 +87,9 @@ INSTANTIATE_TEST_SUITE_P(Heads, MixtureNllTest,
                                            Case{4, 2, UParam::kCholesky}));
 
 TEST(SpanNet, LayerNamesAreTheArtifactTensorNames) {
-  SpanNetConfig cfg;
+  NetConfig cfg;
   cfg.hidden = {10, 20};
-  SpanNet net(16, cfg, HeadLayout{4, 1, UParam::kCholesky});
+  Net net(16, cfg, HeadLayout{4, 1, UParam::kCholesky});
   EXPECT_EQ(net->DenseLayerNames(), (std::vector<std::string>{"mlp.0", "mlp.2", "head"}));
   std::vector<std::string> keys;
   for (const auto& p : net->named_parameters()) keys.push_back(p.key());
@@ -100,4 +100,4 @@ TEST(SpanNet, LayerNamesAreTheArtifactTensorNames) {
 }
 
 }  // namespace
-}  // namespace foresight
+}  // namespace foresight::span

@@ -96,7 +96,7 @@ TEST(CrowdForecast, TablesThePredictorAndAgreesWithTheBoundByBruteForce) {
     spec.seconds_per_step = 0.1;
     spec.components = components;
     testing::WriteRandomSpanArtifact(dir.File("p.h5"), spec);
-    const SpanPredictor model = SpanPredictor::Load(dir.File("p.h5"));
+    const span::Predictor model = span::Predictor::Load(dir.File("p.h5"));
     auto ws = model.MakeWorkspace();
     std::vector<TrajectoryDistribution> dists{model.MakeDistribution(), model.MakeDistribution()};
     Eigen::MatrixXd rows(2, 10);

@@ -19,8 +19,8 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 
 /// 12 m x 8 m free room with 0.1 m cells; `wall` adds a vertical wall at x = 5 with a gap at y in
 /// [5, 6.5].
-GridMap Room(bool wall) {
-  GridGeometry g;
+occupancy::GridMap Room(bool wall) {
+  occupancy::GridGeometry g;
   g.x_min = -1;
   g.y_min = -1;
   g.resolution = 0.1;
@@ -34,7 +34,7 @@ GridMap Room(bool wall) {
       const bool w = wall && std::abs(x - 5.0) < 0.15 && !(y > 5.0 && y < 6.5);
       if (border || w) p(iy, ix) = 0.95f;
     }
-  return GridMap(g, p, CellType::kFloat32);
+  return occupancy::GridMap(g, p, occupancy::CellType::kFloat32);
 }
 
 /// Rows of standing pedestrians observed for `p` steps.
@@ -47,9 +47,9 @@ Eigen::MatrixXd Standing(const std::vector<Eigen::Vector2d>& at, int p) {
 }
 
 TEST(StaticCollisionField, TabulatesTheSweptOccupancy) {
-  const GridMap map = Room(true);
+  const occupancy::GridMap map = Room(true);
   const StaticCollisionField field(map, 0.4, 0.05);
-  MapWorkspace ws = field.MakeWorkspace();
+  occupancy::MapWorkspace ws = field.MakeWorkspace();
   int disagree = 0, checked = 0;
   for (double x = 0.0; x < 12.0; x += 0.173)
     for (double y = 0.0; y < 8.0; y += 0.191) {
@@ -71,7 +71,7 @@ TEST(StaticCollisionField, TabulatesTheSweptOccupancy) {
 }
 
 TEST(GoalDistanceField, IsEuclideanInOpenSpaceAndGoesAroundWalls) {
-  const GridMap open = Room(false), walled = Room(true);
+  const occupancy::GridMap open = Room(false), walled = Room(true);
   const StaticCollisionField open_field(open, 0.4, 0.05), walled_field(walled, 0.4, 0.05);
   const Eigen::Vector2d goal(9, 2);
   const GoalDistanceField free_space(open_field, goal, 0.25), around(walled_field, goal, 0.25);
@@ -130,7 +130,7 @@ TEST(SpanController, CostIsDistancePlusKappaOverTheFirstCollisionTime) {
 }
 
 TEST(SpanController, CobylaFindsAsGoodAControlAsAGridSearch) {
-  const GridMap map = Room(false);
+  const occupancy::GridMap map = Room(false);
   const StaticCollisionField field(map, 0.4, 0.05);
   SpanController c(nullptr, &field, Options());
   const Eigen::MatrixXd rows = Standing({{2.5, 0.3}, {3.0, -1.2}, {4.0, 2.0}}, 5);
@@ -168,10 +168,10 @@ TEST(SpanController, ClosedLoopPassesAStandingPedestrianWithoutCollision) {
 }
 
 TEST(SpanController, WithTheMapGoesThroughTheGap) {
-  const GridMap map = Room(true);
+  const occupancy::GridMap map = Room(true);
   const StaticCollisionField field(map, 0.4, 0.05);
   SpanController c(nullptr, &field, Options());
-  MapWorkspace ws = field.MakeWorkspace();
+  occupancy::MapWorkspace ws = field.MakeWorkspace();
   UnicycleState s{2, 5.75, 0};
   const Eigen::Vector2d goal(9, 5.75);
   int steps = 0;
@@ -212,7 +212,7 @@ TEST(Baselines, NonFiniteObservationsAreDroppedNotObstacles) {
   in.past_rows = &rows;
   ReactiveController reactive(nullptr, Options());
   EXPECT_TRUE(reactive.Compute(in).solved());
-  const GridMap map = Room(false);
+  const occupancy::GridMap map = Room(false);
   const StaticCollisionField field(map, 0.4, 0.05);
   ClRrtStarOptions o;
   o.max_iterations = 300;
@@ -266,13 +266,13 @@ TEST(PurePursuit, SteersTowardsTheLookaheadPoint) {
 }
 
 TEST(ClRrtStar, PlansThroughTheGapAndStaysPutWhenBlocked) {
-  const GridMap map = Room(true);
+  const occupancy::GridMap map = Room(true);
   const StaticCollisionField field(map, 0.4, 0.05);
   ClRrtStarOptions o;
   o.budget_s = 1.0;
   o.max_iterations = 400;
   ClRrtStarController c(&field, Eigen::Vector4d(-0.5, 12.5, -0.5, 8.5), o, 1);
-  MapWorkspace ws = field.MakeWorkspace();
+  occupancy::MapWorkspace ws = field.MakeWorkspace();
   UnicycleState s{2, 2, 0};
   const Eigen::Vector2d goal(9, 2);
   int steps = 0;

@@ -16,7 +16,7 @@
 #include "tests/occupancy_test_util.h"
 #include "tests/test_util.h"
 
-namespace foresight {
+namespace foresight::occupancy {
 namespace {
 
 using testing::PointSet;
@@ -289,4 +289,4 @@ TEST(CoupledBhm, BadInputIsAnErrorNamingIt) {
 }
 
 }  // namespace
-}  // namespace foresight
+}  // namespace foresight::occupancy

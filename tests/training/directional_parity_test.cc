@@ -17,11 +17,11 @@
 #include "training/directional/config.h"
 #include "training/directional/pipeline.h"
 
-namespace foresight {
+namespace foresight::directional {
 namespace {
 
-DirectionalFeatureConfig Features() {
-  DirectionalFeatureConfig f;
+FeatureConfig TestFeatureConfig() {
+  FeatureConfig f;
   f.x_min = -1;
   f.x_max = 9;
   f.y_min = 0;
@@ -37,13 +37,13 @@ DirectionalFeatureConfig Features() {
   return f;
 }
 
-class Parity : public ::testing::TestWithParam<DirectionalVariant> {};
+class Parity : public ::testing::TestWithParam<Variant> {};
 
 TEST_P(Parity, EngineMatchesLibTorchOnARandomExportedModel) {
-  const DirectionalFeatureConfig fc = Features();
-  const DirectionalFeatures feats(fc);
+  const FeatureConfig fc = TestFeatureConfig();
+  const Features feats(fc);
   torch::manual_seed(5);
-  DirectionalNet net(GetParam(), feats.spatial_size(), 5, 40);
+  Net net(GetParam(), feats.spatial_size(), 5, 40);
   {
     torch::NoGradGuard no_grad;
     for (auto& p : net->parameters())
@@ -51,11 +51,11 @@ TEST_P(Parity, EngineMatchesLibTorchOnARandomExportedModel) {
   }
   testing::TempDir dir;
   const std::string path = dir.File("model.h5");
-  WriteDirectionalArtifact(*net, fc, "model: directional\n", 5, path);
-  const DirectionalMap engine = DirectionalMap::Load(path);
+  WriteArtifact(*net, fc, "model: directional\n", 5, path);
+  const Map engine = Map::Load(path);
   EXPECT_EQ(engine.variant(), GetParam());
   auto ws = engine.MakeWorkspace();
-  LoadedDirectionalNet reloaded = LoadDirectionalNetFromArtifact(path);
+  LoadedNet reloaded = LoadNetFromArtifact(path);
   net->eval();
   std::mt19937_64 rng(2);
   std::uniform_real_distribution<double> ux(-3, 11), uy(-2, 8), ut(-10, 60);
@@ -79,7 +79,7 @@ TEST_P(Parity, EngineMatchesLibTorchOnARandomExportedModel) {
           << "output " << k << " at " << x << ", " << y << ", " << t;
     }
     // Decoded mixtures agree too.
-    const auto p = DecodeDirectionalHead(raw.to(torch::kFloat64), 5);
+    const auto p = DecodeVonMisesHead(raw.to(torch::kFloat64), 5);
     engine.QueryOne(x, y, t, &ws);
     for (int r = 0; r < 5; ++r) {
       EXPECT_NEAR(ws.alpha[r], std::exp(p.log_alpha[0][r].item<double>()), 1e-5);
@@ -91,16 +91,15 @@ TEST_P(Parity, EngineMatchesLibTorchOnARandomExportedModel) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Directional, Parity,
-                         ::testing::Values(DirectionalVariant::kSpatiotemporal,
-                                           DirectionalVariant::kSpatial),
-                         [](const ::testing::TestParamInfo<DirectionalVariant>& p) {
+                         ::testing::Values(Variant::kSpatiotemporal, Variant::kSpatial),
+                         [](const ::testing::TestParamInfo<Variant>& p) {
                            return std::string(VariantName(p.param));
                          });
 
 TEST(DirectionalNet, WrittenOutLstmMatchesTorchLstmAndSparseMatchesDense) {
-  const DirectionalFeatures feats(Features());
+  const Features feats(TestFeatureConfig());
   torch::manual_seed(9);
-  DirectionalNet net(DirectionalVariant::kSpatiotemporal, feats.spatial_size(), 4, 24);
+  Net net(Variant::kSpatiotemporal, feats.spatial_size(), 4, 24);
   // torch::nn::LSTM with the same parameters on the sequence phi_s * phi_t[k].
   torch::nn::LSTM ref(torch::nn::LSTMOptions(feats.spatial_size(), 24).batch_first(true));
   {
@@ -139,7 +138,7 @@ TEST(DirectionalNet, WrittenOutLstmMatchesTorchLstmAndSparseMatchesDense) {
                           torch::from_blob(value.data(), {n}, torch::kFloat32),
                           torch::from_blob(offsets.data(), {B + 1}, torch::kInt64), tt);
   EXPECT_LT((sparse - dense).abs().max().item<float>(), 1e-5f);
-  DirectionalNet spatial(DirectionalVariant::kSpatial, feats.spatial_size(), 4, 0);
+  Net spatial(Variant::kSpatial, feats.spatial_size(), 4, 0);
   const auto sd = spatial->forward(ts, tt);
   const auto ss =
       spatial->forward_sparse(torch::from_blob(index.data(), {n}, torch::kInt64),
@@ -155,7 +154,7 @@ TEST(DirectionalLoss, NllMatchesCoreVonMisesMixture) {
   raw.narrow(1, 2 * R, R)
       .mul_(3.0);  // log kappa over roughly [-20, 20]: both clamps and large kappa
   const auto theta = (torch::rand({B}, torch::kFloat64) * 2 - 1) * M_PI;
-  const auto p = DecodeDirectionalHead(raw, R, 1e6);  // large kappa allowed here
+  const auto p = DecodeVonMisesHead(raw, R, 1e6);  // large kappa allowed here
   const auto nll = VonMisesMixtureNll(p, theta);
   for (int b = 0; b < B; ++b) {
     Eigen::VectorXd alpha(R), mu(R), kappa(R);
@@ -181,7 +180,7 @@ TEST(DirectionalLoss, GradientsMatchFiniteDifferencesAndPenaltyIsAdded) {
   auto raw = (torch::randn({B, 3 * R}, torch::kFloat64)).requires_grad_(true);
   const auto theta = (torch::rand({B}, torch::kFloat64) * 2 - 1) * M_PI;
   auto loss_of = [&](const torch::Tensor& r) {
-    return VonMisesMixtureNll(DecodeDirectionalHead(r, R), theta).mean();
+    return VonMisesMixtureNll(DecodeVonMisesHead(r, R), theta).mean();
   };
   const auto loss = loss_of(raw);
   loss.backward();
@@ -196,14 +195,14 @@ TEST(DirectionalLoss, GradientsMatchFiniteDifferencesAndPenaltyIsAdded) {
       EXPECT_NEAR(grad[b][k].item<double>(), fd, 1e-6) << b << " " << k;
     }
   // L_reg = mean NLL + lambda_a ||W_a||^2 + lambda_k ||W_k||^2 (+ lambda_m ||W_m||^2, 0 here).
-  DirectionalNet net(DirectionalVariant::kSpatial, 6, R, 0);
+  Net net(Variant::kSpatial, 6, R, 0);
   const auto s = torch::rand({B, 6});
   const auto t = torch::rand({B, 1});
   const auto th = theta.to(torch::kFloat32);
-  const DirectionalPenalty pen{0.01, 0.0, 0.02};
-  const double with = DirectionalLoss(*net, s, t, th, pen).item<double>();
+  const Penalty pen{0.01, 0.0, 0.02};
+  const double with = Loss(*net, s, t, th, pen).item<double>();
   const double nll =
-      VonMisesMixtureNll(DecodeDirectionalHead(net->forward(s, t), R), th).mean().item<double>();
+      VonMisesMixtureNll(DecodeVonMisesHead(net->forward(s, t), R), th).mean().item<double>();
   const double expected = 0.01 * net->alpha_head()->weight.square().sum().item<double>() +
                           0.02 * net->kappa_head()->weight.square().sum().item<double>();
   EXPECT_GT(expected, 0);
@@ -215,9 +214,9 @@ TEST(DirectionalLoss, GradientsMatchFiniteDifferencesAndPenaltyIsAdded) {
   EXPECT_GT(net->alpha_head()->weight.grad().abs().max().item<float>(), 0.0f);
 }
 
-DirectionalExperimentConfig TinyCrossing() {
-  DirectionalExperimentConfig c;
-  c.data.format = DirectionalSource::kCrossing;
+ExperimentConfig TinyCrossing() {
+  ExperimentConfig c;
+  c.data.format = Source::kCrossing;
   c.data.crossing.flow.num_tracks = 120;
   c.data.crossing.flow.duration = 60;
   c.features.x_min = 0;
@@ -252,13 +251,13 @@ std::string ReadFile(const std::string& path) {
 
 TEST(DirectionalPipeline, TinyCrossingTrainExportEval) {
   testing::TempDir dir;
-  const DirectionalExperimentConfig c = TinyCrossing();
-  const DirectionalRunResult r = RunDirectionalExperiment(c, dir.path(), false);
+  const ExperimentConfig c = TinyCrossing();
+  const RunResult r = RunExperiment(c, dir.path(), false);
   EXPECT_FALSE(r.interrupted);
   EXPECT_EQ(r.report.folds_evaluated, 2);
   for (const char* m :
        {"spatiotemporal", "spatial", "grid_um", "grid_mm", "grid_um_dense", "grid_mm_dense"}) {
-    const DirectionalMethodMetrics* mm = r.report.Find(m);
+    const MethodMetrics* mm = r.report.Find(m);
     ASSERT_NE(mm, nullptr) << m;
     EXPECT_EQ(mm->al.size(), 2u);
     EXPECT_TRUE(std::isfinite(mm->MeanAl()) && mm->MeanAl() > 0) << m;
@@ -270,83 +269,77 @@ TEST(DirectionalPipeline, TinyCrossingTrainExportEval) {
     EXPECT_NE(json.find(key), std::string::npos) << key << " not in " << json;
   EXPECT_EQ(json.find("null"), std::string::npos);
   EXPECT_NE(ReadFile(dir.File("eval.csv")).find("grid_mm,1,"), std::string::npos);
-  const DirectionalMap m = DirectionalMap::Load(dir.File("model.h5"));
-  EXPECT_EQ(m.variant(), DirectionalVariant::kSpatiotemporal);
+  const Map m = Map::Load(dir.File("model.h5"));
+  EXPECT_EQ(m.variant(), Variant::kSpatiotemporal);
   EXPECT_EQ(m.components(), 3);
-  EXPECT_EQ(DirectionalMap::Load(dir.File("model_spatial.h5")).variant(),
-            DirectionalVariant::kSpatial);
+  EXPECT_EQ(Map::Load(dir.File("model_spatial.h5")).variant(), Variant::kSpatial);
   for (const char* f : {"plots/directions.png", "plots/trajectories.png",
                         "folds/1/spatial/metrics.csv", "config.yaml"})
     EXPECT_TRUE(std::filesystem::exists(dir.File(f))) << f;
   // A fresh start refuses the used directory; resume finds everything done and gives the same
   // report.
-  testing::ExpectErrorContains([&] { RunDirectionalExperiment(c, dir.path(), false); },
+  testing::ExpectErrorContains([&] { RunExperiment(c, dir.path(), false); },
                                {"already holds a run"});
-  const DirectionalRunResult again = RunDirectionalExperiment(c, dir.path(), true);
+  const RunResult again = RunExperiment(c, dir.path(), true);
   EXPECT_DOUBLE_EQ(again.report.Find("spatiotemporal")->MeanAl(),
                    r.report.Find("spatiotemporal")->MeanAl());
-  DirectionalExperimentConfig other = c;
+  ExperimentConfig other = c;
   other.train.epochs = 4;
-  testing::ExpectErrorContains([&] { RunDirectionalExperiment(other, dir.path(), true); },
-                               {"differs"});
+  testing::ExpectErrorContains([&] { RunExperiment(other, dir.path(), true); }, {"differs"});
 }
 
 TEST(DirectionalPipeline, BadInput) {
   testing::TempDir dir;
-  DirectionalExperimentConfig c = TinyCrossing();
-  c.data.format = DirectionalSource::kGridCsv;
+  ExperimentConfig c = TinyCrossing();
+  c.data.format = Source::kGridCsv;
   // NaN coordinates.
   testing::WriteText(dir.File("nan.csv"),
                      "x_m,y_m,orientation_raw_rad,path_id\n1,2,0,0\nnan,2.5,0,0\n1,3,0,0\n");
   c.data.file = dir.File("nan.csv");
-  testing::ExpectErrorContains([&] { LoadDirectionalSamples(c); }, {"nan.csv"});
+  testing::ExpectErrorContains([&] { LoadSamples(c); }, {"nan.csv"});
   // No data rows.
   testing::WriteText(dir.File("empty.csv"), "x_m,y_m,orientation_raw_rad,path_id\n");
   c.data.file = dir.File("empty.csv");
-  testing::ExpectErrorContains([&] { RunDirectionalExperiment(c, dir.File("run"), false); },
-                               {"empty.csv"});
+  testing::ExpectErrorContains([&] { RunExperiment(c, dir.File("run"), false); }, {"empty.csv"});
   // Config errors name the key.
   testing::ExpectErrorContains(
       [&] {
-        config::ExperimentConfigFromYaml<DirectionalExperimentConfig>(
+        config::ExperimentConfigFromYaml<ExperimentConfig>(
             "model: directional\ndata: {format: grid_csv}\n", "x.yaml");
       },
       {"x.yaml", "data.file"});
   testing::ExpectErrorContains(
       [&] {
-        config::ExperimentConfigFromYaml<DirectionalExperimentConfig>(
+        config::ExperimentConfigFromYaml<ExperimentConfig>(
             "model: directional\nfeatures: {cells: 3}\n", "x.yaml");
       },
       {"x.yaml", "features.cells"});
   testing::ExpectErrorContains(
       [&] {
-        config::ExperimentConfigFromYaml<DirectionalExperimentConfig>("model: span_predictor\n",
-                                                                      "x.yaml");
+        config::ExperimentConfigFromYaml<ExperimentConfig>("model: span_predictor\n", "x.yaml");
       },
       {"'model'", "directional"});
   // Artifacts of the other kind, both ways.
   const std::string span = dir.File("span.h5");
   testing::WriteRandomSpanArtifact(span, {});
-  testing::ExpectErrorContains([&] { LoadDirectionalNetFromArtifact(span); },
-                               {"expected 'directional_map'"});
-  DirectionalNet net(DirectionalVariant::kSpatial, 35, 5, 0);
+  testing::ExpectErrorContains([&] { LoadNetFromArtifact(span); }, {"expected 'directional_map'"});
+  Net net(Variant::kSpatial, 35, 5, 0);
   const std::string dm = dir.File("dm.h5");
-  WriteDirectionalArtifact(*net, Features(), "model: directional\n", 0, dm);
-  testing::ExpectErrorContains([&] { SpanPredictor::Load(dm); }, {"expected 'span_predictor'"});
-  DirectionalFeatureConfig unresolved = Features();
+  WriteArtifact(*net, TestFeatureConfig(), "model: directional\n", 0, dm);
+  testing::ExpectErrorContains([&] { span::Predictor::Load(dm); }, {"expected 'span_predictor'"});
+  FeatureConfig unresolved = TestFeatureConfig();
   unresolved.auto_extent = true;
-  testing::ExpectErrorContains([&] { WriteDirectionalArtifact(*net, unresolved, "", 0, dm); },
-                               {"unresolved"});
+  testing::ExpectErrorContains([&] { WriteArtifact(*net, unresolved, "", 0, dm); }, {"unresolved"});
 }
 
 TEST(DirectionalConfigs, ShippedConfigsLoad) {
   const char* src = std::getenv("FORESIGHT_SOURCE_DIR");
   ASSERT_NE(src, nullptr);
   for (const char* name : {"p1", "p2", "crossing", "edinburgh"})
-    EXPECT_NO_THROW(config::LoadExperimentConfig<DirectionalExperimentConfig>(
+    EXPECT_NO_THROW(config::LoadExperimentConfig<ExperimentConfig>(
         std::string(src) + "/configs/directional/" + name + ".yaml", {}))
         << name;
 }
 
 }  // namespace
-}  // namespace foresight
+}  // namespace foresight::directional

@@ -38,7 +38,7 @@ TEST(Docs, ShippedNavigationConfigsLoad) {
     EXPECT_GE(c.episodes, 20);
   }
   for (const char* name : {"predictor", "predictor_thor"})
-    EXPECT_NO_THROW(config::LoadExperimentConfig<SpanExperimentConfig>(
+    EXPECT_NO_THROW(config::LoadExperimentConfig<span::ExperimentConfig>(
         src + "/configs/navigation/" + name + ".yaml", {}))
         << name;
 }
@@ -47,11 +47,11 @@ TEST(Docs, ShippedConfigsLoad) {
   const std::string src = std::getenv("FORESIGHT_SOURCE_DIR");
   for (const char* name : {"quickstart", "span/eth_ucy_eth", "span/eth_ucy_hotel",
                            "span/eth_ucy_univ", "span/eth_ucy_zara1"})
-    EXPECT_NO_THROW(
-        config::LoadExperimentConfig<SpanExperimentConfig>(src + "/configs/" + name + ".yaml", {}))
+    EXPECT_NO_THROW(config::LoadExperimentConfig<span::ExperimentConfig>(
+        src + "/configs/" + name + ".yaml", {}))
         << name;
   for (const char* name : {"intel", "intel_fusion", "synthetic", "synthetic_fusion"})
-    EXPECT_NO_THROW(config::LoadExperimentConfig<OccupancyExperimentConfig>(
+    EXPECT_NO_THROW(config::LoadExperimentConfig<occupancy::ExperimentConfig>(
         src + "/configs/occupancy/" + name + ".yaml", {}))
         << name;
 }

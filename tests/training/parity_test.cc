@@ -21,13 +21,13 @@ namespace {
 
 struct Trained {
   testing::TempDir dir;
-  SpanExperimentConfig config;
+  span::ExperimentConfig config;
   std::string artifact;
 };
 
 std::unique_ptr<Trained> TrainTiny(int components, UParam u) {
   auto t = std::make_unique<Trained>();
-  SpanExperimentConfig& c = t->config;
+  span::ExperimentConfig& c = t->config;
   c.data.synthetic.num_tracks = 150;
   c.network.hidden = {24, 24};
   c.network.components = components;
@@ -36,8 +36,8 @@ std::unique_ptr<Trained> TrainTiny(int components, UParam u) {
   c.train.epochs = 3;
   c.train.batch_size = 64;
   c.train.progress = ProgressStyle::kNone;
-  TrainSpan(c, t->dir.path(), false);
-  t->artifact = ExportSpan(t->dir.path());
+  span::TrainRun(c, t->dir.path(), false);
+  t->artifact = span::ExportRun(t->dir.path());
   return t;
 }
 
@@ -45,8 +45,8 @@ class Parity : public ::testing::TestWithParam<std::pair<int, UParam>> {};
 
 TEST_P(Parity, EngineMatchesLibTorchOnRandomInputs) {
   const auto t = TrainTiny(GetParam().first, GetParam().second);
-  const SpanPredictor engine = SpanPredictor::Load(t->artifact);
-  LoadedSpanNet torch_net = LoadSpanNetFromArtifact(t->artifact);
+  const span::Predictor engine = span::Predictor::Load(t->artifact);
+  span::LoadedNet torch_net = span::LoadNetFromArtifact(t->artifact);
   const h5::File f = h5::File::Open(t->artifact);
   const Eigen::VectorXd mean = f.ReadMatrixD("/normalisation/input_mean").col(0);
   const Eigen::VectorXd std = f.ReadMatrixD("/normalisation/input_std").col(0);
@@ -78,7 +78,7 @@ TEST_P(Parity, EngineMatchesLibTorchOnRandomInputs) {
     // Decoded distributions agree: the engine density of a world-frame W equals the LibTorch NLL
     // of the same trajectory expressed in the ego frame (rotation invariance of the density).
     engine.Predict(past, &ws, &dist);
-    const auto params = DecodeHead(raw.to(torch::kFloat64), L);
+    const auto params = span::DecodeHead(raw.to(torch::kFloat64), L);
     const int m = L.basis;
     // A plausible W: component 0's mean plus a small perturbation (keeps the NLL moderate).
     auto w_ego = params.mean.select(1, 0) + 0.05 * torch::randn({1, m, 2}, torch::kFloat64);
@@ -87,7 +87,7 @@ TEST_P(Parity, EngineMatchesLibTorchOnRandomInputs) {
       const Eigen::Vector2d e(w_ego[0][j][0].item<double>(), w_ego[0][j][1].item<double>());
       w_world.row(j) = (frame.rotation * e).transpose();
     }
-    const double nll_torch = MixtureNll(params, w_ego, L)[0].item<double>();
+    const double nll_torch = span::MixtureNll(params, w_ego, L)[0].item<double>();
     MatrixNormalMixture mix;
     for (int r = 0; r < dist.components(); ++r) {
       mix.weights.push_back(dist.alpha(r));
@@ -115,7 +115,7 @@ INSTANTIATE_TEST_SUITE_P(Heads, Parity,
 
 TEST(Pipeline, TrainExportEvalWritesEveryKey) {
   const auto t = TrainTiny(1, UParam::kCholesky);
-  const SpanEvalReport r = EvaluateSpan(t->config, t->artifact, t->dir.path());
+  const span::EvalReport r = span::Evaluate(t->config, t->artifact, t->dir.path());
   EXPECT_GT(r.windows, 0);
   std::ifstream in(t->dir.File("eval.json"));
   std::stringstream ss;
@@ -128,38 +128,38 @@ TEST(Pipeline, TrainExportEvalWritesEveryKey) {
   EXPECT_TRUE(std::isfinite(r.model.ade) && std::isfinite(r.model.nll) && std::isfinite(r.cv.nll));
   EXPECT_LE(r.model.best_of_n_ade, r.model.ade + 1e-9);
   // The artifact carries the resolved config and the seed.
-  const Artifact art = Artifact::Open(t->artifact, kSpanModelType);
+  const Artifact art = Artifact::Open(t->artifact, span::kModelType);
   EXPECT_EQ(art.config_yaml(), config::ToYaml(t->config));
   EXPECT_EQ(art.seed(), t->config.seed);
 }
 
 TEST(Pipeline, EvalRefusesDataWindowsOrSeedOtherThanTrainedWith) {
   const auto t = TrainTiny(1, UParam::kCholesky);
-  SpanExperimentConfig c = t->config;
+  span::ExperimentConfig c = t->config;
   c.data.synthetic.num_tracks = 100;
   testing::ExpectErrorContains(
-      [&] { EvaluateSpan(c, t->artifact, t->dir.path()); },
+      [&] { span::Evaluate(c, t->artifact, t->dir.path()); },
       {t->artifact, "data.synthetic.num_tracks = 150, not 100", "config.yaml"});
   c = t->config;
   c.windows.predicted = 10;
-  testing::ExpectErrorContains([&] { EvaluateSpan(c, t->artifact, t->dir.path()); },
+  testing::ExpectErrorContains([&] { span::Evaluate(c, t->artifact, t->dir.path()); },
                                {"windows.predicted = 12, not 10"});
   c = t->config;
   c.seed = 5;
-  testing::ExpectErrorContains([&] { EvaluateSpan(c, t->artifact, t->dir.path()); },
+  testing::ExpectErrorContains([&] { span::Evaluate(c, t->artifact, t->dir.path()); },
                                {"seed = 0, not 5"});
   // Where the files are and how to evaluate may differ.
   c = t->config;
   c.data.root = "/elsewhere";
   c.eval.num_samples = 5;
   c.eval.plot_tracks = 0;
-  EXPECT_GT(EvaluateSpan(c, t->artifact, t->dir.path()).windows, 0);
+  EXPECT_GT(span::Evaluate(c, t->artifact, t->dir.path()).windows, 0);
 }
 
-SpanEvalReport ReportWith(double value, int val_windows) {
-  SpanEvalReport r;
+span::EvalReport ReportWith(double value, int val_windows) {
+  span::EvalReport r;
   r.windows = 10;
-  for (SpanMetrics* m : {&r.model, &r.cv, &r.val_model, &r.val_cv})
+  for (span::Metrics* m : {&r.model, &r.cv, &r.val_model, &r.val_cv})
     m->ade = m->fde = m->nll = m->best_of_n_ade = m->best_of_n_fde = value;
   r.val_windows = val_windows;
   return r;
@@ -194,12 +194,12 @@ TEST(EvalJson, EmptySplitsAreErrors) {
   empty.past.resize(0, empty.past.cols());
   empty.future.resize(0, empty.future.cols());
   empty.track.clear();
-  SpanEvalConfig ec;
+  span::EvalConfig ec;
   ec.num_samples = 2;
-  EXPECT_GT(EvaluateSpanOn(artifact, windows, windows, ec).windows, 0);
-  testing::ExpectErrorContains([&] { EvaluateSpanOn(artifact, windows, empty, ec); },
+  EXPECT_GT(span::EvaluateOn(artifact, windows, windows, ec).windows, 0);
+  testing::ExpectErrorContains([&] { span::EvaluateOn(artifact, windows, empty, ec); },
                                {artifact, "no windows"});
-  testing::ExpectErrorContains([&] { EvaluateSpanOn(artifact, empty, windows, ec); },
+  testing::ExpectErrorContains([&] { span::EvaluateOn(artifact, empty, windows, ec); },
                                {"constant-velocity", "no training windows"});
 }
 

@@ -17,8 +17,8 @@
 namespace foresight {
 namespace {
 
-SpanExperimentConfig TinyConfig() {
-  SpanExperimentConfig c;
+span::ExperimentConfig TinyConfig() {
+  span::ExperimentConfig c;
   c.data.synthetic.num_tracks = 120;
   c.network.hidden = {16, 16};
   c.basis.num_centres = 5;
@@ -30,9 +30,9 @@ SpanExperimentConfig TinyConfig() {
 }
 
 std::vector<torch::Tensor> Parameters(const std::string& checkpoint,
-                                      const SpanExperimentConfig& c) {
-  SpanNet net(2 * c.windows.observed, c.network,
-              HeadLayout{c.basis.num_centres, c.network.components, c.network.u_param});
+                                      const span::ExperimentConfig& c) {
+  span::Net net(2 * c.windows.observed, c.network,
+                HeadLayout{c.basis.num_centres, c.network.components, c.network.u_param});
   LoadCheckpointModel(checkpoint, net.ptr().get());
   std::vector<torch::Tensor> out;
   for (const auto& p : net->parameters()) out.push_back(p.detach().clone());
@@ -52,17 +52,17 @@ std::string LossColumns(const std::string& path) {
 
 TEST(Trainer, ResumeAfterAnInterruptionIsBitIdentical) {
   testing::TempDir dir;
-  const SpanExperimentConfig c = TinyConfig();
-  const auto full = TrainSpan(c, dir.File("full"), false);
+  const span::ExperimentConfig c = TinyConfig();
+  const auto full = span::TrainRun(c, dir.File("full"), false);
   EXPECT_EQ(full.reason, TerminationReason::kMaxEpochs);
   EXPECT_EQ(full.epochs_completed, 4);
 
   TrainHooks stop_after_two;
   stop_after_two.continue_after_epoch = [](int completed) { return completed < 2; };
-  const auto first = TrainSpan(c, dir.File("resumed"), false, stop_after_two);
+  const auto first = span::TrainRun(c, dir.File("resumed"), false, stop_after_two);
   EXPECT_EQ(first.reason, TerminationReason::kInterrupted);
   EXPECT_EQ(first.epochs_completed, 2);
-  const auto second = TrainSpan(c, dir.File("resumed"), true);
+  const auto second = span::TrainRun(c, dir.File("resumed"), true);
   EXPECT_EQ(second.reason, TerminationReason::kMaxEpochs);
   EXPECT_EQ(second.epochs_completed, 4);
 
@@ -169,32 +169,32 @@ std::string ArtifactDigest(const std::string& path) {
 // pipeline (train, export, eval) of a resumed run must match the uninterrupted one exactly.
 TEST(Trainer, ResumedRunExportsAndEvaluatesTheSameModelAsAnUninterruptedOne) {
   testing::TempDir dir;
-  SpanExperimentConfig c = TinyConfig();
+  span::ExperimentConfig c = TinyConfig();
   c.train.epochs = 8;
   c.train.patience = 3;
   c.eval.plot_tracks = 0;
-  const auto full = TrainSpan(c, dir.File("full"), false);
-  TrainSpan(c, dir.File("resumed"), false, StopAfter(2));
-  const auto resumed = TrainSpan(c, dir.File("resumed"), true);
+  const auto full = span::TrainRun(c, dir.File("full"), false);
+  span::TrainRun(c, dir.File("resumed"), false, StopAfter(2));
+  const auto resumed = span::TrainRun(c, dir.File("resumed"), true);
   ASSERT_GT(full.best_epoch, 2) << "the test needs a best epoch after the interruption";
   EXPECT_EQ(resumed.reason, full.reason);
   EXPECT_EQ(resumed.epochs_completed, full.epochs_completed);
   EXPECT_EQ(resumed.best_epoch, full.best_epoch);
   EXPECT_EQ(resumed.best_val_loss, full.best_val_loss);
 
-  const std::string a = ExportSpan(dir.File("full"));
-  const std::string b = ExportSpan(dir.File("resumed"));
+  const std::string a = span::ExportRun(dir.File("full"));
+  const std::string b = span::ExportRun(dir.File("resumed"));
   EXPECT_EQ(ArtifactDigest(a), ArtifactDigest(b));
-  EvaluateSpan(c, a, dir.File("full"));
-  EvaluateSpan(c, b, dir.File("resumed"));
+  span::Evaluate(c, a, dir.File("full"));
+  span::Evaluate(c, b, dir.File("resumed"));
   EXPECT_EQ(testing::ReadText(dir.File("full/eval.json")),
             testing::ReadText(dir.File("resumed/eval.json")));
 }
 
 TEST(Trainer, MetricsRowPrecedesItsCheckpointAndResumeRewritesIt) {
   testing::TempDir dir;
-  const SpanExperimentConfig c = TinyConfig();
-  TrainSpan(c, dir.File("full"), false);
+  const span::ExperimentConfig c = TinyConfig();
+  span::TrainRun(c, dir.File("full"), false);
   // The checkpoint of epoch 3 cannot be written (its temporary file is taken by a directory).
   const std::string run = dir.File("failed");
   TrainHooks hooks;
@@ -202,10 +202,10 @@ TEST(Trainer, MetricsRowPrecedesItsCheckpointAndResumeRewritesIt) {
     if (completed == 2) std::filesystem::create_directories(run + "/checkpoints/last.pt.tmp");
     return true;
   };
-  EXPECT_ANY_THROW(TrainSpan(c, run, false, hooks));
+  EXPECT_ANY_THROW(span::TrainRun(c, run, false, hooks));
   EXPECT_EQ(Lines(run + "/metrics.csv").size(), 4u) << "header and the rows of epochs 1-3";
   std::filesystem::remove(run + "/checkpoints/last.pt.tmp");
-  const auto resumed = TrainSpan(c, run, true);  // from the checkpoint of epoch 2
+  const auto resumed = span::TrainRun(c, run, true);  // from the checkpoint of epoch 2
   EXPECT_EQ(resumed.epochs_completed, 4);
   EXPECT_EQ(LossColumns(dir.File("full") + "/metrics.csv"), LossColumns(run + "/metrics.csv"));
 }
@@ -214,29 +214,29 @@ TEST(Trainer, MetricsRowPrecedesItsCheckpointAndResumeRewritesIt) {
 // the last good checkpoint (LibTorch's file writer used to abort the process).
 TEST(Trainer, FullDiskDuringACheckpointKeepsThePreviousOne) {
   testing::TempDir dir;
-  const SpanExperimentConfig c = TinyConfig();
+  const span::ExperimentConfig c = TinyConfig();
   std::unique_ptr<testing::ScopedFileSizeLimit> limit;
   TrainHooks hooks;
   hooks.continue_after_epoch = [&](int completed) {
     if (completed == 2) limit = std::make_unique<testing::ScopedFileSizeLimit>(4096);
     return true;
   };
-  testing::ExpectErrorContains([&] { TrainSpan(c, dir.path(), false, hooks); },
+  testing::ExpectErrorContains([&] { span::TrainRun(c, dir.path(), false, hooks); },
                                {"checkpoints/", "cannot write", "the previous ", ".pt is kept"});
   limit.reset();
   EXPECT_FALSE(std::filesystem::exists(dir.File("checkpoints/last.pt.tmp")));
   EXPECT_FALSE(std::filesystem::exists(dir.File("checkpoints/best.pt.tmp")));
-  const auto resumed = TrainSpan(c, dir.path(), true);  // from the checkpoint of epoch 2
+  const auto resumed = span::TrainRun(c, dir.path(), true);  // from the checkpoint of epoch 2
   EXPECT_EQ(resumed.epochs_completed, 4);
 }
 
 TEST(Trainer, ResumeRestartsAMissingMetricsFileWithItsHeader) {
   testing::TempDir dir;
-  const SpanExperimentConfig c = TinyConfig();
-  TrainSpan(c, dir.path(), false, StopAfter(2));
+  const span::ExperimentConfig c = TinyConfig();
+  span::TrainRun(c, dir.path(), false, StopAfter(2));
   const auto header = Lines(dir.File("metrics.csv")).at(0);
   std::filesystem::remove(dir.File("metrics.csv"));
-  TrainSpan(c, dir.path(), true);
+  span::TrainRun(c, dir.path(), true);
   const auto lines = Lines(dir.File("metrics.csv"));
   ASSERT_EQ(lines.size(), 3u);
   EXPECT_EQ(lines[0], header);
@@ -246,54 +246,54 @@ TEST(Trainer, ResumeRestartsAMissingMetricsFileWithItsHeader) {
 
 TEST(Trainer, CorruptMetricsIsAClearErrorOnResume) {
   testing::TempDir dir;
-  const SpanExperimentConfig c = TinyConfig();
-  TrainSpan(c, dir.path(), false, StopAfter(1));
+  const span::ExperimentConfig c = TinyConfig();
+  span::TrainRun(c, dir.path(), false, StopAfter(1));
   testing::WriteText(dir.File("metrics.csv"), "epoch,train_loss\nfirst,1.0\n");
-  testing::ExpectErrorContains([&] { TrainSpan(c, dir.path(), true); },
+  testing::ExpectErrorContains([&] { span::TrainRun(c, dir.path(), true); },
                                {dir.File("metrics.csv") + ":2", "epoch number"});
 }
 
 TEST(Trainer, EmptyValidationSplitIsAClearError) {
   testing::TempDir dir;
-  SpanExperimentConfig c = TinyConfig();
+  span::ExperimentConfig c = TinyConfig();
   c.data.val_fraction = 0.0;
-  testing::ExpectErrorContains([&] { TrainSpan(c, dir.path(), false); },
+  testing::ExpectErrorContains([&] { span::TrainRun(c, dir.path(), false); },
                                {"no validation windows", "data.val_fraction"});
 }
 
 TEST(Trainer, FreshStartRefusesARunDirectoryThatHoldsARun) {
   testing::TempDir dir;
-  SpanExperimentConfig c = TinyConfig();
+  span::ExperimentConfig c = TinyConfig();
   c.train.epochs = 1;
   // An attempt that failed before training leaves config.yaml and log.txt: that is no run yet.
   c.data.val_fraction = 0.0;
-  EXPECT_THROW(TrainSpan(c, dir.path(), false), Error);
+  EXPECT_THROW(span::TrainRun(c, dir.path(), false), Error);
   c.data.val_fraction = 0.1;
-  TrainSpan(c, dir.path(), false);
+  span::TrainRun(c, dir.path(), false);
   testing::ExpectErrorContains(
-      [&] { TrainSpan(c, dir.path(), false); },
+      [&] { span::TrainRun(c, dir.path(), false); },
       {dir.path(), "already holds a run (checkpoints/)", "--resume", "--run-dir"});
   for (const char* name : {"model.h5", "eval.json"}) {
     testing::TempDir other;
     testing::WriteText(other.File(name), "x");
-    testing::ExpectErrorContains([&] { TrainSpan(c, other.path(), false); },
+    testing::ExpectErrorContains([&] { span::TrainRun(c, other.path(), false); },
                                  {other.path(), std::string("(") + name + ")", "--resume"});
   }
   // A run killed in epoch 1 leaves metrics.csv but no checkpoint: nothing to resume, so a fresh
   // start may replace it.
   testing::TempDir killed;
   testing::WriteText(killed.File("metrics.csv"), "epoch,train_loss\n1,0.5\n");
-  EXPECT_NO_THROW(TrainSpan(c, killed.path(), false));
+  EXPECT_NO_THROW(span::TrainRun(c, killed.path(), false));
 }
 
 TEST(Trainer, InterruptedBeforeTheFirstCheckpointSuggestsNoResume) {
   testing::TempDir dir;
-  const SpanExperimentConfig c = TinyConfig();
+  const span::ExperimentConfig c = TinyConfig();
   const std::atomic<bool> interrupted{true};
   TrainHooks hooks;
   hooks.interrupt = &interrupted;
   ::testing::internal::CaptureStderr();
-  const auto s = TrainSpan(c, dir.path(), false, hooks);
+  const auto s = span::TrainRun(c, dir.path(), false, hooks);
   const std::string err = ::testing::internal::GetCapturedStderr();
   EXPECT_EQ(s.reason, TerminationReason::kInterrupted);
   EXPECT_EQ(s.epochs_completed, 0);
@@ -301,7 +301,7 @@ TEST(Trainer, InterruptedBeforeTheFirstCheckpointSuggestsNoResume) {
   EXPECT_EQ(err.find("--resume"), std::string::npos) << err;
   // Nothing was saved, so starting again in the same directory is allowed.
   EXPECT_FALSE(std::filesystem::exists(dir.File("metrics.csv")));
-  EXPECT_EQ(TrainSpan(c, dir.path(), false, StopAfter(1)).epochs_completed, 1);
+  EXPECT_EQ(span::TrainRun(c, dir.path(), false, StopAfter(1)).epochs_completed, 1);
 }
 
 TEST(Trainer, SummaryJsonHasNoInfinityOrNan) {
@@ -335,11 +335,12 @@ TEST(Trainer, InterruptFlagRestoresThePreviousHandlers) {
 
 TEST(Trainer, ResumeRefusesADifferentConfig) {
   testing::TempDir dir;
-  SpanExperimentConfig c = TinyConfig();
+  span::ExperimentConfig c = TinyConfig();
   c.train.epochs = 1;
-  TrainSpan(c, dir.path(), false);
+  span::TrainRun(c, dir.path(), false);
   c.train.learning_rate = 0.5;
-  testing::ExpectErrorContains([&] { TrainSpan(c, dir.path(), true); }, {"config.yaml", "differs"});
+  testing::ExpectErrorContains([&] { span::TrainRun(c, dir.path(), true); },
+                               {"config.yaml", "differs"});
 }
 
 /// A task whose loss turns NaN in its third epoch.
@@ -383,15 +384,15 @@ TEST(Trainer, NonFiniteLossStopsCleanlyAndKeepsTheLastGoodCheckpoint) {
 
 TEST(Trainer, CorruptOrMissingCheckpointIsAClearError) {
   testing::TempDir dir;
-  SpanExperimentConfig c = TinyConfig();
+  span::ExperimentConfig c = TinyConfig();
   c.train.epochs = 1;
-  TrainSpan(c, dir.path(), false);
+  span::TrainRun(c, dir.path(), false);
   const std::string ckpt = dir.File("checkpoints/last.pt");
   testing::Truncate(ckpt, std::filesystem::file_size(ckpt) / 3);
-  testing::ExpectErrorContains([&] { TrainSpan(c, dir.path(), true); },
+  testing::ExpectErrorContains([&] { span::TrainRun(c, dir.path(), true); },
                                {ckpt, "no checksum trailer (truncated"});
   testing::TempDir empty;
-  testing::ExpectErrorContains([&] { TrainSpan(c, empty.path(), true); },
+  testing::ExpectErrorContains([&] { span::TrainRun(c, empty.path(), true); },
                                {"no config.yaml to resume from"});
 }
 
@@ -399,9 +400,9 @@ TEST(Trainer, CorruptOrMissingCheckpointIsAClearError) {
 // Its checksum now refuses it before anything is read, for resume and for export alike.
 TEST(Trainer, CheckpointWithFlippedBytesIsRefused) {
   testing::TempDir dir;
-  SpanExperimentConfig c = TinyConfig();
+  span::ExperimentConfig c = TinyConfig();
   c.train.epochs = 1;
-  TrainSpan(c, dir.path(), false);
+  span::TrainRun(c, dir.path(), false);
   for (const char* name : {"checkpoints/last.pt", "checkpoints/best.pt"}) {
     std::string bytes = testing::ReadText(dir.File(name));
     ASSERT_GT(bytes.size(), 1000u);
@@ -409,9 +410,9 @@ TEST(Trainer, CheckpointWithFlippedBytesIsRefused) {
     std::ofstream out(dir.File(name), std::ios::binary | std::ios::trunc);
     out << bytes;
   }
-  testing::ExpectErrorContains([&] { TrainSpan(c, dir.path(), true); },
+  testing::ExpectErrorContains([&] { span::TrainRun(c, dir.path(), true); },
                                {dir.File("checkpoints/last.pt"), "checksum does not match"});
-  testing::ExpectErrorContains([&] { ExportSpan(dir.path()); },
+  testing::ExpectErrorContains([&] { span::ExportRun(dir.path()); },
                                {dir.File("checkpoints/best.pt"), "checksum does not match"});
 }
 

@@ -34,7 +34,7 @@ struct ConstrainedSplitConfig {
 };
 
 struct ConstrainedMapConfig {
-  RasterMapKind kind = RasterMapKind::kFastBhm;
+  occupancy::RasterMapKind kind = occupancy::RasterMapKind::kFastBhm;
   double sample_step = 0.1;  ///< labelled points every this many m (cells for occ_traj)
   double spacing = 0.25;     ///< Fast-BHM inducing-point spacing
   double margin = 1.0;       ///< the map covers the raster grown by this much
@@ -43,8 +43,9 @@ struct ConstrainedMapConfig {
   void Serialize(A* a) {
     using config::Range;
     a->VisitEnum("kind", &kind,
-                 config::EnumNames<RasterMapKind>{{RasterMapKind::kFastBhm, "fast_bhm"},
-                                                  {RasterMapKind::kGrid, "grid"}},
+                 config::EnumNames<occupancy::RasterMapKind>{
+                     {occupancy::RasterMapKind::kFastBhm, "fast_bhm"},
+                     {occupancy::RasterMapKind::kGrid, "grid"}},
                  "occupancy map fitted to each scene's obstacle raster (p(m=1|x) and gradient)");
     a->Visit("sample_step", &sample_step, Range::Closed(0.01, 10.0),
              "labelled raster points every this many m (cells for occ_traj)");
@@ -52,7 +53,7 @@ struct ConstrainedMapConfig {
              "Fast-BHM inducing-point spacing (gamma scales as spacing^-2)");
     a->Visit("margin", &margin, Range::Closed(0, 20.0), "the map covers the raster grown by this");
   }
-  RasterMapOptions Options() const { return {kind, sample_step, spacing, margin}; }
+  occupancy::RasterMapOptions Options() const { return {kind, sample_step, spacing, margin}; }
 };
 
 struct KtmConfig {
@@ -140,8 +141,8 @@ struct ConstrainedConfig {
   ConstrainedSplitConfig split;
   WindowConfig windows{10, 15, 1};
   ConstrainedMapConfig map;
-  TrajectoryBasisConfig basis;
-  SpanNetConfig network;
+  span::TrajectoryBasisConfig basis;
+  span::NetConfig network;
   TrainConfig train;
   KtmConfig ktm;
   NaiveConfig naive;

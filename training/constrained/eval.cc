@@ -44,7 +44,7 @@ bool FitSceneMaps(const ConstrainedConfig& c, const std::vector<MapScene>& scene
     const std::string path = run_dir + "/" + SceneMapFile(s);
     if (fs::exists(path)) continue;
     const auto t0 = std::chrono::steady_clock::now();
-    WriteRasterMap(s.raster, c.map.Options(), path, config::ToYaml(c), c.seed);
+    occupancy::WriteRasterMap(s.raster, c.map.Options(), path, config::ToYaml(c), c.seed);
     log::Info("constrained: fitted the map of ", s.name, " (",
               std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
               " s) -> ", path);
@@ -96,9 +96,9 @@ JsonObject Percentiles(const std::vector<double>& v, double scale) {
 /// Monte Carlo estimate of the mixture's C on `map` (rectangle rule over `times`, as the cost):
 /// independent of the quadrature code (positions from TrajectoryDistribution::Position).
 std::pair<double, double> MonteCarloCost(const TrajectoryDistribution& d,
-                                         const Eigen::VectorXd& times, const OccupancyMap& map,
+                                         const Eigen::VectorXd& times, const occupancy::Map& map,
                                          int samples, std::mt19937_64* rng) {
-  MapWorkspace ws = map.MakeWorkspace();
+  occupancy::MapWorkspace ws = map.MakeWorkspace();
   std::normal_distribution<double> normal;
   const int per_time = std::max(50, samples / static_cast<int>(times.size()));
   double c = 0, var = 0;
@@ -169,11 +169,11 @@ std::string EvaluateConstrained(const ConstrainedConfig& c, const ConstrainedDat
   const RunArtifacts art = ArtifactsOf(c, run_dir);
   for (const std::string& a : {art.prior, art.ktm, art.naive})
     FS_THROW_UNLESS(a.empty() || fs::exists(a), a, " is missing; train (or export) the run first");
-  const SpanPredictor prior = SpanPredictor::Load(art.prior);
+  const span::Predictor prior = span::Predictor::Load(art.prior);
   FS_THROW_UNLESS(prior.layout().u_param == UParam::kDiagonal, art.prior,
                   ": the prior's U is not diagonal (network.u_param must be diagonal)");
-  std::optional<SpanPredictor> ktm;
-  if (!art.ktm.empty()) ktm = SpanPredictor::Load(art.ktm);
+  std::optional<span::Predictor> ktm;
+  if (!art.ktm.empty()) ktm = span::Predictor::Load(art.ktm);
   std::optional<NaivePredictor> naive;
   if (!art.naive.empty()) naive = NaivePredictor::Load(art.naive);
 
@@ -206,7 +206,7 @@ std::string EvaluateConstrained(const ConstrainedConfig& c, const ConstrainedDat
   po_ref.order = kReferenceOrder;
 
   struct SceneRuntime {
-    std::unique_ptr<OccupancyMap> map;
+    std::unique_ptr<occupancy::Map> map;
     std::unique_ptr<DistributionProjector> projector, reference, fine;
     // One workspace per operator: each is sized for its map, order and time points.
     std::optional<DistributionProjector::Workspace> ws, ws_reference, ws_fine;
@@ -215,7 +215,7 @@ std::string EvaluateConstrained(const ConstrainedConfig& c, const ConstrainedDat
   auto runtime = [&](int s) -> SceneRuntime& {
     SceneRuntime& r = rt[static_cast<std::size_t>(s)];
     if (!r.map) {
-      r.map = LoadOccupancyMap(run_dir + "/" + SceneMapFile(scenes[static_cast<std::size_t>(s)]));
+      r.map = occupancy::LoadMap(run_dir + "/" + SceneMapFile(scenes[static_cast<std::size_t>(s)]));
       r.projector = std::make_unique<DistributionProjector>(r.map.get(), prior.basis(), times, po);
       r.reference =
           std::make_unique<DistributionProjector>(r.map.get(), prior.basis(), times, po_ref);
@@ -229,9 +229,9 @@ std::string EvaluateConstrained(const ConstrainedConfig& c, const ConstrainedDat
 
   const int n_all = d.test.windows.size();
   const int n = c.eval.max_windows > 0 ? std::min(n_all, c.eval.max_windows) : n_all;
-  SpanPredictor::Workspace pws = prior.MakeWorkspace();
+  span::Predictor::Workspace pws = prior.MakeWorkspace();
   TrajectoryDistribution dist = prior.MakeDistribution(), opt = prior.MakeDistribution();
-  std::optional<SpanPredictor::Workspace> kws;
+  std::optional<span::Predictor::Workspace> kws;
   std::optional<TrajectoryDistribution> kdist;
   if (ktm) {
     kws = ktm->MakeWorkspace();
@@ -339,7 +339,7 @@ std::string EvaluateConstrained(const ConstrainedConfig& c, const ConstrainedDat
 
   JsonObject data;
   data.Set("source", c.data.source).Set("scenes", d.report.scenes);
-  data.Set("map_kind", c.map.kind == RasterMapKind::kGrid ? "grid" : "fast_bhm");
+  data.Set("map_kind", c.map.kind == occupancy::RasterMapKind::kGrid ? "grid" : "fast_bhm");
   data.Set("tracks_read", d.report.tracks_read).Set("tracks_kept", d.report.tracks_kept);
   data.Set("tracks_too_short", d.report.too_short);
   data.Set("tracks_outside_map_frame", d.report.outside_frame);

@@ -21,8 +21,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-SpanModelSpec SpanSpecOf(const LearnerSpec& s) {
-  SpanModelSpec m;
+span::ModelSpec SpanSpecOf(const LearnerSpec& s) {
+  span::ModelSpec m;
   m.observed = s.observed;
   m.predicted = s.predicted;
   m.seconds_per_step = s.seconds_per_step;
@@ -173,11 +173,11 @@ bool TrainPrior(const LearnerSpec& spec, const WindowSet& train, const WindowSet
                   ", the prior of constrained prediction needs diagonal (its KL and cost "
                   "gradients are in the log-diagonal of U)");
   CheckWindows(spec, train, val, "prior", dir);
-  const SpanModelSpec s = SpanSpecOf(spec);
+  const span::ModelSpec s = SpanSpecOf(spec);
   log::Info(resume ? "resuming" : "training", " the prior in ", dir, " (", train.size(), " train, ",
             val.size(), " val windows)");
   const TrainingSummary summary =
-      TrainSpanOnWindows(s, train, val, spec.train, spec.seed, dir, resume, hooks);
+      span::TrainOnWindows(s, train, val, spec.train, spec.seed, dir, resume, hooks);
   if (Interrupted(summary, "prior", dir)) return false;
   ExportPrior(spec, dir, artifact, config_yaml);
   return true;
@@ -185,11 +185,11 @@ bool TrainPrior(const LearnerSpec& spec, const WindowSet& train, const WindowSet
 
 void ExportPrior(const LearnerSpec& spec, const std::string& dir, const std::string& artifact,
                  const std::string& config_yaml) {
-  const SpanPredictorWeights w =
-      SpanWeightsFromCheckpoint(SpanSpecOf(spec), 2 * spec.observed,
-                                CheckpointToExport(dir, "prior"), dir + "/normalisation.h5");
-  SpanPredictor::Save(artifact, w, config_yaml, spec.seed);
-  (void)SpanPredictor::Load(artifact);
+  const span::PredictorWeights w =
+      span::WeightsFromCheckpoint(SpanSpecOf(spec), 2 * spec.observed,
+                                  CheckpointToExport(dir, "prior"), dir + "/normalisation.h5");
+  span::Predictor::Save(artifact, w, config_yaml, spec.seed);
+  (void)span::Predictor::Load(artifact);
 }
 
 bool TrainKtm(const LearnerSpec& spec, const KtmSpec& ktm, const WindowSet& train,
@@ -201,9 +201,9 @@ bool TrainKtm(const LearnerSpec& spec, const KtmSpec& ktm, const WindowSet& trai
   FS_THROW_UNLESS(ktm.references >= 1 && ktm.references <= train.size(), "ktm in ", dir,
                   ": ktm.references = ", ktm.references, " must be in [1, ", train.size(),
                   "] (the training windows)");
-  const SpanModelSpec s = SpanSpecOf(spec);
-  SpanSamples train_s = MakeSpanSamples(s, train);
-  SpanSamples val_s = MakeSpanSamples(s, val);
+  const span::ModelSpec s = SpanSpecOf(spec);
+  span::Samples train_s = span::MakeSamples(s, train);
+  span::Samples val_s = span::MakeSamples(s, val);
   // The references are part of the training state: a resume reads them back.
   const std::string refs_path = dir + "/ktm_references.h5";
   Eigen::MatrixXd refs;
@@ -220,7 +220,7 @@ bool TrainKtm(const LearnerSpec& spec, const KtmSpec& ktm, const WindowSet& trai
   log::Info(resume ? "resuming" : "training", " ktm in ", dir, " (", ktm.references,
             " references, l = ", ktm.lengthscale, " m)");
   const TrainingSummary summary =
-      TrainSpanNet(s, train_s, val_s, spec.train, spec.seed, dir, resume, hooks);
+      span::TrainNet(s, train_s, val_s, spec.train, spec.seed, dir, resume, hooks);
   if (Interrupted(summary, "ktm", dir)) return false;
   ExportKtm(spec, ktm, dir, artifact, config_yaml);
   return true;
@@ -230,13 +230,13 @@ void ExportKtm(const LearnerSpec& spec, const KtmSpec& ktm, const std::string& d
                const std::string& artifact, const std::string& config_yaml) {
   const std::string refs_path = dir + "/ktm_references.h5";
   FS_THROW_UNLESS(fs::exists(refs_path), refs_path, ": missing, nothing to export");
-  SpanPredictorWeights w = SpanWeightsFromCheckpoint(
+  span::PredictorWeights w = span::WeightsFromCheckpoint(
       SpanSpecOf(spec), ktm.references, CheckpointToExport(dir, "ktm"), dir + "/normalisation.h5");
   w.ktm_references =
       h5::File::Open(refs_path).ReadMatrixD("/references", ktm.references, 2 * spec.observed);
   w.ktm_lengthscale = ktm.lengthscale;
-  SpanPredictor::Save(artifact, w, config_yaml, spec.seed);
-  (void)SpanPredictor::Load(artifact);
+  span::Predictor::Save(artifact, w, config_yaml, spec.seed);
+  (void)span::Predictor::Load(artifact);
 }
 
 bool TrainNaive(const LearnerSpec& spec, const NaiveSpec& naive, const WindowSet& train,
@@ -247,19 +247,20 @@ bool TrainNaive(const LearnerSpec& spec, const NaiveSpec& naive, const WindowSet
   const Eigen::MatrixXd x_train = EgoPasts(train, rotate), x_val = EgoPasts(val, rotate);
   fs::create_directories(dir);
   const std::string norm_path = dir + "/normalisation.h5";
-  const InputNormalisation norm =
-      resume ? ReadInputNormalisation(norm_path) : FitInputNormalisation(x_train);
+  const span::InputNormalisation norm =
+      resume ? span::ReadInputNormalisation(norm_path) : span::FitInputNormalisation(x_train);
   FS_THROW_UNLESS(norm.mean.size() == x_train.cols(), norm_path, ": normalisation of ",
                   norm.mean.size(), " inputs, expected 2 x observed = ", x_train.cols());
-  if (!resume) WriteInputNormalisation(norm_path, norm);
+  if (!resume) span::WriteInputNormalisation(norm_path, norm);
   log::Info(resume ? "resuming" : "training", " naive in ", dir, " (", train.size(), " train, ",
             val.size(), " val windows)");
 
   const int in = 2 * spec.observed, out = 2 * spec.predicted;
   torch::manual_seed(static_cast<std::uint64_t>(spec.seed));
   NaiveNet net(in, naive.hidden, out);
-  NaiveTask task(net, ToFloatTensor(norm.Apply(x_train)), ToFloatTensor(EgoFutures(train, rotate)),
-                 ToFloatTensor(norm.Apply(x_val)), ToFloatTensor(EgoFutures(val, rotate)));
+  NaiveTask task(
+      net, span::ToFloatTensor(norm.Apply(x_train)), span::ToFloatTensor(EgoFutures(train, rotate)),
+      span::ToFloatTensor(norm.Apply(x_val)), span::ToFloatTensor(EgoFutures(val, rotate)));
   const TrainingSummary summary =
       Train(&task, spec.train, RunPaths{dir}, static_cast<std::uint64_t>(spec.seed), resume, hooks);
   if (Interrupted(summary, "naive", dir)) return false;
@@ -270,7 +271,7 @@ bool TrainNaive(const LearnerSpec& spec, const NaiveSpec& naive, const WindowSet
 void ExportNaive(const LearnerSpec& spec, const NaiveSpec& naive, const std::string& dir,
                  const std::string& artifact, const std::string& config_yaml) {
   const int in = 2 * spec.observed, out = 2 * spec.predicted;
-  const InputNormalisation norm = ReadInputNormalisation(dir + "/normalisation.h5");
+  const span::InputNormalisation norm = span::ReadInputNormalisation(dir + "/normalisation.h5");
   NaiveNet best(in, naive.hidden, out);
   LoadCheckpointModel(CheckpointToExport(dir, "naive"), best.ptr().get());
   NaivePredictorWeights w;
@@ -281,7 +282,7 @@ void ExportNaive(const LearnerSpec& spec, const NaiveSpec& naive, const std::str
   w.input_mean = norm.mean;
   w.input_std = norm.std;
   w.layer_names = best->DenseLayerNames();
-  w.mlp = ToEngineMlp(*best, w.layer_names);
+  w.mlp = span::ToEngineMlp(*best, w.layer_names);
   NaivePredictor::Save(artifact, w, config_yaml, spec.seed);
   (void)NaivePredictor::Load(artifact);
 }

@@ -30,9 +30,9 @@ struct LearnerSpec {
   int observed = 10, predicted = 15;
   double seconds_per_step = 0.4;  ///< s; must equal the windows' step
   std::int64_t seed = 0;
-  TrajectoryBasisConfig basis;  ///< the future basis of the prior and KTM heads
-  SpanNetConfig network;  ///< the prior's net; components R (thesis 2), u_param must be diagonal
-  TrainConfig train;      ///< epochs, patience, lr, ... of every learner
+  span::TrajectoryBasisConfig basis;  ///< the future basis of the prior and KTM heads
+  span::NetConfig network;  ///< the prior's net; components R (thesis 2), u_param must be diagonal
+  TrainConfig train;        ///< epochs, patience, lr, ... of every learner
 };
 
 /// Kernel Trajectory Maps. Features of an observed segment q (ego frame, 2p numbers):

@@ -18,7 +18,7 @@
 #include "training/directional/pipeline.h"
 #include "training/kinds.h"
 
-namespace foresight {
+namespace foresight::directional {
 namespace {
 
 using bench::Clock;
@@ -27,7 +27,7 @@ using RowMatrixF = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::R
 
 double Us(Clock::time_point a, Clock::time_point b) { return bench::Micros(a, b); }
 
-struct DirectionalBenchOptions {
+struct BenchOptions {
   int calls = 5000;
   int repeats = 15;
 
@@ -38,11 +38,11 @@ struct DirectionalBenchOptions {
   }
 };
 
-void RunDirectionalBench(const BenchRequest& req, const DirectionalBenchOptions& a) {
+void RunBench(const BenchRequest& req, const BenchOptions& a) {
   torch::set_num_threads(1);
   const std::string artifact = BenchArtifact(req, "model.h5");
-  const DirectionalMap map = DirectionalMap::Load(artifact);
-  const DirectionalFeatureConfig& fc = map.features().config();
+  const Map map = Map::Load(artifact);
+  const FeatureConfig& fc = map.features().config();
   const int n = 1024;
   std::mt19937_64 rng(1);
   std::uniform_real_distribution<double> ux(fc.x_min, fc.x_max), uy(fc.y_min, fc.y_max),
@@ -71,8 +71,8 @@ void RunDirectionalBench(const BenchRequest& req, const DirectionalBenchOptions&
   }
 
   // LibTorch on the same network: features (same code) -> forward -> decode.
-  LoadedDirectionalNet net = LoadDirectionalNetFromArtifact(artifact);
-  const DirectionalFeatures& feats = map.features();
+  LoadedNet net = LoadNetFromArtifact(artifact);
+  const Features& feats = map.features();
   c10::InferenceMode guard;
   auto torch_query = [&](int begin, int len, std::vector<double>* forward_only) {
     const auto t0 = Clock::now();
@@ -82,8 +82,8 @@ void RunDirectionalBench(const BenchRequest& req, const DirectionalBenchOptions&
     const auto ts = torch::from_blob(s.data(), {s.rows(), s.cols()}, torch::kFloat32);
     const auto tt = torch::from_blob(tm.data(), {tm.rows(), tm.cols()}, torch::kFloat32);
     const auto t1 = Clock::now();
-    const auto p = DecodeDirectionalHead(net.net->forward(ts, tt), net.net->components(),
-                                         net.net->max_kappa());
+    const auto p =
+        DecodeVonMisesHead(net.net->forward(ts, tt), net.net->components(), net.net->max_kappa());
     (void)p.kappa.sum().item<float>();
     const auto t2 = Clock::now();
     if (forward_only) forward_only->push_back(Us(t1, t2));
@@ -99,7 +99,7 @@ void RunDirectionalBench(const BenchRequest& req, const DirectionalBenchOptions&
     RowMatrixF tm(len, feats.time_size());
     feats.TemporalBatch(t.segment(begin, len), tm);
     const auto nnz = static_cast<std::int64_t>(index.size());
-    const auto p = DecodeDirectionalHead(
+    const auto p = DecodeVonMisesHead(
         net.net->forward_sparse(
             torch::from_blob(index.data(), {nnz}, torch::kInt64),
             torch::from_blob(value.data(), {nnz}, torch::kFloat32),
@@ -162,8 +162,6 @@ void RunDirectionalBench(const BenchRequest& req, const DirectionalBenchOptions&
 
 }  // namespace
 
-void SetDirectionalBench(ExperimentKind* kind) {
-  SetBench<DirectionalBenchOptions>(kind, RunDirectionalBench);
-}
+void SetBenchStep(ExperimentKind* kind) { SetBench<BenchOptions>(kind, RunBench); }
 
-}  // namespace foresight
+}  // namespace foresight::directional

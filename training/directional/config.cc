@@ -1,12 +1,12 @@
 #include "training/directional/config.h"
 
-namespace foresight {
-void DirectionalExperimentConfig::Validate(const std::string& source) const {
-  const DirectionalExperimentConfig& c = *this;
+namespace foresight::directional {
+void ExperimentConfig::Validate(const std::string& source) const {
+  const ExperimentConfig& c = *this;
   FS_THROW_UNLESS(c.model == "directional", source, ": key 'model': value '", c.model,
                   "' is not 'directional'");
   FS_THROW_UNLESS(
-      c.data.format == DirectionalSource::kCrossing || !c.data.file.empty(), source,
+      c.data.format == Source::kCrossing || !c.data.file.empty(), source,
       ": key 'data.file' must name a data file when data.format is grid_csv or edinburgh");
   const auto& f = c.features;
   FS_THROW_UNLESS(f.auto_extent || (f.x_max > f.x_min && f.y_max > f.y_min), source,
@@ -24,4 +24,4 @@ void DirectionalExperimentConfig::Validate(const std::string& source) const {
                   c.eval.max_folds, ") must be <= eval.folds (", c.eval.folds, ")");
 }
 
-}  // namespace foresight
+}  // namespace foresight::directional

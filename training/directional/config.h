@@ -12,14 +12,14 @@
 #include "inference/directional/features.h"
 #include "training/train_config.h"
 
-namespace foresight {
+namespace foresight::directional {
 
-enum class DirectionalSource { kCrossing, kGridCsv, kEdinburgh };
+enum class Source { kCrossing, kGridCsv, kEdinburgh };
 /// How K-fold cross-validation splits the samples: whole paths (every way-point of a path in one
 /// fold; neighbours on a path are near-copies of each other) or single points (the thesis).
-enum class DirectionalFoldsBy { kPath, kPoint };
+enum class FoldsBy { kPath, kPoint };
 
-struct DirectionalCrossingSection {
+struct CrossingSection {
   CrossingFlowConfig flow;
   template <class A>
   void Serialize(A* a) {
@@ -38,7 +38,7 @@ struct DirectionalCrossingSection {
   }
 };
 
-struct DirectionalFilterSection {
+struct FilterSection {
   HeadingFilter filter;
   template <class A>
   void Serialize(A* a) {
@@ -53,25 +53,25 @@ struct DirectionalFilterSection {
   }
 };
 
-struct DirectionalDataConfig {
-  DirectionalSource format = DirectionalSource::kCrossing;
+struct DataConfig {
+  Source format = Source::kCrossing;
   std::string
       root;  ///< directory of relative file names (empty: $FORESIGHT_DATA or ../shared/data)
   std::string file;  ///< grid_csv: P1/P2 csv; edinburgh: tracks.*.txt
   double train_fraction =
       1.0;  ///< keep this random fraction of each fold's training split (5 % experiment)
   int max_samples = 0;  ///< random subsample of the whole data set (0: all)
-  DirectionalFilterSection edinburgh;
-  DirectionalCrossingSection crossing;
+  FilterSection edinburgh;
+  CrossingSection crossing;
 
   template <class A>
   void Serialize(A* a) {
     using config::Range;
     a->VisitEnum(
         "format", &format,
-        config::EnumNames<DirectionalSource>{{DirectionalSource::kCrossing, "crossing"},
-                                             {DirectionalSource::kGridCsv, "grid_csv"},
-                                             {DirectionalSource::kEdinburgh, "edinburgh"}},
+        config::EnumNames<Source>{{Source::kCrossing, "crossing"},
+                                  {Source::kGridCsv, "grid_csv"},
+                                  {Source::kEdinburgh, "edinburgh"}},
         "crossing: synthetic time-varying flow; grid_csv: P1/P2 csv; edinburgh: tracks file");
     a->Visit("root", &root, Range::Any(),
              "directory for relative file names (empty: $FORESIGHT_DATA or ../shared/data)");
@@ -89,7 +89,7 @@ struct DirectionalDataConfig {
   }
 };
 
-struct DirectionalNetworkConfig {
+struct NetworkConfig {
   int components = 5;           ///< R
   int hidden = 0;               ///< LSTM width; 0: 40 R (thesis)
   double lambda_alpha = 0.001;  ///< L2 on the mixing-weight head (added to the loss, errata)
@@ -118,9 +118,9 @@ struct DirectionalNetworkConfig {
   }
 };
 
-struct DirectionalEvalConfig {
+struct EvalConfig {
   int folds = 10;  ///< K of K-fold cross-validation
-  DirectionalFoldsBy folds_by = DirectionalFoldsBy::kPath;
+  FoldsBy folds_by = FoldsBy::kPath;
   int knn_k = 10;                ///< k of the k-nearest-neighbour baseline (1-NN always runs)
   double mre_min_weight = 0.05;  ///< mre_w: components lighter than this are ignored
   std::vector<double> metric_caps{10, 30, 100};  ///< AL also reported with kappa capped at each
@@ -141,8 +141,7 @@ struct DirectionalEvalConfig {
     using config::Range;
     a->Visit("folds", &folds, Range::Closed(2, 100), "K of K-fold cross-validation (thesis: 10)");
     a->VisitEnum("folds_by", &folds_by,
-                 config::EnumNames<DirectionalFoldsBy>{{DirectionalFoldsBy::kPath, "path"},
-                                                       {DirectionalFoldsBy::kPoint, "point"}},
+                 config::EnumNames<FoldsBy>{{FoldsBy::kPath, "path"}, {FoldsBy::kPoint, "point"}},
                  "fold unit: whole paths (default) or single points (the thesis's protocol)");
     a->Visit("knn_k", &knn_k, Range::Closed(1, 100),
              "k of the k-nearest-neighbour baseline (knn; nn1 always runs); both use max_kappa");
@@ -174,14 +173,14 @@ struct DirectionalEvalConfig {
   }
 };
 
-struct DirectionalExperimentConfig {
+struct ExperimentConfig {
   std::string model = "directional";
   std::int64_t seed = 0;
-  DirectionalDataConfig data;
-  DirectionalFeatureConfig features;
-  DirectionalNetworkConfig network;
+  DataConfig data;
+  FeatureConfig features;
+  NetworkConfig network;
   TrainConfig train;
-  DirectionalEvalConfig eval;
+  EvalConfig eval;
 
   template <class A>
   void Serialize(A* a) {
@@ -199,4 +198,4 @@ struct DirectionalExperimentConfig {
   void Validate(const std::string& source) const;
 };
 
-}  // namespace foresight
+}  // namespace foresight::directional

@@ -6,41 +6,40 @@
 #include "training/directional/pipeline.h"
 #include "training/kinds.h"
 
-namespace foresight {
+namespace foresight::directional {
 
-ExperimentKind DirectionalKind() {
+ExperimentKind Kind() {
   ExperimentKind k;
   k.tag = "directional";
   k.summary = "Directional maps (thesis ch 4)";
   k.configs = "configs/directional/*.yaml";
   k.resumable = true;
-  k.reference = [] { return config::ReferenceTable<DirectionalExperimentConfig>(); };
+  k.reference = [] { return config::ReferenceTable<ExperimentConfig>(); };
   k.train = [](const TrainRequest& req) {
     FS_THROW_UNLESS(
         req.config != "default" && !req.config.empty(),
         "directional maps have no embedded default config; name one (configs/directional/*.yaml)");
-    const auto c =
-        config::LoadExperimentConfig<DirectionalExperimentConfig>(req.config, req.overrides);
-    DirectionalRunResult r;
+    const auto c = config::LoadExperimentConfig<ExperimentConfig>(req.config, req.overrides);
+    RunResult r;
     {
       const ScopedInterruptFlag interrupt;
       TrainHooks hooks;
       hooks.interrupt = interrupt.flag();
-      r = RunDirectionalExperiment(c, req.run_dir, req.resume,
-                                   hooks);  // trains, exports and evaluates each fold
+      r = RunExperiment(c, req.run_dir, req.resume,
+                        hooks);  // trains, exports and evaluates each fold
     }
     if (r.interrupted) Fail("interrupted; continue with --resume --run-dir ", req.run_dir);
     std::cout << r.report.BriefReport() << "\n"
               << "wrote " << req.run_dir << "/model.h5, eval.json, eval.csv and plots/*.png\n";
   };
-  k.export_run = ExportDirectionalRun;
+  k.export_run = ExportRun;
   k.evaluate = [](const std::string& run_dir, const std::vector<std::string>& overrides) {
     // Every fold again with its trained networks; the run's config.yaml is left as it was.
-    const auto c = LoadRunConfig<DirectionalExperimentConfig>(run_dir, overrides);
-    return EvaluateDirectionalRun(c, run_dir).ToJson();
+    const auto c = LoadRunConfig<ExperimentConfig>(run_dir, overrides);
+    return EvaluateRun(c, run_dir).ToJson();
   };
-  SetDirectionalBench(&k);
+  SetBenchStep(&k);
   return k;
 }
 
-}  // namespace foresight
+}  // namespace foresight::directional

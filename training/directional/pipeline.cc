@@ -22,21 +22,21 @@
 #include "training/run_dir.h"
 #include "training/tensor_eigen.h"
 
-namespace foresight {
+namespace foresight::directional {
 namespace fs = std::filesystem;
 
 namespace {
 
 /// The networks a config trains: spatiotemporal and/or spatial.
-std::vector<DirectionalVariant> TrainedVariants(const DirectionalExperimentConfig& c) {
-  std::vector<DirectionalVariant> variants;
-  if (c.eval.spatiotemporal) variants.push_back(DirectionalVariant::kSpatiotemporal);
-  if (c.eval.spatial) variants.push_back(DirectionalVariant::kSpatial);
+std::vector<Variant> TrainedVariants(const ExperimentConfig& c) {
+  std::vector<Variant> variants;
+  if (c.eval.spatiotemporal) variants.push_back(Variant::kSpatiotemporal);
+  if (c.eval.spatial) variants.push_back(Variant::kSpatial);
   return variants;
 }
 
 /// How many of the K folds a run evaluates (eval.max_folds, 0: all).
-int EvaluatedFolds(const DirectionalExperimentConfig& c) {
+int EvaluatedFolds(const ExperimentConfig& c) {
   return c.eval.max_folds > 0 ? c.eval.max_folds : c.eval.folds;
 }
 
@@ -62,8 +62,8 @@ torch::Tensor ToTensor(const Eigen::VectorXd& v) {
 /// Features are computed per batch from the positions (memory stays O(n), not O(n M_s)).
 class DirectionalTask : public TrainingTask {
  public:
-  DirectionalTask(DirectionalNet net, DirectionalFeatures features, const DirectionalSamples& train,
-                  const DirectionalSamples& val, const DirectionalPenalty& penalty)
+  DirectionalTask(Net net, Features features, const DirectionalSamples& train,
+                  const DirectionalSamples& val, const Penalty& penalty)
       : net_(std::move(net)),
         features_(std::move(features)),
         train_(train),
@@ -82,8 +82,7 @@ class DirectionalTask : public TrainingTask {
     Eigen::VectorXd x(b), y(b), t(b);
     for (std::int64_t i = 0; i < b; ++i)
       x[i] = train_.x[p[i]], y[i] = train_.y[p[i]], t[i] = train_.t[p[i]];
-    return DirectionalLossFromRaw(*net_, Forward(x, y, t), theta_train_.index_select(0, idx),
-                                  penalty_);
+    return LossFromRaw(*net_, Forward(x, y, t), theta_train_.index_select(0, idx), penalty_);
   }
 
   double ValidationLoss() override {
@@ -95,7 +94,7 @@ class DirectionalTask : public TrainingTask {
       const Eigen::Index len = std::min<Eigen::Index>(512, n - b);
       const auto raw =
           Forward(val_.x.segment(b, len), val_.y.segment(b, len), val_.t.segment(b, len));
-      sum += VonMisesMixtureNll(DecodeDirectionalHead(raw, net_->components(), net_->max_kappa()),
+      sum += VonMisesMixtureNll(DecodeVonMisesHead(raw, net_->components(), net_->max_kappa()),
                                 theta_val_.narrow(0, b, len))
                  .sum()
                  .item<double>();
@@ -120,24 +119,21 @@ class DirectionalTask : public TrainingTask {
     return net_->forward_sparse(ti, tv, to, tt);
   }
 
-  DirectionalNet net_;
-  DirectionalFeatures features_;
+  Net net_;
+  Features features_;
   std::vector<std::int64_t> index_, offsets_;
   std::vector<float> value_;
   const DirectionalSamples& train_;
   const DirectionalSamples& val_;
-  DirectionalPenalty penalty_;
+  Penalty penalty_;
   torch::Tensor theta_train_, theta_val_;
 };
 
-DirectionalPenalty PenaltyOf(const DirectionalNetworkConfig& n) {
-  return {n.lambda_alpha, n.lambda_mu, n.lambda_kappa};
-}
+Penalty PenaltyOf(const NetworkConfig& n) { return {n.lambda_alpha, n.lambda_mu, n.lambda_kappa}; }
 
-DirectionalNet MakeNet(const DirectionalExperimentConfig& c, const DirectionalFeatureConfig& f,
-                       DirectionalVariant v) {
-  return DirectionalNet(v, f.cells_x * f.cells_y, c.network.components, c.network.Hidden(),
-                        c.network.max_kappa);
+Net MakeNet(const ExperimentConfig& c, const FeatureConfig& f, Variant v) {
+  return Net(v, f.cells_x * f.cells_y, c.network.components, c.network.Hidden(),
+             c.network.max_kappa);
 }
 
 /// Splits `samples` into (train, val) with a seeded val_fraction (both non-empty).
@@ -187,10 +183,9 @@ double Std(const std::vector<double>& v) {
   return std::sqrt(s / static_cast<double>(v.size() - 1));
 }
 
-DirectionalGridConfig GridConfig(const DirectionalExperimentConfig& c,
-                                 const DirectionalFeatureConfig& f, GridDirectionalKind kind,
-                                 bool dense) {
-  DirectionalGridConfig g;
+GridConfig GridConfigOf(const ExperimentConfig& c, const FeatureConfig& f, GridKind kind,
+                        bool dense) {
+  GridConfig g;
   g.kind = kind;
   g.cells_x = f.cells_x;
   g.cells_y = f.cells_y;
@@ -204,9 +199,8 @@ DirectionalGridConfig GridConfig(const DirectionalExperimentConfig& c,
   return g;
 }
 
-DirectionalScore Score(const DirectionalEvalConfig& e, const VonMisesMixtureBatch& b,
-                       const Eigen::VectorXd& theta) {
-  DirectionalScore s;
+Score ScoreOf(const EvalConfig& e, const VonMisesMixtureBatch& b, const Eigen::VectorXd& theta) {
+  Score s;
   s.al = AverageLikelihood(b, theta);
   s.mre = MinimumRotationError(b, theta);
   s.mre_w = MinimumRotationError(b, theta, e.mre_min_weight);
@@ -229,28 +223,28 @@ std::string CapName(double cap) {
 
 // ---------------------------------------------------------------------------------------------
 
-DirectionalSamples LoadDirectionalSamples(const DirectionalExperimentConfig& c) {
+DirectionalSamples LoadSamples(const ExperimentConfig& c) {
   DirectionalSamples s;
   DirectionalReadStats stats;
   std::string where;
   switch (c.data.format) {
-    case DirectionalSource::kCrossing: {
+    case Source::kCrossing: {
       CrossingFlowConfig flow = c.data.crossing.flow;
       flow.seed = static_cast<std::uint64_t>(c.seed);
       s = GenerateCrossingFlow(flow);
       where = "synthetic crossing";
       break;
     }
-    case DirectionalSource::kGridCsv:
+    case Source::kGridCsv:
       where = ResolveDataFile(c.data.root, c.data.file);
       s = ReadDirectionalGridCsv(where, &stats);
       break;
-    case DirectionalSource::kEdinburgh:
+    case Source::kEdinburgh:
       where = ResolveDataFile(c.data.root, c.data.file);
       s = ReadEdinburghTracks(where, c.data.edinburgh.filter, &stats);
       break;
   }
-  if (c.data.format != DirectionalSource::kCrossing)
+  if (c.data.format != Source::kCrossing)
     log::Info(where, ": ", stats.points, " points in ", stats.tracks, " tracks, kept ", stats.kept,
               " headings; dropped standing ", stats.dropped_standing, ", jumps ",
               stats.dropped_jump, ", gaps ", stats.dropped_gap, ", short tracks ",
@@ -265,34 +259,33 @@ DirectionalSamples LoadDirectionalSamples(const DirectionalExperimentConfig& c) 
   return s;
 }
 
-void WriteDirectionalArtifact(DirectionalNetImpl& net, const DirectionalFeatureConfig& fc,
-                              const std::string& config_yaml, std::int64_t seed,
-                              const std::string& path) {
+void WriteArtifact(NetImpl& net, const FeatureConfig& fc, const std::string& config_yaml,
+                   std::int64_t seed, const std::string& path) {
   FS_THROW_UNLESS(!fc.auto_extent && !fc.auto_time_range,
                   "WriteDirectionalArtifact: unresolved feature extent");
   const auto params = net.named_parameters();
   auto matrix = [&](const std::string& name) { return ToEigenMatrix(params[name]); };
   auto vector = [&](const std::string& name) { return ToEigenVector(params[name]); };
   Lstm lstm;
-  if (net.variant() == DirectionalVariant::kSpatiotemporal)
+  if (net.variant() == Variant::kSpatiotemporal)
     lstm = Lstm(LstmWeights{matrix("lstm.weight_ih_l0"), matrix("lstm.weight_hh_l0"),
                             vector("lstm.bias_ih_l0"), vector("lstm.bias_hh_l0")});
-  DirectionalHeads heads{matrix("alpha.weight"), matrix("mu.weight"), matrix("kappa.weight"),
-                         vector("alpha.bias"),   vector("mu.bias"),   vector("kappa.bias")};
-  DirectionalMap(net.variant(), fc, std::move(lstm), std::move(heads), net.max_kappa())
+  Heads heads{matrix("alpha.weight"), matrix("mu.weight"), matrix("kappa.weight"),
+              vector("alpha.bias"),   vector("mu.bias"),   vector("kappa.bias")};
+  Map(net.variant(), fc, std::move(lstm), std::move(heads), net.max_kappa())
       .Save(path, config_yaml, seed);
 }
 
-LoadedDirectionalNet LoadDirectionalNetFromArtifact(const std::string& path) {
-  const Artifact art = Artifact::Open(path, kDirectionalModelType);
+LoadedNet LoadNetFromArtifact(const std::string& path) {
+  const Artifact art = Artifact::Open(path, kModelType);
   const h5::File& f = art.file();
   // The engine loader checks every shape; reuse it for the feature config and the variant.
-  const DirectionalMap map = DirectionalMap::Load(path);
-  LoadedDirectionalNet out;
+  const Map map = Map::Load(path);
+  LoadedNet out;
   out.features = map.features().config();
-  const int hidden = map.variant() == DirectionalVariant::kSpatial ? 0 : map.lstm().hidden_size();
-  out.net = DirectionalNet(map.variant(), map.features().spatial_size(), map.components(), hidden,
-                           map.max_kappa());
+  const int hidden = map.variant() == Variant::kSpatial ? 0 : map.lstm().hidden_size();
+  out.net =
+      Net(map.variant(), map.features().spatial_size(), map.components(), hidden, map.max_kappa());
   torch::NoGradGuard no_grad;
   for (auto& item : out.net->named_parameters()) {
     const std::string& key = item.key();
@@ -307,11 +300,9 @@ LoadedDirectionalNet LoadDirectionalNetFromArtifact(const std::string& path) {
   return out;
 }
 
-TrainingSummary TrainDirectionalNet(const DirectionalExperimentConfig& c,
-                                    const DirectionalFeatureConfig& features,
-                                    DirectionalVariant variant, const DirectionalSamples& train,
-                                    const DirectionalSamples& val, const std::string& dir,
-                                    bool resume, const TrainHooks& hooks) {
+TrainingSummary TrainNet(const ExperimentConfig& c, const FeatureConfig& features, Variant variant,
+                         const DirectionalSamples& train, const DirectionalSamples& val,
+                         const std::string& dir, bool resume, const TrainHooks& hooks) {
   const std::string artifact = dir + "/model.h5";
   if (fs::exists(artifact)) {
     TrainingSummary s;
@@ -322,10 +313,10 @@ TrainingSummary TrainDirectionalNet(const DirectionalExperimentConfig& c,
   RunPaths run{dir};
   const bool can_resume = resume && fs::exists(run.Checkpoint());
   torch::manual_seed(static_cast<std::uint64_t>(c.seed));
-  DirectionalNet net = MakeNet(c, features, variant);
-  DirectionalTask task(net, DirectionalFeatures(features), train, val, PenaltyOf(c.network));
+  Net net = MakeNet(c, features, variant);
+  DirectionalTask task(net, Features(features), train, val, PenaltyOf(c.network));
   TrainConfig tc = c.train;
-  if (variant == DirectionalVariant::kSpatial && c.network.spatial_epochs > 0)
+  if (variant == Variant::kSpatial && c.network.spatial_epochs > 0)
     tc.epochs = c.network.spatial_epochs;
   if (c.data.train_fraction < 1.0) {
     // Epochs count passes over a full training split: a fraction f trains epochs / f passes (the
@@ -340,46 +331,46 @@ TrainingSummary TrainDirectionalNet(const DirectionalExperimentConfig& c,
       fs::exists(run.BestCheckpoint()) ? run.BestCheckpoint() : run.Checkpoint();
   FS_THROW_UNLESS(fs::exists(ckpt), dir, ": training produced no checkpoint (", ToString(s.reason),
                   ")");
-  DirectionalNet best = MakeNet(c, features, variant);
+  Net best = MakeNet(c, features, variant);
   LoadCheckpointModel(ckpt, best.ptr().get());
-  WriteDirectionalArtifact(*best, features, config::ToYaml(c), c.seed, artifact);
-  (void)DirectionalMap::Load(artifact);  // the engine loads what was written
+  WriteArtifact(*best, features, config::ToYaml(c), c.seed, artifact);
+  (void)Map::Load(artifact);  // the engine loads what was written
   return s;
 }
 
-std::vector<std::pair<std::string, DirectionalScore>> EvaluateDirectionalSplit(
-    const DirectionalExperimentConfig& c, const DirectionalFeatureConfig& f,
-    const DirectionalSamples& train_all, const DirectionalSamples& test,
-    const std::string& work_dir, const TrainHooks& hooks, bool* interrupted) {
-  std::vector<std::pair<std::string, DirectionalScore>> out;
+std::vector<std::pair<std::string, Score>> EvaluateSplit(
+    const ExperimentConfig& c, const FeatureConfig& f, const DirectionalSamples& train_all,
+    const DirectionalSamples& test, const std::string& work_dir, const TrainHooks& hooks,
+    bool* interrupted) {
+  std::vector<std::pair<std::string, Score>> out;
   if (interrupted) *interrupted = false;
   VonMisesMixtureBatch batch;
   const auto [train, val] =
       SplitVal(train_all, c.eval.val_fraction, static_cast<std::uint64_t>(c.seed) + 17);
-  const std::vector<DirectionalVariant> variants = TrainedVariants(c);
-  for (const DirectionalVariant v : variants) {
+  const std::vector<Variant> variants = TrainedVariants(c);
+  for (const Variant v : variants) {
     const std::string dir = work_dir + "/" + VariantName(v);
-    const TrainingSummary s = TrainDirectionalNet(c, f, v, train, val, dir, true, hooks);
+    const TrainingSummary s = TrainNet(c, f, v, train, val, dir, true, hooks);
     if (s.reason == TerminationReason::kInterrupted) {
       if (interrupted) *interrupted = true;
       return out;
     }
-    const DirectionalMap map = DirectionalMap::Load(dir + "/model.h5");
+    const Map map = Map::Load(dir + "/model.h5");
     auto ws = map.MakeWorkspace();
     map.Query(test.x, test.y, test.t, &ws, &batch);
-    out.push_back({VariantName(v), Score(c.eval, batch, test.theta)});
+    out.push_back({VariantName(v), ScoreOf(c.eval, batch, test.theta)});
   }
-  std::vector<std::pair<std::string, DirectionalGridConfig>> grids{
-      {"grid_um", GridConfig(c, f, GridDirectionalKind::kUnimodal, false)},
-      {"grid_mm", GridConfig(c, f, GridDirectionalKind::kMultimodal, false)}};
+  std::vector<std::pair<std::string, GridConfig>> grids{
+      {"grid_um", GridConfigOf(c, f, GridKind::kUnimodal, false)},
+      {"grid_mm", GridConfigOf(c, f, GridKind::kMultimodal, false)}};
   if (c.eval.dense) {
-    grids.push_back({"grid_um_dense", GridConfig(c, f, GridDirectionalKind::kUnimodal, true)});
-    grids.push_back({"grid_mm_dense", GridConfig(c, f, GridDirectionalKind::kMultimodal, true)});
+    grids.push_back({"grid_um_dense", GridConfigOf(c, f, GridKind::kUnimodal, true)});
+    grids.push_back({"grid_mm_dense", GridConfigOf(c, f, GridKind::kMultimodal, true)});
   }
   for (const auto& [name, g] : grids) {
-    const DirectionalGridMap grid = DirectionalGridMap::Fit(train_all, g);
+    const GridMap grid = GridMap::Fit(train_all, g);
     grid.Query(test.x, test.y, &batch);
-    out.push_back({name, Score(c.eval, batch, test.theta)});
+    out.push_back({name, ScoreOf(c.eval, batch, test.theta)});
   }
   // Nearest training headings at the same cap: the trivial baseline every table carries. With
   // more than one time point, time is a coordinate scaled so that one temporal length scale
@@ -389,32 +380,32 @@ std::vector<std::pair<std::string, DirectionalScore>> EvaluateDirectionalSplit(
     if (k == c.eval.knn_k && k == 1) continue;  // knn with k = 1 is nn1
     FS_THROW_UNLESS(k <= train_all.size(), "eval.knn_k = ", k, " exceeds the ", train_all.size(),
                     " training samples of a fold");
-    KnnDirectionalConfig kc;
+    KnnConfig kc;
     kc.k = k;
     kc.kappa = c.network.max_kappa;
     kc.use_time = timed;
     kc.time_scale = timed ? f.length_scale / f.time_length_scale : 1.0;
-    const KnnDirectionalMap knn = KnnDirectionalMap::Fit(train_all, kc);
+    const KnnMap knn = KnnMap::Fit(train_all, kc);
     knn.Query(test.x, test.y, test.t, &batch);
-    out.push_back({k == 1 ? "nn1" : "knn", Score(c.eval, batch, test.theta)});
+    out.push_back({k == 1 ? "nn1" : "knn", ScoreOf(c.eval, batch, test.theta)});
   }
   return out;
 }
 
 // ---------------------------------------------------------------------------------------------
 
-double DirectionalMethodMetrics::MeanAl() const { return Mean(al); }
-double DirectionalMethodMetrics::MeanMre() const { return Mean(mre); }
-double DirectionalMethodMetrics::StdAl() const { return Std(al); }
-double DirectionalMethodMetrics::StdMre() const { return Std(mre); }
+double MethodMetrics::MeanAl() const { return Mean(al); }
+double MethodMetrics::MeanMre() const { return Mean(mre); }
+double MethodMetrics::StdAl() const { return Std(al); }
+double MethodMetrics::StdMre() const { return Std(mre); }
 
-const DirectionalMethodMetrics* DirectionalEvalReport::Find(const std::string& method) const {
+const MethodMetrics* EvalReport::Find(const std::string& method) const {
   for (const auto& m : methods)
     if (m.method == method) return &m;
   return nullptr;
 }
 
-std::string DirectionalEvalReport::ToJson() const {
+std::string EvalReport::ToJson() const {
   std::ostringstream os;
   os << "{\n";
   auto list = [](const std::vector<double>& v) {
@@ -446,7 +437,7 @@ std::string DirectionalEvalReport::ToJson() const {
   return os.str();
 }
 
-std::string DirectionalEvalReport::ToCsv() const {
+std::string EvalReport::ToCsv() const {
   std::ostringstream os;
   os << "method,fold,al,mre,mre_w";
   for (const double cap : metric_caps) os << ",al_cap" << CapName(cap);
@@ -462,7 +453,7 @@ std::string DirectionalEvalReport::ToCsv() const {
   return os.str();
 }
 
-std::string DirectionalEvalReport::BriefReport() const {
+std::string EvalReport::BriefReport() const {
   std::ostringstream os;
   os << "directional eval (" << samples << " samples, " << folds_evaluated << "/" << folds
      << " folds, " << features.cells_x * features.cells_y << " inducing points / cells):";
@@ -475,7 +466,7 @@ std::string DirectionalEvalReport::BriefReport() const {
 namespace {
 /// The run's artifacts: fold 0's networks (trained on fold 0's training split). model.h5 is the
 /// spatiotemporal one, or the spatial one when only that was trained.
-void PublishFoldZero(const DirectionalExperimentConfig& c, const std::string& run_dir) {
+void PublishFoldZero(const ExperimentConfig& c, const std::string& run_dir) {
   if (c.eval.spatiotemporal)
     fs::copy_file(run_dir + "/folds/0/spatiotemporal/model.h5", run_dir + "/model.h5",
                   fs::copy_options::overwrite_existing);
@@ -486,25 +477,24 @@ void PublishFoldZero(const DirectionalExperimentConfig& c, const std::string& ru
 }
 }  // namespace
 
-std::string ExportDirectionalRun(const std::string& run_dir) {
-  const auto c =
-      config::LoadExperimentConfig<DirectionalExperimentConfig>(run_dir + "/config.yaml");
-  const DirectionalSamples data = LoadDirectionalSamples(c);
-  const DirectionalFeatureConfig f = ResolveExtent(c.features, data.x, data.y, data.t);
-  const std::vector<DirectionalVariant> variants = TrainedVariants(c);
+std::string ExportRun(const std::string& run_dir) {
+  const auto c = config::LoadExperimentConfig<ExperimentConfig>(run_dir + "/config.yaml");
+  const DirectionalSamples data = LoadSamples(c);
+  const FeatureConfig f = ResolveExtent(c.features, data.x, data.y, data.t);
+  const std::vector<Variant> variants = TrainedVariants(c);
   const int folds = EvaluatedFolds(c);
   for (int k = 0; k < folds; ++k) {
-    for (const DirectionalVariant v : variants) {
+    for (const Variant v : variants) {
       const std::string dir = run_dir + "/folds/" + std::to_string(k) + "/" + VariantName(v);
       const RunPaths run{dir};
       const std::string ckpt =
           fs::exists(run.BestCheckpoint()) ? run.BestCheckpoint() : run.Checkpoint();
       FS_THROW_UNLESS(fs::exists(ckpt), dir, ": no checkpoint to export (fold ", k,
                       " is not trained yet; ", "continue with train --resume)");
-      DirectionalNet best = MakeNet(c, f, v);
+      Net best = MakeNet(c, f, v);
       LoadCheckpointModel(ckpt, best.ptr().get());
-      WriteDirectionalArtifact(*best, f, config::ToYaml(c), c.seed, dir + "/model.h5");
-      (void)DirectionalMap::Load(dir + "/model.h5");
+      WriteArtifact(*best, f, config::ToYaml(c), c.seed, dir + "/model.h5");
+      (void)Map::Load(dir + "/model.h5");
     }
   }
   PublishFoldZero(c, run_dir);
@@ -516,23 +506,20 @@ std::string ExportDirectionalRun(const std::string& run_dir) {
 namespace {
 /// Every fold: train what is not trained yet (nothing, when evaluating a finished run), query
 /// the networks and fit the grids; then eval.json, eval.csv, the run's artifacts and plots.
-DirectionalRunResult RunFolds(const DirectionalExperimentConfig& c, const std::string& run_dir,
-                              const TrainHooks& hooks);
+RunResult RunFolds(const ExperimentConfig& c, const std::string& run_dir, const TrainHooks& hooks);
 }  // namespace
 
-DirectionalRunResult RunDirectionalExperiment(const DirectionalExperimentConfig& c,
-                                              const std::string& run_dir, bool resume,
-                                              const TrainHooks& hooks) {
+RunResult RunExperiment(const ExperimentConfig& c, const std::string& run_dir, bool resume,
+                        const TrainHooks& hooks) {
   StartRunDirectory(run_dir, config::ToYaml(c), resume, kDirectionalRunRules);
   log::Info(resume ? "resuming" : "training", " directional maps in ", run_dir, " (seed ", c.seed,
             ")");
   return RunFolds(c, run_dir, hooks);
 }
 
-DirectionalEvalReport EvaluateDirectionalRun(const DirectionalExperimentConfig& c,
-                                             const std::string& run_dir) {
+EvalReport EvaluateRun(const ExperimentConfig& c, const std::string& run_dir) {
   for (int k = 0; k < EvaluatedFolds(c); ++k)
-    for (const DirectionalVariant v : TrainedVariants(c)) {
+    for (const Variant v : TrainedVariants(c)) {
       const std::string dir = run_dir + "/folds/" + std::to_string(k) + "/" + VariantName(v);
       FS_THROW_UNLESS(fs::exists(dir + "/model.h5"), dir,
                       ": no model.h5 (the run is not finished; continue it with train --resume)");
@@ -572,15 +559,14 @@ void CheckFoldRows(const std::string& work, const std::vector<Eigen::Index>& row
   WriteFileAtomically(path, want.str() + "\n");
 }
 
-DirectionalRunResult RunFolds(const DirectionalExperimentConfig& c, const std::string& run_dir,
-                              const TrainHooks& hooks) {
-  const DirectionalSamples data = LoadDirectionalSamples(c);
-  const DirectionalFeatureConfig f = ResolveExtent(c.features, data.x, data.y, data.t);
-  (void)DirectionalFeatures(f);  // checks the resolved extent
+RunResult RunFolds(const ExperimentConfig& c, const std::string& run_dir, const TrainHooks& hooks) {
+  const DirectionalSamples data = LoadSamples(c);
+  const FeatureConfig f = ResolveExtent(c.features, data.x, data.y, data.t);
+  (void)Features(f);  // checks the resolved extent
   log::Info(data.size(), " samples; ", f.cells_x, " x ", f.cells_y,
             " spatial inducing points over x [", f.x_min, ", ", f.x_max, "], y [", f.y_min, ", ",
             f.y_max, "], ", f.time_points, " temporal over [", f.t_min, ", ", f.t_max, "] s");
-  const bool by_path = c.eval.folds_by == DirectionalFoldsBy::kPath;
+  const bool by_path = c.eval.folds_by == FoldsBy::kPath;
   FS_THROW_UNLESS(!by_path || static_cast<Eigen::Index>(data.path.size()) == data.size(),
                   "eval.folds_by: path, but the samples carry no path ids (use point)");
   std::vector<std::vector<Eigen::Index>> folds;
@@ -595,8 +581,8 @@ DirectionalRunResult RunFolds(const DirectionalExperimentConfig& c, const std::s
   }
   const int evaluate = EvaluatedFolds(c);
 
-  DirectionalRunResult result;
-  DirectionalEvalReport& report = result.report;
+  RunResult result;
+  EvalReport& report = result.report;
   report.samples = data.size();
   report.folds = c.eval.folds;
   report.folds_by = by_path ? "path" : "point";
@@ -614,13 +600,13 @@ DirectionalRunResult RunFolds(const DirectionalExperimentConfig& c, const std::s
     const std::string work = run_dir + "/folds/" + std::to_string(k);
     CheckFoldRows(work, test_idx, by_path);
     bool interrupted = false;
-    const auto scores = EvaluateDirectionalSplit(c, f, train, test, work, hooks, &interrupted);
+    const auto scores = EvaluateSplit(c, f, train, test, work, hooks, &interrupted);
     if (interrupted) {
       result.interrupted = true;
       return result;
     }
     for (const auto& [name, score] : scores) {
-      DirectionalMethodMetrics* m = nullptr;
+      MethodMetrics* m = nullptr;
       for (auto& existing : report.methods)
         if (existing.method == name) m = &existing;
       if (!m) {
@@ -643,12 +629,11 @@ DirectionalRunResult RunFolds(const DirectionalExperimentConfig& c, const std::s
   WriteFileAtomically(run_dir + "/eval.csv", report.ToCsv());
   if (c.eval.plots) {
     fs::create_directories(run_dir + "/plots");
-    const DirectionalMap first = DirectionalMap::Load(run_dir + "/model.h5");
-    std::unique_ptr<DirectionalMap> sp;
+    const Map first = Map::Load(run_dir + "/model.h5");
+    std::unique_ptr<Map> sp;
     if (c.eval.spatial && c.eval.spatiotemporal)
-      sp = std::make_unique<DirectionalMap>(DirectionalMap::Load(run_dir + "/model_spatial.h5"));
-    PlotDirectionalMaps(data, first, sp.get(), c.eval, static_cast<std::uint64_t>(c.seed),
-                        run_dir + "/plots");
+      sp = std::make_unique<Map>(Map::Load(run_dir + "/model_spatial.h5"));
+    PlotMaps(data, first, sp.get(), c.eval, static_cast<std::uint64_t>(c.seed), run_dir + "/plots");
   }
   log::Info(report.BriefReport());
   return result;
@@ -656,4 +641,4 @@ DirectionalRunResult RunFolds(const DirectionalExperimentConfig& c, const std::s
 
 }  // namespace
 
-}  // namespace foresight
+}  // namespace foresight::directional

@@ -23,42 +23,40 @@
 #include "training/run_dir.h"
 #include "training/trainer.h"
 
-namespace foresight {
+namespace foresight::directional {
 
 /// Loads (or generates) the config's samples, validated; reader statistics are logged.
-DirectionalSamples LoadDirectionalSamples(const DirectionalExperimentConfig& config);
+DirectionalSamples LoadSamples(const ExperimentConfig& config);
 
 /// Trains one network on `train` (early stopping / best epoch on `val`) into `dir` and exports
 /// dir/model.h5 from the best checkpoint. `features` must be resolved (no auto flags). An already
 /// exported dir is left alone (returns a summary with reason kAlreadyComplete).
-TrainingSummary TrainDirectionalNet(const DirectionalExperimentConfig& config,
-                                    const DirectionalFeatureConfig& features,
-                                    DirectionalVariant variant, const DirectionalSamples& train,
-                                    const DirectionalSamples& val, const std::string& dir,
-                                    bool resume, const TrainHooks& hooks = {});
+TrainingSummary TrainNet(const ExperimentConfig& config, const FeatureConfig& features,
+                         Variant variant, const DirectionalSamples& train,
+                         const DirectionalSamples& val, const std::string& dir, bool resume,
+                         const TrainHooks& hooks = {});
 
 /// Writes an artifact of `net` (schema: docs/artifact_schema.md, model_type directional_map).
-void WriteDirectionalArtifact(DirectionalNetImpl& net, const DirectionalFeatureConfig& features,
-                              const std::string& config_yaml, std::int64_t seed,
-                              const std::string& path);
+void WriteArtifact(NetImpl& net, const FeatureConfig& features, const std::string& config_yaml,
+                   std::int64_t seed, const std::string& path);
 
 /// Rebuilds the LibTorch network of an artifact (parity tests, benchmark).
-struct LoadedDirectionalNet {
-  DirectionalNet net{nullptr};
-  DirectionalFeatureConfig features;
+struct LoadedNet {
+  Net net{nullptr};
+  FeatureConfig features;
 };
-LoadedDirectionalNet LoadDirectionalNetFromArtifact(const std::string& path);
+LoadedNet LoadNetFromArtifact(const std::string& path);
 
 /// One method's scores on one test split: AL and MRE as the thesis defines them (every
 /// concentration as the method predicts it, capped at network.max_kappa), AL again with the
 /// concentrations capped at each eval.metric_caps value, and mre_w, the MRE over the components
 /// weighing at least eval.mre_min_weight (so a spike of negligible weight cannot score).
-struct DirectionalScore {
+struct Score {
   double al = 0, mre = 0, mre_w = 0;
   std::vector<double> al_caps;  ///< [metric_caps]
 };
 
-struct DirectionalMethodMetrics {
+struct MethodMetrics {
   std::string method;
   std::vector<double> al, mre;               ///< per fold
   std::vector<double> mre_w;                 ///< per fold
@@ -69,14 +67,14 @@ struct DirectionalMethodMetrics {
   double StdMre() const;
 };
 
-struct DirectionalEvalReport {
+struct EvalReport {
   Eigen::Index samples = 0;
   int folds = 0, folds_evaluated = 0;
-  std::string folds_by;               ///< "path" or "point"
-  std::vector<double> metric_caps;    ///< of al_caps
-  DirectionalFeatureConfig features;  ///< resolved
-  std::vector<DirectionalMethodMetrics> methods;
-  const DirectionalMethodMetrics* Find(const std::string& method) const;
+  std::string folds_by;             ///< "path" or "point"
+  std::vector<double> metric_caps;  ///< of al_caps
+  FeatureConfig features;           ///< resolved
+  std::vector<MethodMetrics> methods;
+  const MethodMetrics* Find(const std::string& method) const;
   /// `{ "spatiotemporal": {"al": .., "mre": .., "al_std": .., "mre_std": .., "al_folds": [..],
   /// "mre_folds": [..], "mre_w": .., "al_cap10": .., ...}, ..., "samples": n, "folds": K,
   /// "folds_by": "path", "folds_evaluated": k, "resolution": {..} }`
@@ -85,8 +83,8 @@ struct DirectionalEvalReport {
   std::string BriefReport() const;
 };
 
-struct DirectionalRunResult {
-  DirectionalEvalReport report;
+struct RunResult {
+  EvalReport report;
   TrainingSummary last;  ///< of the last trained network
   bool interrupted = false;
 };
@@ -96,27 +94,25 @@ inline const RunDirectoryRules kDirectionalRunRules{{"folds", "model.h5", "eval.
 
 /// The whole experiment into `run_dir` (see above). A fresh start refuses a directory that holds
 /// an earlier run. Empty or non-finite data is an Error naming the source.
-DirectionalRunResult RunDirectionalExperiment(const DirectionalExperimentConfig& config,
-                                              const std::string& run_dir, bool resume,
-                                              const TrainHooks& hooks = {});
+RunResult RunExperiment(const ExperimentConfig& config, const std::string& run_dir, bool resume,
+                        const TrainHooks& hooks = {});
 
 /// Evaluates a finished run again (every fold network exists; an Error names the first missing
 /// one) with `config`, which may differ from the run's in where the data is (data.root): writes
 /// eval.json, eval.csv and the plots; trains nothing and does not touch config.yaml.
-DirectionalEvalReport EvaluateDirectionalRun(const DirectionalExperimentConfig& config,
-                                             const std::string& run_dir);
+EvalReport EvaluateRun(const ExperimentConfig& config, const std::string& run_dir);
 
 /// Rewrites every fold network's model.h5 from its best checkpoint and the run's model.h5 (fold 0).
 /// A fold without a checkpoint is an Error naming it. @return the run's artifact path.
-std::string ExportDirectionalRun(const std::string& run_dir);
+std::string ExportRun(const std::string& run_dir);
 
 /// Evaluates the methods on one split: returns the scores of spatiotemporal, spatial (optional),
 /// grid_um, grid_mm (+ dense), nn1 and knn (nearest training headings at max_kappa; with time as
 /// a coordinate when the features have more than one time point). Networks are trained into
 /// `work_dir`/<variant>.
-std::vector<std::pair<std::string, DirectionalScore>> EvaluateDirectionalSplit(
-    const DirectionalExperimentConfig& config, const DirectionalFeatureConfig& features,
-    const DirectionalSamples& train, const DirectionalSamples& test, const std::string& work_dir,
-    const TrainHooks& hooks = {}, bool* interrupted = nullptr);
+std::vector<std::pair<std::string, Score>> EvaluateSplit(
+    const ExperimentConfig& config, const FeatureConfig& features, const DirectionalSamples& train,
+    const DirectionalSamples& test, const std::string& work_dir, const TrainHooks& hooks = {},
+    bool* interrupted = nullptr);
 
-}  // namespace foresight
+}  // namespace foresight::directional

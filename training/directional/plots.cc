@@ -9,9 +9,9 @@
 #include "core/von_mises.h"
 #include "training/image_io.h"
 
-namespace foresight {
+namespace foresight::directional {
 
-Eigen::Matrix<double, Eigen::Dynamic, 2> GenerateTrajectory(const DirectionalMap& map,
+Eigen::Matrix<double, Eigen::Dynamic, 2> GenerateTrajectory(const Map& map,
                                                             const Eigen::Vector2d& start, double t,
                                                             double step, int steps,
                                                             std::mt19937_64* rng) {
@@ -20,7 +20,7 @@ Eigen::Matrix<double, Eigen::Dynamic, 2> GenerateTrajectory(const DirectionalMap
   path.row(0) = start.transpose();
   std::uniform_real_distribution<double> u01(0.0, 1.0);
   Eigen::Vector2d p = start;
-  const DirectionalFeatureConfig& f = map.features().config();
+  const FeatureConfig& f = map.features().config();
   for (int n = 0; n < steps; ++n) {
     if (p.x() < f.x_min || p.x() > f.x_max || p.y() < f.y_min || p.y() > f.y_max) {
       path.conservativeResize(n + 1, 2);  // left the map
@@ -44,7 +44,7 @@ namespace {
 
 struct Panel {
   std::string title;
-  const DirectionalMap* map;
+  const Map* map;
   double t;
   double window;  ///< data within |t_i - t| <= window are drawn (infinite: all)
 };
@@ -59,10 +59,9 @@ struct Canvas {
   }
 };
 
-void Draw(const DirectionalSamples& data, const std::vector<Panel>& panels,
-          const DirectionalEvalConfig& eval, std::uint64_t seed, bool trajectories,
-          const std::string& png) {
-  const DirectionalFeatureConfig& f = panels[0].map->features().config();
+void Draw(const DirectionalSamples& data, const std::vector<Panel>& panels, const EvalConfig& eval,
+          std::uint64_t seed, bool trajectories, const std::string& png) {
+  const FeatureConfig& f = panels[0].map->features().config();
   Canvas cv_;
   cv_.e = Eigen::Vector4d(f.x_min, f.x_max, f.y_min, f.y_max);
   cv_.scale = 420.0 / std::max(f.x_max - f.x_min, f.y_max - f.y_min);
@@ -129,10 +128,9 @@ void Draw(const DirectionalSamples& data, const std::vector<Panel>& panels,
 
 }  // namespace
 
-void PlotDirectionalMaps(const DirectionalSamples& data, const DirectionalMap& st,
-                         const DirectionalMap* spatial, const DirectionalEvalConfig& eval,
-                         std::uint64_t seed, const std::string& dir) {
-  const DirectionalFeatureConfig& f = st.features().config();
+void PlotMaps(const DirectionalSamples& data, const Map& st, const Map* spatial,
+              const EvalConfig& eval, std::uint64_t seed, const std::string& dir) {
+  const FeatureConfig& f = st.features().config();
   const double range = f.t_max - f.t_min;
   auto fmt = [](double v) {
     char b[32];
@@ -151,4 +149,4 @@ void PlotDirectionalMaps(const DirectionalSamples& data, const DirectionalMap& s
   Draw(data, panels, eval, seed, true, dir + "/trajectories.png");
 }
 
-}  // namespace foresight
+}  // namespace foresight::directional

@@ -53,11 +53,11 @@ std::string EnsureNavigationPredictor(const NavigationExperimentConfig& c,
   const std::vector<std::string> data = {
       "data.format=track_store", "data.root=", "data.train_files=[" + tracks_file + "]",
       "data.seconds_per_step=" + std::to_string(stored.seconds_per_step)};
-  const SpanExperimentConfig span =
+  const span::ExperimentConfig span =
       p.train_config == "default"
-          ? config::ExperimentConfigFromYaml<SpanExperimentConfig>(
+          ? config::ExperimentConfigFromYaml<span::ExperimentConfig>(
                 embedded_default, "<embedded configs/navigation/predictor.yaml>", data)
-          : config::LoadExperimentConfig<SpanExperimentConfig>(p.train_config, data);
+          : config::LoadExperimentConfig<span::ExperimentConfig>(p.train_config, data);
   const bool resume = fs::exists(run_dir + "/checkpoints/last.pt");
   std::cout << "training the SPAN predictor into " << run_dir << (resume ? " (resuming)" : "")
             << "\n";
@@ -66,7 +66,7 @@ std::string EnsureNavigationPredictor(const NavigationExperimentConfig& c,
     const ScopedInterruptFlag interrupt;
     TrainHooks hooks;
     hooks.interrupt = interrupt.flag();
-    s = TrainSpan(span, run_dir, resume, hooks);
+    s = span::TrainRun(span, run_dir, resume, hooks);
   }
   WriteTrainingSummary(run_dir + "/training_summary.json", s);
   std::cout << s.BriefReport() << "\n";
@@ -74,8 +74,8 @@ std::string EnsureNavigationPredictor(const NavigationExperimentConfig& c,
                   "predictor training interrupted; run again to resume");
   FS_THROW_UNLESS(s.best_epoch >= 0, run_dir,
                   ": predictor training produced no usable checkpoint (", ToString(s.reason), ")");
-  const std::string out = ExportSpan(run_dir);
-  const SpanEvalReport r = EvaluateSpan(span, out, run_dir);
+  const std::string out = span::ExportRun(run_dir);
+  const span::EvalReport r = span::Evaluate(span, out, run_dir);
   std::cout << "predictor eval (" << r.windows << " test windows): ADE " << r.model.ade << " FDE "
             << r.model.fde << " NLL " << r.model.nll << " | constant velocity ADE " << r.cv.ade
             << " FDE " << r.cv.fde << "\n";

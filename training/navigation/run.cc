@@ -37,12 +37,13 @@ bool UsesPredictor(const NavigationExperimentConfig& c) { return c.Uses(Navigati
 /// Fast-BHM (or grid) map of the scenario's obstacles, saved as an artifact at `path`.
 void BuildScenarioMap(const NavigationExperimentConfig& c, const OccupancyRaster& raster,
                       const std::string& path) {
-  RasterMapOptions o;
-  o.kind = c.map.kind == NavigationMapKind::kGrid ? RasterMapKind::kGrid : RasterMapKind::kFastBhm;
+  occupancy::RasterMapOptions o;
+  o.kind = c.map.kind == NavigationMapKind::kGrid ? occupancy::RasterMapKind::kGrid
+                                                  : occupancy::RasterMapKind::kFastBhm;
   o.sample_step = c.map.raster_resolution;
   o.spacing = c.map.spacing;
   o.margin = 1.0;
-  WriteRasterMap(raster, o, path, config::ToYaml(c), c.seed);
+  occupancy::WriteRasterMap(raster, o, path, config::ToYaml(c), c.seed);
 }
 
 /// Distance (m) from each raster cell to the nearest occupied cell or the outside of the raster
@@ -185,14 +186,14 @@ NavigationResources PrepareNavigation(const NavigationExperimentConfig& c,
     map_path = out_dir + "/map.h5";
     BuildScenarioMap(c, res.raster, map_path);
   }
-  res.map = LoadOccupancyMap(map_path);
+  res.map = occupancy::LoadMap(map_path);
   res.field = std::make_unique<nav::StaticCollisionField>(*res.map, c.scenario.robot_radius,
                                                           c.map.field_resolution);
   if (UsesPredictor(c)) {
     FS_THROW_UNLESS(fs::exists(c.predictor.artifact), "predictor.artifact: ", c.predictor.artifact,
                     " not found (train it with `foresight navigate` in a LibTorch build, or "
                     "`foresight train`)");
-    res.predictor = std::make_unique<SpanPredictor>(SpanPredictor::Load(c.predictor.artifact));
+    res.predictor = std::make_unique<span::Predictor>(span::Predictor::Load(c.predictor.artifact));
     const double ratio = res.predictor->seconds_per_step() / c.dt;
     FS_THROW_UNLESS(std::abs(ratio - std::round(ratio)) < 1e-6 && ratio >= 1,
                     "predictor.artifact: ", c.predictor.artifact, " observes every ",
@@ -453,7 +454,7 @@ std::vector<MethodSummary> RunNavigation(const NavigationExperimentConfig& c,
                     " is unreachable from the start on the static map");
     // The controllers see the map artifact (through the swept field), not the raster: check there
     // too.
-    MapWorkspace ws = res.field->MakeWorkspace();
+    occupancy::MapWorkspace ws = res.field->MakeWorkspace();
     const double eps = c.span.options.epsilon;
     FS_THROW_UNLESS(!res.field->Collides(start.x(), start.y(), eps, &ws), "scenario.robot_start: (",
                     start.transpose(), ") of episode ", e,

@@ -24,12 +24,12 @@ namespace foresight {
 /// What every episode shares: the static map (through its artifact), the swept field, the
 /// ground-truth obstacle raster (for collision metrics) and the predictor.
 struct NavigationResources {
-  std::unique_ptr<OccupancyMap> map;
+  std::unique_ptr<occupancy::Map> map;
   std::unique_ptr<nav::StaticCollisionField> field;
   OccupancyRaster raster;
   Eigen::MatrixXf
       static_distance;  ///< [rows x cols] of `raster`: distance to the nearest obstacle (m)
-  std::unique_ptr<SpanPredictor> predictor;  ///< null when no method needs it
+  std::unique_ptr<span::Predictor> predictor;  ///< null when no method needs it
   double StaticDistance(double x, double y) const;
 };
 

@@ -20,12 +20,12 @@
 #include "training/occupancy/octomap_baseline.h"
 #include "training/occupancy/pipeline.h"
 
-namespace foresight {
+namespace foresight::occupancy {
 namespace {
 
 using bench::MedianSeconds;
 
-struct OccupancyBenchOptions {
+struct BenchOptions {
   int repeats = 5;
   double bhm_spacing = 1.0;
   int bhm_scans = 40;
@@ -43,9 +43,9 @@ struct OccupancyBenchOptions {
   }
 };
 
-void RunOccupancyBench(const BenchRequest& req, const OccupancyBenchOptions& a) {
-  const auto c = LoadBenchConfig<OccupancyExperimentConfig>(req);
-  const OccupancyData data = LoadOccupancyData(c);
+void RunBench(const BenchRequest& req, const BenchOptions& a) {
+  const auto c = LoadBenchConfig<ExperimentConfig>(req);
+  const Data data = LoadData(c);
   const HingeGrid grid(c.features);
 
   // Fast-BHM on the full training set.
@@ -83,7 +83,7 @@ void RunOccupancyBench(const BenchRequest& req, const OccupancyBenchOptions& a) 
   const double query_s = MedianSeconds(a.repeats, [&] {
     for (int p = 0; p < passes; ++p)
       for (std::int64_t i = 0; i < n; ++i) {
-        const OccupancyQuery q = map->Query(data.test.xy(0, i), data.test.xy(1, i), &ws);
+        const QueryResult q = map->Query(data.test.xy(0, i), data.test.xy(1, i), &ws);
         sink += q.probability + q.dp_dx + q.variance;
       }
   });
@@ -119,8 +119,6 @@ void RunOccupancyBench(const BenchRequest& req, const OccupancyBenchOptions& a) 
 
 }  // namespace
 
-void SetOccupancyBench(ExperimentKind* kind) {
-  SetBench<OccupancyBenchOptions>(kind, RunOccupancyBench);
-}
+void SetBenchStep(ExperimentKind* kind) { SetBench<BenchOptions>(kind, RunBench); }
 
-}  // namespace foresight
+}  // namespace foresight::occupancy

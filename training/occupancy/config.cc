@@ -2,9 +2,9 @@
 
 #include <algorithm>
 
-namespace foresight {
-void OccupancyExperimentConfig::Validate(const std::string& source) const {
-  const OccupancyExperimentConfig& c = *this;
+namespace foresight::occupancy {
+void ExperimentConfig::Validate(const std::string& source) const {
+  const ExperimentConfig& c = *this;
   static const std::vector<std::string> kModels{"occupancy.fast_bhm", "occupancy.bhm",
                                                 "occupancy.hilbert", "occupancy.grid",
                                                 "occupancy.fusion"};
@@ -23,4 +23,4 @@ void OccupancyExperimentConfig::Validate(const std::string& source) const {
                   ": keys 'grid.x_min/x_max/y_min/y_max' give an empty extent");
 }
 
-}  // namespace foresight
+}  // namespace foresight::occupancy

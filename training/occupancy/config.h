@@ -17,11 +17,11 @@
 #include "models/occupancy/grid_builder.h"
 #include "models/occupancy/hilbert_map.h"
 
-namespace foresight {
+namespace foresight::occupancy {
 
 enum class ScanSource { kCarmen, kSynthetic };
 
-struct OccupancyDataConfig {
+struct DataConfig {
   ScanSource format = ScanSource::kSynthetic;
   std::string
       root;  ///< directory of relative file names (empty: $FORESIGHT_DATA or ../shared/data)
@@ -77,7 +77,7 @@ struct FusionExperimentConfig {
   }
 };
 
-struct OccupancyEvalConfig {
+struct EvalConfig {
   double plot_resolution = 0.1;  ///< m per pixel of plots/map.png
   int roc_points = 200;          ///< rows of roc.csv
 
@@ -89,18 +89,18 @@ struct OccupancyEvalConfig {
   }
 };
 
-struct OccupancyExperimentConfig {
+struct ExperimentConfig {
   /// occupancy.fast_bhm | occupancy.bhm | occupancy.hilbert | occupancy.grid | occupancy.fusion
   std::string model = "occupancy.fast_bhm";
   std::int64_t seed = 0;
-  OccupancyDataConfig data;
+  DataConfig data;
   HingeGridConfig features;
   FastBhmConfig fast_bhm;
   HilbertMapConfig hilbert;
   GridMapConfig grid;
   FusionExperimentConfig fusion;
   StoredPrecision precision = StoredPrecision::kFloat32;
-  OccupancyEvalConfig eval;
+  EvalConfig eval;
 
   template <class A>
   void Serialize(A* a) {
@@ -126,4 +126,4 @@ struct OccupancyExperimentConfig {
   void Validate(const std::string& source) const;
 };
 
-}  // namespace foresight
+}  // namespace foresight::occupancy

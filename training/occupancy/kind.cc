@@ -9,44 +9,42 @@
 #include "training/kinds.h"
 #include "training/occupancy/pipeline.h"
 
-namespace foresight {
+namespace foresight::occupancy {
 
-ExperimentKind OccupancyKind() {
+ExperimentKind Kind() {
   ExperimentKind k;
   k.tag = "occupancy.";
   k.tag_is_prefix = true;
   k.summary = "Occupancy maps and their fusion (thesis ch 3)";
   k.configs = "configs/occupancy/*.yaml";
   k.resumable = false;  // one pass of seconds
-  k.reference = [] { return config::ReferenceTable<OccupancyExperimentConfig>(); };
+  k.reference = [] { return config::ReferenceTable<ExperimentConfig>(); };
   k.train = [](const TrainRequest& req) {
     FS_THROW_UNLESS(
         req.config != "default" && !req.config.empty(),
         "occupancy maps have no embedded default config; name one (configs/occupancy/*.yaml)");
-    const auto c =
-        config::LoadExperimentConfig<OccupancyExperimentConfig>(req.config, req.overrides);
+    const auto c = config::LoadExperimentConfig<ExperimentConfig>(req.config, req.overrides);
     FS_THROW_UNLESS(!req.resume,
                     "--resume: occupancy maps train in one pass (seconds); run again into a new "
                     "or empty --run-dir");
-    TrainOccupancyRun(c, req.run_dir);
+    TrainRun(c, req.run_dir);
     std::cout << "artifact: " << req.run_dir << "/model.h5\n";
     if (!req.evaluate) return;
-    std::cout << EvaluateOccupancyRun(c, req.run_dir) << "wrote " << req.run_dir
+    std::cout << EvaluateRun(c, req.run_dir) << "wrote " << req.run_dir
               << "/eval.json, roc.csv and plots/map.png\n";
   };
   k.export_run = [](const std::string& run_dir) {
     const std::string artifact = run_dir + "/model.h5";
     FS_THROW_UNLESS(std::filesystem::exists(artifact), artifact,
                     ": not found (train the map first)");
-    (void)LoadOccupancyMap(artifact);  // the engine loads what training wrote
+    (void)LoadMap(artifact);  // the engine loads what training wrote
     return artifact;
   };
   k.evaluate = [](const std::string& run_dir, const std::vector<std::string>& overrides) {
-    return EvaluateOccupancyRun(LoadRunConfig<OccupancyExperimentConfig>(run_dir, overrides),
-                                run_dir);
+    return EvaluateRun(LoadRunConfig<ExperimentConfig>(run_dir, overrides), run_dir);
   };
-  SetOccupancyBench(&k);
+  SetBenchStep(&k);
   return k;
 }
 
-}  // namespace foresight
+}  // namespace foresight::occupancy

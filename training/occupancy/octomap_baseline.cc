@@ -8,9 +8,9 @@
 #include <memory>
 #include <sstream>
 
-namespace foresight {
+namespace foresight::occupancy {
 
-OctomapFigures RunOctomapBaseline(const OccupancyData& data, double max_range, double resolution,
+OctomapFigures RunOctomapBaseline(const Data& data, double max_range, double resolution,
                                   int repeats) {
   OctomapFigures f;
   std::unique_ptr<octomap::OcTree> tree;
@@ -52,4 +52,4 @@ OctomapFigures RunOctomapBaseline(const OccupancyData& data, double max_range, d
   return f;
 }
 
-}  // namespace foresight
+}  // namespace foresight::occupancy

@@ -8,7 +8,7 @@
 
 #include "training/occupancy/pipeline.h"
 
-namespace foresight {
+namespace foresight::occupancy {
 
 struct OctomapFigures {
   double insert_s = 0;  ///< wall-clock time to insert all training scans (median of repeats)
@@ -17,7 +17,7 @@ struct OctomapFigures {
   std::int64_t memory = 0;  ///< OcTree::memoryUsage()
 };
 
-OctomapFigures RunOctomapBaseline(const OccupancyData& data, double max_range, double resolution,
+OctomapFigures RunOctomapBaseline(const Data& data, double max_range, double resolution,
                                   int repeats);
 
-}  // namespace foresight
+}  // namespace foresight::occupancy

@@ -23,7 +23,7 @@
 #include "models/occupancy/scan_training.h"
 #include "training/occupancy/plots.h"
 
-namespace foresight {
+namespace foresight::occupancy {
 namespace fs = std::filesystem;
 
 namespace {
@@ -44,8 +44,7 @@ std::string MetricsJson(const BinaryMetrics& m) {
          ", \"recall\": " + Json(m.recall) + "}";
 }
 
-void WriteRoc(const OccupancyMap& map, const LabelledPoints& test, int points,
-              const std::string& path) {
+void WriteRoc(const Map& map, const LabelledPoints& test, int points, const std::string& path) {
   MapWorkspace ws = map.MakeWorkspace();
   std::vector<double> scores(test.size());
   for (std::int64_t i = 0; i < test.size(); ++i)
@@ -59,18 +58,18 @@ void WriteRoc(const OccupancyMap& map, const LabelledPoints& test, int points,
 
 }  // namespace
 
-std::vector<LaserScan> OccupancyData::TrainScanList() const {
+std::vector<LaserScan> Data::TrainScanList() const {
   std::vector<LaserScan> out;
   out.reserve(train_scans.size());
   for (const int s : train_scans) out.push_back(scans[s]);
   return out;
 }
 
-OccupancyData LoadOccupancyData(const OccupancyExperimentConfig& c) {
-  const OccupancyDataConfig& d = c.data;
+Data LoadData(const ExperimentConfig& c) {
+  const DataConfig& d = c.data;
   FS_THROW_UNLESS(d.test_offset < d.test_every, "data.test_offset ", d.test_offset,
                   " must be smaller than data.test_every ", d.test_every);
-  OccupancyData data;
+  Data data;
   if (d.format == ScanSource::kCarmen) {
     FS_THROW_UNLESS(!d.file.empty(), "data.file: no CARMEN log given (format: carmen)");
     const std::string path = ResolveDataFile(d.root, d.file);
@@ -146,12 +145,10 @@ std::string BoundReportsJson(const std::vector<BoundUpdateReport>& reports) {
 
 }  // namespace
 
-std::unique_ptr<OccupancyMap> TrainOccupancyMap(const std::string& model,
-                                                const OccupancyExperimentConfig& c,
-                                                const OccupancyData& data, double* seconds,
-                                                std::vector<BoundUpdateReport>* bound_reports) {
+std::unique_ptr<Map> TrainMap(const std::string& model, const ExperimentConfig& c, const Data& data,
+                              double* seconds, std::vector<BoundUpdateReport>* bound_reports) {
   const auto start = std::chrono::steady_clock::now();
-  std::unique_ptr<OccupancyMap> map;
+  std::unique_ptr<Map> map;
   const bool coupled = c.fast_bhm.update == FastBhmUpdate::kCoupled;
   if (model == kFastBhmType && coupled) {
     const auto learner = FitCoupledBhm(HingeGrid(c.features), c.fast_bhm, data.train,
@@ -197,8 +194,7 @@ std::unique_ptr<OccupancyMap> TrainOccupancyMap(const std::string& model,
   return map;
 }
 
-void SaveOccupancyMap(const OccupancyMap& map, const std::string& path,
-                      const OccupancyExperimentConfig& c) {
+void SaveMap(const Map& map, const std::string& path, const ExperimentConfig& c) {
   const std::string yaml = config::ToYaml(c);
   if (const auto* h = dynamic_cast<const HingeMap*>(&map)) {
     h->Save(path, yaml, c.seed, c.precision);
@@ -209,17 +205,17 @@ void SaveOccupancyMap(const OccupancyMap& map, const std::string& path,
   }
 }
 
-std::int64_t ArtifactBytes(const OccupancyMap& map, const OccupancyExperimentConfig& c) {
+std::int64_t ArtifactBytes(const Map& map, const ExperimentConfig& c) {
   const fs::path tmp =
       fs::temp_directory_path() /
       ("foresight_artifact_size_" + std::to_string(reinterpret_cast<std::uintptr_t>(&map)) + ".h5");
-  SaveOccupancyMap(map, tmp.string(), c);
+  SaveMap(map, tmp.string(), c);
   const auto bytes = static_cast<std::int64_t>(fs::file_size(tmp));
   fs::remove(tmp);
   return bytes;
 }
 
-BinaryMetrics EvaluateMap(const OccupancyMap& map, const LabelledPoints& points) {
+BinaryMetrics EvaluateMap(const Map& map, const LabelledPoints& points) {
   MapWorkspace ws = map.MakeWorkspace();
   std::vector<double> scores(points.size());
   for (std::int64_t i = 0; i < points.size(); ++i)
@@ -227,7 +223,7 @@ BinaryMetrics EvaluateMap(const OccupancyMap& map, const LabelledPoints& points)
   return EvaluateBinary(scores, points.occupied, 0.5);
 }
 
-FusionResult RunFusion(const OccupancyExperimentConfig& c, const OccupancyData& data) {
+FusionResult RunFusion(const ExperimentConfig& c, const Data& data) {
   const HingeGrid grid(c.features);
   FusionResult r;
   // Robots: lists of indices into data.train's scans, in recording order.
@@ -309,18 +305,18 @@ FusionResult RunFusion(const OccupancyExperimentConfig& c, const OccupancyData& 
   return r;
 }
 
-void TrainOccupancyRun(const OccupancyExperimentConfig& c, const std::string& run_dir) {
+void TrainRun(const ExperimentConfig& c, const std::string& run_dir) {
   StartRunDirectory(run_dir, config::ToYaml(c), false, kOccupancyRunRules);
-  const OccupancyData data = LoadOccupancyData(c);
+  const Data data = LoadData(c);
   const std::string artifact = run_dir + "/model.h5";
   const auto start = std::chrono::steady_clock::now();
   if (c.model == "occupancy.fusion") {
     const FusionResult r = RunFusion(c, data);
-    SaveOccupancyMap(*r.single, run_dir + "/single.h5", c);
-    SaveOccupancyMap(*r.fuse_once, run_dir + "/fuse_once.h5", c);
-    if (r.conflated) SaveOccupancyMap(*r.conflated, run_dir + "/conflated.h5", c);
+    SaveMap(*r.single, run_dir + "/single.h5", c);
+    SaveMap(*r.fuse_once, run_dir + "/fuse_once.h5", c);
+    if (r.conflated) SaveMap(*r.conflated, run_dir + "/conflated.h5", c);
     // The run's map: the exactly fused learning map (coupled), else the repeated fusion.
-    SaveOccupancyMap(r.repeated ? *r.repeated : *r.fuse_once, artifact, c);
+    SaveMap(r.repeated ? *r.repeated : *r.fuse_once, artifact, c);
     std::ostringstream out;
     out << "{\"seconds\": " << Json(Seconds(start)) << ", \"robots\": " << r.robot_scans.size()
         << ", \"robot_scans\": [";
@@ -336,8 +332,8 @@ void TrainOccupancyRun(const OccupancyExperimentConfig& c, const std::string& ru
   } else {
     double secs = 0;
     std::vector<BoundUpdateReport> bounds;
-    const std::unique_ptr<OccupancyMap> map = TrainOccupancyMap(c.model, c, data, &secs, &bounds);
-    SaveOccupancyMap(*map, artifact, c);
+    const std::unique_ptr<Map> map = TrainMap(c.model, c, data, &secs, &bounds);
+    SaveMap(*map, artifact, c);
     std::ostringstream out;
     out << "{\"seconds\": " << Json(secs) << ", \"bound_updates\": " << BoundReportsJson(bounds)
         << "}\n";
@@ -346,10 +342,10 @@ void TrainOccupancyRun(const OccupancyExperimentConfig& c, const std::string& ru
   }
 }
 
-std::string EvaluateOccupancyRun(const OccupancyExperimentConfig& c, const std::string& run_dir) {
+std::string EvaluateRun(const ExperimentConfig& c, const std::string& run_dir) {
   const std::string artifact = run_dir + "/model.h5";
   FS_THROW_UNLESS(fs::exists(artifact), artifact, ": not found (train the map first)");
-  const OccupancyData data = LoadOccupancyData(c);
+  const Data data = LoadData(c);
   fs::create_directories(run_dir + "/plots");
   std::ostringstream json;
   json << "{\n  \"model\": \"" << c.model << "\",\n  \"train_scans\": " << data.train_scans.size()
@@ -369,13 +365,13 @@ std::string EvaluateOccupancyRun(const OccupancyExperimentConfig& c, const std::
                                                                 "conflated.h5"}}
             : std::vector<std::pair<std::string, std::string>>{
                   {"single", "single.h5"}, {"fuse_once", "fuse_once.h5"}, {"repeated", "model.h5"}};
-    std::vector<std::unique_ptr<OccupancyMap>> maps;
+    std::vector<std::unique_ptr<Map>> maps;
     std::vector<MapPanel> panels;
     json << "  \"update\": \"" << (coupled ? "coupled" : "published") << "\"";
     if (!coupled) json << ",\n  \"merges\": " << c.fusion.merges;  // coupled fuses once
     BinaryMetrics last;
     for (const auto& [name, file] : files) {
-      maps.push_back(LoadOccupancyMap(run_dir + "/" + file));
+      maps.push_back(LoadMap(run_dir + "/" + file));
       last = EvaluateMap(*maps.back(), data.test);
       json << ",\n  \"auc_" << name << "\": " << Json(last.auc) << ",\n  \"" << name
            << "\": " << MetricsJson(last) << ",\n  \"" << name
@@ -383,14 +379,14 @@ std::string EvaluateOccupancyRun(const OccupancyExperimentConfig& c, const std::
       panels.push_back({name, maps.back().get()});
       log::Info("fusion: ", name, " AUC ", last.auc);
     }
-    const BinaryMetrics shipped = EvaluateMap(*LoadOccupancyMap(artifact), data.test);
+    const BinaryMetrics shipped = EvaluateMap(*LoadMap(artifact), data.test);
     json << ",\n  \"auc\": " << Json(shipped.auc)
          << ",\n  \"precision\": " << Json(shipped.precision)
          << ",\n  \"recall\": " << Json(shipped.recall)
          << ",\n  \"artifact_bytes\": " << fs::file_size(artifact) << "\n}\n";
     WriteMapPanels(panels, c.eval.plot_resolution, run_dir + "/plots/map.png");
   } else {
-    const std::unique_ptr<OccupancyMap> loaded = LoadOccupancyMap(artifact);  // evaluate what ships
+    const std::unique_ptr<Map> loaded = LoadMap(artifact);  // evaluate what ships
     const BinaryMetrics m = EvaluateMap(*loaded, data.test);
     json << "  \"auc\": " << Json(m.auc) << ",\n  \"precision\": " << Json(m.precision)
          << ",\n  \"recall\": " << Json(m.recall)
@@ -406,4 +402,4 @@ std::string EvaluateOccupancyRun(const OccupancyExperimentConfig& c, const std::
   return json.str();
 }
 
-}  // namespace foresight
+}  // namespace foresight::occupancy

@@ -15,12 +15,12 @@
 #include "training/occupancy/config.h"
 #include "training/run_dir.h"
 
-namespace foresight {
+namespace foresight::occupancy {
 
 struct BoundUpdateReport;  // models/occupancy/coupled_bhm.h
 
 /// Scans and labelled points of an experiment, split by scan.
-struct OccupancyData {
+struct Data {
   std::vector<LaserScan> scans;  ///< all scans, in recording order
   LabelledPoints points;         ///< labelled points of all scans (scan s of points = scans[s])
   std::vector<int> train_scans, val_scans, test_scans;  ///< indices into scans, in order
@@ -30,44 +30,42 @@ struct OccupancyData {
 
 /// Reads or simulates the scans and splits them (test: every test_every-th scan; training: the
 /// rest, thinned by train_scan_stride, minus every val_every-th for validation).
-OccupancyData LoadOccupancyData(const OccupancyExperimentConfig& config);
+Data LoadData(const ExperimentConfig& config);
 
 /// Trains one map of kind `model` (occupancy.fast_bhm | bhm | hilbert | grid) on the training
 /// scans, in recording order. `seconds` receives the wall-clock training time; `bound_reports`
 /// the ELBO of every bound update (fast_bhm.update: coupled; also for bhm, whose coupled variant
 /// keeps the learned posterior with its dense covariance).
-std::unique_ptr<OccupancyMap> TrainOccupancyMap(
-    const std::string& model, const OccupancyExperimentConfig& config, const OccupancyData& data,
-    double* seconds = nullptr, std::vector<BoundUpdateReport>* bound_reports = nullptr);
+std::unique_ptr<Map> TrainMap(const std::string& model, const ExperimentConfig& config,
+                              const Data& data, double* seconds = nullptr,
+                              std::vector<BoundUpdateReport>* bound_reports = nullptr);
 /// Writes the map's artifact (hinge maps with config.precision).
-void SaveOccupancyMap(const OccupancyMap& map, const std::string& path,
-                      const OccupancyExperimentConfig& config);
+void SaveMap(const Map& map, const std::string& path, const ExperimentConfig& config);
 /// Size in bytes of the artifact SaveOccupancyMap would write (measured via a temporary file).
-std::int64_t ArtifactBytes(const OccupancyMap& map, const OccupancyExperimentConfig& config);
+std::int64_t ArtifactBytes(const Map& map, const ExperimentConfig& config);
 /// AUC, precision and recall (threshold 0.5) of the map's probabilities on labelled points.
-BinaryMetrics EvaluateMap(const OccupancyMap& map, const LabelledPoints& points);
+BinaryMetrics EvaluateMap(const Map& map, const LabelledPoints& points);
 
 /// Multi-robot fusion (thesis ch 3 "Fusion of Fast-BHM"): single map, fuse once, repeated fusion.
 /// fast_bhm.update: coupled -> single, fuse_once (the robots' sparse information summed: exact
 /// for their bounds) and conflated (their diagonal maps conflated: approximate); published ->
 /// single, fuse_once and repeated (conflation, the thesis's algorithms).
 struct FusionResult {
-  std::unique_ptr<OccupancyMap> single, fuse_once, repeated, conflated;
+  std::unique_ptr<Map> single, fuse_once, repeated, conflated;
   std::vector<int> robot_scans;                 ///< training scans per robot
   std::vector<std::int64_t> information_bytes;  ///< coupled: per robot, of its sparse information
 };
-FusionResult RunFusion(const OccupancyExperimentConfig& config, const OccupancyData& data);
+FusionResult RunFusion(const ExperimentConfig& config, const Data& data);
 
 /// What shows an occupancy run in a directory (maps train in one pass: no resume).
 inline const RunDirectoryRules kOccupancyRunRules{{"model.h5", "eval.json"}, false};
 
 /// Trains the map (or the fusion experiment) into RUN_DIR: model.h5 (the fused map for
 /// occupancy.fusion, with single.h5 and fuse_once.h5), training_summary.json (seconds).
-void TrainOccupancyRun(const OccupancyExperimentConfig& config, const std::string& run_dir);
+void TrainRun(const ExperimentConfig& config, const std::string& run_dir);
 
 /// Evaluates the run's maps as loaded from their artifacts on the held-out scans: writes
 /// eval.json, roc.csv (single maps) and plots/map.png. @return the eval.json text.
-std::string EvaluateOccupancyRun(const OccupancyExperimentConfig& config,
-                                 const std::string& run_dir);
+std::string EvaluateRun(const ExperimentConfig& config, const std::string& run_dir);
 
-}  // namespace foresight
+}  // namespace foresight::occupancy

@@ -7,7 +7,7 @@
 #include "core/error.h"
 #include "training/image_io.h"
 
-namespace foresight {
+namespace foresight::occupancy {
 
 void WriteMapPanels(const std::vector<MapPanel>& panels, double resolution,
                     const std::string& png_path) {
@@ -21,14 +21,14 @@ void WriteMapPanels(const std::vector<MapPanel>& panels, double resolution,
   cv::Mat canvas(2 * (h + kTitle), static_cast<int>(panels.size()) * (w + 4), CV_8UC3,
                  cv::Scalar(255, 255, 255));
   for (std::size_t k = 0; k < panels.size(); ++k) {
-    const OccupancyMap& map = *panels[k].map;
+    const Map& map = *panels[k].map;
     MapWorkspace ws = map.MakeWorkspace();
     cv::Mat prob(h, w, CV_8UC1), var(h, w, CV_8UC1);
     for (int r = 0; r < h; ++r) {
       const double y = e[3] - (r + 0.5) * resolution;  // image rows go down, y up
       for (int col = 0; col < w; ++col) {
         const double x = e[0] + (col + 0.5) * resolution;
-        const OccupancyQuery q = map.Query(x, y, &ws);
+        const QueryResult q = map.Query(x, y, &ws);
         prob.at<std::uint8_t>(r, col) =
             static_cast<std::uint8_t>(std::lround(255.0 * (1.0 - q.probability)));
         // log10 variance from 1e-3 to 1e4 onto 0..255
@@ -51,4 +51,4 @@ void WriteMapPanels(const std::vector<MapPanel>& panels, double resolution,
   WriteImage(png_path, canvas);
 }
 
-}  // namespace foresight
+}  // namespace foresight::occupancy

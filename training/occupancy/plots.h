@@ -7,15 +7,15 @@
 
 #include "inference/mapping/occupancy_map.h"
 
-namespace foresight {
+namespace foresight::occupancy {
 
 struct MapPanel {
   std::string title;
-  const OccupancyMap* map;
+  const Map* map;
 };
 
 /// Renders every map over the first map's extent at `resolution` m per pixel, side by side.
 void WriteMapPanels(const std::vector<MapPanel>& panels, double resolution,
                     const std::string& png_path);
 
-}  // namespace foresight
+}  // namespace foresight::occupancy

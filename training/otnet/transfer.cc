@@ -49,12 +49,12 @@ std::vector<Eigen::Vector2d> BorderOpenings(const BinaryGrid& g, int count) {
   return out;
 }
 
-BinaryGrid RasteriseSection(const foresight::OccupancyMap& map, double x_min, double y_min,
+BinaryGrid RasteriseSection(const foresight::occupancy::Map& map, double x_min, double y_min,
                             double side, int size, double threshold) {
   FS_THROW_UNLESS(side > 0 && size > 0, "RasteriseSection: side ", side, " and size ", size,
                   " must be positive");
   BinaryGrid g(size, size);
-  MapWorkspace ws = map.MakeWorkspace();
+  occupancy::MapWorkspace ws = map.MakeWorkspace();
   const double cell = side / size;
   for (int r = 0; r < size; ++r)
     for (int c = 0; c < size; ++c)
@@ -71,7 +71,8 @@ Scores TransferToOccupancyMap(const OtnetConfig& c, const OtnetModel& model,
                   " numbers; expected x_min, y_min, side per section");
   FS_THROW_UNLESS(t.starts.size() % 2 == 0 && t.openings >= 1, "transfer.starts: ", t.starts.size(),
                   " numbers; expected x, y pairs");
-  const std::unique_ptr<foresight::OccupancyMap> occupancy = LoadOccupancyMap(t.occupancy_artifact);
+  const std::unique_ptr<foresight::occupancy::Map> occupancy =
+      occupancy::LoadMap(t.occupancy_artifact);
   const int size = model.encoder().width();
   std::vector<BinaryGrid> train_maps;
   for (const MapTrajectories& m : train.maps) train_maps.push_back(m.map);

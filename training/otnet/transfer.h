@@ -16,7 +16,7 @@ namespace foresight::otnet {
 /// Section [x_min, y_min, side] (m) of `map` as a size x size grid: cell (r, c) is occupied when
 /// p(occupied) at its centre (x_min + (c + 1/2) side / size, y_min + (r + 1/2) side / size) is at
 /// or above threshold. Row r grows with y.
-BinaryGrid RasteriseSection(const foresight::OccupancyMap& map, double x_min, double y_min,
+BinaryGrid RasteriseSection(const foresight::occupancy::Map& map, double x_min, double y_min,
                             double side, int size, double threshold);
 
 /// Start points at the openings of the section's border (Occ-Traj120's trajectories enter through

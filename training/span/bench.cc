@@ -17,7 +17,7 @@
 #include "training/kinds.h"
 #include "training/span/torch_io.h"
 
-namespace foresight {
+namespace foresight::span {
 namespace {
 
 using bench::Clock;
@@ -39,7 +39,7 @@ Eigen::MatrixXd RandomPasts(int n, int p, double dt, std::uint64_t seed) {
   return out;
 }
 
-struct SpanBenchOptions {
+struct BenchOptions {
   int calls = 20000;  ///< timed single calls of the engine
 
   template <class A>
@@ -49,9 +49,9 @@ struct SpanBenchOptions {
   }
 };
 
-void RunSpanBench(const BenchRequest& req, const SpanBenchOptions& a) {
+void RunBench(const BenchRequest& req, const BenchOptions& a) {
   const std::string artifact = BenchArtifact(req, "model.h5");
-  const SpanPredictor model = SpanPredictor::Load(artifact);
+  const Predictor model = Predictor::Load(artifact);
   const int p = model.observed();
   const Eigen::MatrixXd pasts = RandomPasts(256, p, model.seconds_per_step(), 1);
   auto ws = model.MakeWorkspace();
@@ -80,7 +80,7 @@ void RunSpanBench(const BenchRequest& req, const SpanBenchOptions& a) {
   const double engine_batch1024_us = Median(batch_times);
 
   torch::set_num_threads(1);
-  LoadedSpanNet loaded = LoadSpanNetFromArtifact(artifact);
+  LoadedNet loaded = LoadNetFromArtifact(artifact);
   double libtorch_us = NAN, train_windows_per_s = NAN;
   {
     c10::InferenceMode guard;
@@ -147,6 +147,6 @@ void RunSpanBench(const BenchRequest& req, const SpanBenchOptions& a) {
 
 }  // namespace
 
-void SetSpanBench(ExperimentKind* kind) { SetBench<SpanBenchOptions>(kind, RunSpanBench); }
+void SetBenchStep(ExperimentKind* kind) { SetBench<BenchOptions>(kind, RunBench); }
 
-}  // namespace foresight
+}  // namespace foresight::span

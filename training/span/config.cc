@@ -2,10 +2,10 @@
 
 #include "core/layer_widths.h"
 
-namespace foresight {
+namespace foresight::span {
 
-void SpanExperimentConfig::Validate(const std::string& source) const {
-  const SpanExperimentConfig& c = *this;
+void ExperimentConfig::Validate(const std::string& source) const {
+  const ExperimentConfig& c = *this;
   FS_THROW_UNLESS(c.model == "span_predictor", source, ": key 'model': value '", c.model,
                   "' is not 'span_predictor'");
   FS_THROW_UNLESS(c.data.synthetic.speed_max >= c.data.synthetic.speed_min, source,
@@ -21,4 +21,4 @@ void SpanExperimentConfig::Validate(const std::string& source) const {
   CheckLayerWidths(c.network.hidden, source, "network.hidden");
 }
 
-}  // namespace foresight
+}  // namespace foresight::span

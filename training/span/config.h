@@ -11,9 +11,9 @@
 #include "models/span/span_config.h"
 #include "training/train_config.h"
 
-namespace foresight {
+namespace foresight::span {
 
-struct SpanEvalConfig {
+struct EvalConfig {
   int num_samples = 20;          ///< samples for best-of-N metrics
   std::int64_t sample_seed = 7;  ///< seed of the evaluation sampler
   int plot_tracks = 6;           ///< windows drawn in plots/samples.png
@@ -29,15 +29,15 @@ struct SpanEvalConfig {
   }
 };
 
-struct SpanExperimentConfig {
+struct ExperimentConfig {
   std::string model = "span_predictor";
   std::int64_t seed = 0;
   PedestrianDataConfig data;
   WindowConfig windows;
   TrajectoryBasisConfig basis;
-  SpanNetConfig network;
+  NetConfig network;
   TrainConfig train;
-  SpanEvalConfig eval;
+  EvalConfig eval;
 
   template <class A>
   void Serialize(A* a) {
@@ -54,4 +54,4 @@ struct SpanExperimentConfig {
   void Validate(const std::string& source) const;
 };
 
-}  // namespace foresight
+}  // namespace foresight::span

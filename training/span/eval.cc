@@ -17,7 +17,7 @@
 #include "inference/prediction/span_predictor.h"
 #include "training/span/plots.h"
 
-namespace foresight {
+namespace foresight::span {
 namespace fs = std::filesystem;
 
 namespace {
@@ -102,10 +102,10 @@ std::string FirstDifference(const YAML::Node& trained, const YAML::Node& given,
 /// The test split is held out only when the tracks, windows and seed are the training run's: the
 /// data, windows and seed sections of `config` must equal those stored in the artifact's /config
 /// (data.root, where the files are, may differ).
-void CheckSameDataAsTraining(const SpanExperimentConfig& config, const std::string& artifact) {
-  const SpanExperimentConfig trained = config::ExperimentConfigFromYaml<SpanExperimentConfig>(
-      Artifact::Open(artifact, kSpanModelType).config_yaml(), artifact + ":/config");
-  const auto tree = [](SpanExperimentConfig c) {
+void CheckSameDataAsTraining(const ExperimentConfig& config, const std::string& artifact) {
+  const ExperimentConfig trained = config::ExperimentConfigFromYaml<ExperimentConfig>(
+      Artifact::Open(artifact, kModelType).config_yaml(), artifact + ":/config");
+  const auto tree = [](ExperimentConfig c) {
     c.data.root.clear();
     return config::ParseYaml(config::ToYaml(c), "resolved config");
   };
@@ -120,7 +120,7 @@ void CheckSameDataAsTraining(const SpanExperimentConfig& config, const std::stri
 
 }  // namespace
 
-std::string SpanEvalReport::ToJson(int num_samples) const {
+std::string EvalReport::ToJson(int num_samples) const {
   std::ostringstream os;
   os << "{\n  \"windows\": " << windows << ",\n  \"num_samples\": " << num_samples << ",\n"
      << "  \"ade\": " << Num(model.ade) << ",\n  \"fde\": " << Num(model.fde) << ",\n"
@@ -143,9 +143,9 @@ std::string SpanEvalReport::ToJson(int num_samples) const {
   return os.str();
 }
 
-SpanEvalReport EvaluateSpanOn(const std::string& artifact, const WindowSet& train,
-                              const WindowSet& test, const SpanEvalConfig& ec) {
-  const SpanPredictor model = SpanPredictor::Load(artifact);
+EvalReport EvaluateOn(const std::string& artifact, const WindowSet& train, const WindowSet& test,
+                      const EvalConfig& ec) {
+  const Predictor model = Predictor::Load(artifact);
   FS_THROW_UNLESS(model.observed() == test.observed, artifact, ": model observes ",
                   model.observed(), " points but the test windows have ", test.observed);
   FS_THROW_UNLESS(std::abs(model.seconds_per_step() - test.seconds_per_step) < 1e-9, artifact,
@@ -165,7 +165,7 @@ SpanEvalReport EvaluateSpanOn(const std::string& artifact, const WindowSet& trai
   for (int k = 0; k < f; ++k)
     cv_chol[static_cast<std::size_t>(k)] = cv.cov_ego[static_cast<std::size_t>(k)].llt().matrixL();
 
-  SpanEvalReport rep;
+  EvalReport rep;
   rep.windows = count;
   Eigen::Matrix<double, Eigen::Dynamic, 2> path(f, 2), cv_path(f, 2);
   Eigen::Matrix<double, Eigen::Dynamic, 2> past(test.observed, 2);
@@ -206,15 +206,15 @@ SpanEvalReport EvaluateSpanOn(const std::string& artifact, const WindowSet& trai
     rep.cv.best_of_n_ade += cv_best_ade;
     rep.cv.best_of_n_fde += cv_best_fde;
   }
-  for (SpanMetrics* m : {&rep.model, &rep.cv}) {
+  for (Metrics* m : {&rep.model, &rep.cv}) {
     const double d = count;
     m->ade /= d, m->fde /= d, m->nll /= d, m->best_of_n_ade /= d, m->best_of_n_fde /= d;
   }
   return rep;
 }
 
-SpanEvalReport EvaluateSpan(const SpanExperimentConfig& c, const std::string& artifact,
-                            const std::string& out_dir) {
+EvalReport Evaluate(const ExperimentConfig& c, const std::string& artifact,
+                    const std::string& out_dir) {
   CheckSameDataAsTraining(c, artifact);
   const TrackSplit split = LoadPedestrianSplits(c.data, static_cast<std::uint64_t>(c.seed));
   const WindowSet train = MakeWindows(split.train, c.windows);
@@ -227,18 +227,17 @@ SpanEvalReport EvaluateSpan(const SpanExperimentConfig& c, const std::string& ar
   FS_THROW_UNLESS(train.size() > 0, "no training windows for the constant-velocity baseline: no ",
                   "training track has windows.observed + windows.predicted = ", length,
                   " points (data.train_files, data.val_fraction, data.test_fraction)");
-  SpanEvalReport rep = EvaluateSpanOn(artifact, train, test, c.eval);
+  EvalReport rep = EvaluateOn(artifact, train, test, c.eval);
   const WindowSet val = MakeWindows(split.val, c.windows);
   if (val.size() > 0) {
-    const SpanEvalReport v = EvaluateSpanOn(artifact, train, val, c.eval);
+    const EvalReport v = EvaluateOn(artifact, train, val, c.eval);
     rep.val_windows = v.windows;
     rep.val_model = v.model;
     rep.val_cv = v.cv;
   }
   fs::create_directories(out_dir + "/plots");
   WriteFileAtomically(out_dir + "/eval.json", rep.ToJson(c.eval.num_samples));
-  if (c.eval.plot_tracks > 0)
-    PlotSpanSamples(artifact, test, c.eval, out_dir + "/plots/samples.png");
+  if (c.eval.plot_tracks > 0) PlotSamples(artifact, test, c.eval, out_dir + "/plots/samples.png");
   log::Info("eval on ", rep.windows, " windows: ADE ", rep.model.ade, " FDE ", rep.model.fde,
             " NLL ", rep.model.nll, " best-of-", c.eval.num_samples, " ", rep.model.best_of_n_ade,
             "/", rep.model.best_of_n_fde, " | CV ADE ", rep.cv.ade, " FDE ", rep.cv.fde, " NLL ",
@@ -246,4 +245,4 @@ SpanEvalReport EvaluateSpan(const SpanExperimentConfig& c, const std::string& ar
   return rep;
 }
 
-}  // namespace foresight
+}  // namespace foresight::span

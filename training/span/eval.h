@@ -7,20 +7,20 @@
 #include "datasets/windows.h"
 #include "training/span/config.h"
 
-namespace foresight {
+namespace foresight::span {
 
-struct SpanMetrics {
+struct Metrics {
   double ade = 0, fde = 0;  ///< of the mean prediction (m)
   double nll = 0;           ///< -log density per future point (positions, nats)
   double best_of_n_ade = 0, best_of_n_fde = 0;
 };
 
-struct SpanEvalReport {
+struct EvalReport {
   int windows = 0;
-  SpanMetrics model, cv;
+  Metrics model, cv;
   /// The same metrics on the validation windows (for choosing hyper-parameters; never the test).
   int val_windows = 0;
-  SpanMetrics val_model, val_cv;
+  Metrics val_model, val_cv;
   /// Valid JSON: non-finite metrics are null, and so is "val" without validation windows.
   std::string ToJson(int num_samples) const;
 };
@@ -29,12 +29,12 @@ struct SpanEvalReport {
 /// `out_dir`/plots/samples.png. The data, windows and seed sections of `config` must be those the
 /// artifact was trained with (its /config; data.root may differ), else an Error names the first
 /// differing key. No test or training windows is an Error naming the keys that control the split.
-SpanEvalReport EvaluateSpan(const SpanExperimentConfig& config, const std::string& artifact,
-                            const std::string& out_dir);
+EvalReport Evaluate(const ExperimentConfig& config, const std::string& artifact,
+                    const std::string& out_dir);
 
 /// Same on given windows, the CV Gaussian fitted on `train` (no files written); empty `train` or
 /// `test` is an Error.
-SpanEvalReport EvaluateSpanOn(const std::string& artifact, const WindowSet& train,
-                              const WindowSet& test, const SpanEvalConfig& eval);
+EvalReport EvaluateOn(const std::string& artifact, const WindowSet& train, const WindowSet& test,
+                      const EvalConfig& eval);
 
-}  // namespace foresight
+}  // namespace foresight::span

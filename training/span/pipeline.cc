@@ -15,13 +15,13 @@
 #include "training/run_dir.h"
 #include "training/tensor_eigen.h"
 
-namespace foresight {
+namespace foresight::span {
 namespace fs = std::filesystem;
 
 namespace {
 class SpanTask : public TrainingTask {
  public:
-  SpanTask(SpanNet net, const HeadLayout& layout, torch::Tensor x_train, torch::Tensor w_train,
+  SpanTask(Net net, const HeadLayout& layout, torch::Tensor x_train, torch::Tensor w_train,
            torch::Tensor x_val, torch::Tensor w_val)
       : net_(std::move(net)),
         layout_(layout),
@@ -53,16 +53,16 @@ class SpanTask : public TrainingTask {
   }
 
  private:
-  SpanNet net_;
+  Net net_;
   HeadLayout layout_;
   torch::Tensor x_train_, w_train_, x_val_, w_val_;
 };
 
 }  // namespace
 
-TrainingSummary TrainSpan(const SpanExperimentConfig& c, const std::string& run_dir, bool resume,
-                          const TrainHooks& hooks) {
-  StartRunDirectory(run_dir, config::ToYaml(c), resume, kSpanRunRules);
+TrainingSummary TrainRun(const ExperimentConfig& c, const std::string& run_dir, bool resume,
+                         const TrainHooks& hooks) {
+  StartRunDirectory(run_dir, config::ToYaml(c), resume, kRunRules);
   log::Info(resume ? "resuming" : "training", " span_predictor in ", run_dir, " (seed ", c.seed,
             ")");
 
@@ -80,13 +80,13 @@ TrainingSummary TrainSpan(const SpanExperimentConfig& c, const std::string& run_
                   length, " points (",
                   c.data.val_files.empty() ? "raise data.val_fraction" : "check data.val_files",
                   "); the validation loss chooses the best checkpoint and drives early stopping");
-  SpanModelSpec spec = SpanModelSpecOf(c);
+  ModelSpec spec = ModelSpecOf(c);
   spec.seconds_per_step = train_w.seconds_per_step;
-  return TrainSpanOnWindows(spec, train_w, val_w, c.train, c.seed, run_dir, resume, hooks);
+  return TrainOnWindows(spec, train_w, val_w, c.train, c.seed, run_dir, resume, hooks);
 }
 
-SpanModelSpec SpanModelSpecOf(const SpanExperimentConfig& c) {
-  SpanModelSpec s;
+ModelSpec ModelSpecOf(const ExperimentConfig& c) {
+  ModelSpec s;
   s.observed = c.windows.observed;
   s.predicted = c.windows.predicted;
   s.seconds_per_step = SecondsPerStep(c.data);
@@ -95,7 +95,7 @@ SpanModelSpec SpanModelSpecOf(const SpanExperimentConfig& c) {
   return s;
 }
 
-HeadLayout LayoutOf(const SpanModelSpec& s) {
+HeadLayout LayoutOf(const ModelSpec& s) {
   HeadLayout l;
   l.basis = s.basis.num_centres;
   l.components = s.network.components;
@@ -103,10 +103,10 @@ HeadLayout LayoutOf(const SpanModelSpec& s) {
   return l;
 }
 
-SpanSamples MakeSpanSamples(const SpanModelSpec& s, const WindowSet& windows) {
+Samples MakeSamples(const ModelSpec& s, const WindowSet& windows) {
   const TimeBasis basis = MakeFutureBasis(s.basis, s.predicted, s.seconds_per_step);
-  return MakeSpanSamples(windows, basis, s.basis, s.network.rotate_to_heading,
-                         s.network.residual_to_constant_velocity);
+  return MakeSamples(windows, basis, s.basis, s.network.rotate_to_heading,
+                     s.network.residual_to_constant_velocity);
 }
 
 torch::Tensor ToFloatTensor(const Eigen::MatrixXd& m) {
@@ -148,10 +148,9 @@ InputNormalisation ReadInputNormalisation(const std::string& path) {
   return {f.ReadMatrixD("/input_mean").col(0), f.ReadMatrixD("/input_std").col(0)};
 }
 
-TrainingSummary TrainSpanNet(const SpanModelSpec& spec, const SpanSamples& train_s,
-                             const SpanSamples& val_s, const TrainConfig& train_config,
-                             std::int64_t seed, const std::string& run_dir, bool resume,
-                             const TrainHooks& hooks) {
+TrainingSummary TrainNet(const ModelSpec& spec, const Samples& train_s, const Samples& val_s,
+                         const TrainConfig& train_config, std::int64_t seed,
+                         const std::string& run_dir, bool resume, const TrainHooks& hooks) {
   FS_THROW_UNLESS(train_s.inputs.rows() > 0, run_dir, ": no training samples for the SPAN net");
   FS_THROW_UNLESS(val_s.inputs.rows() > 0, run_dir,
                   ": no validation samples for the SPAN net (the validation loss chooses the best "
@@ -172,7 +171,7 @@ TrainingSummary TrainSpanNet(const SpanModelSpec& spec, const SpanSamples& train
   if (!resume) WriteInputNormalisation(norm_path, norm);
 
   torch::manual_seed(static_cast<std::uint64_t>(seed));
-  SpanNet net(static_cast<int>(train_s.inputs.cols()), spec.network, layout);
+  Net net(static_cast<int>(train_s.inputs.cols()), spec.network, layout);
   auto w_train = ToFloatTensor(train_s.targets).view({train_s.targets.rows(), m, 2});
   auto w_val = ToFloatTensor(val_s.targets).view({val_s.targets.rows(), m, 2});
   SpanTask task(net, layout, ToFloatTensor(norm.Apply(train_s.inputs)), w_train,
@@ -181,10 +180,10 @@ TrainingSummary TrainSpanNet(const SpanModelSpec& spec, const SpanSamples& train
                hooks);
 }
 
-TrainingSummary TrainSpanOnWindows(const SpanModelSpec& spec, const WindowSet& train_w,
-                                   const WindowSet& val_w, const TrainConfig& train_config,
-                                   std::int64_t seed, const std::string& run_dir, bool resume,
-                                   const TrainHooks& hooks) {
+TrainingSummary TrainOnWindows(const ModelSpec& spec, const WindowSet& train_w,
+                               const WindowSet& val_w, const TrainConfig& train_config,
+                               std::int64_t seed, const std::string& run_dir, bool resume,
+                               const TrainHooks& hooks) {
   FS_THROW_UNLESS(train_w.size() > 0, run_dir, ": no training windows");
   FS_THROW_UNLESS(val_w.size() > 0, run_dir, ": no validation windows");
   FS_THROW_UNLESS(train_w.observed == spec.observed && train_w.predicted == spec.predicted &&
@@ -192,8 +191,8 @@ TrainingSummary TrainSpanOnWindows(const SpanModelSpec& spec, const WindowSet& t
                   run_dir, ": windows of ", train_w.observed, " + ", train_w.predicted,
                   " (train) / ", val_w.observed, " + ", val_w.predicted,
                   " (val) points, the model expects ", spec.observed, " + ", spec.predicted);
-  return TrainSpanNet(spec, MakeSpanSamples(spec, train_w), MakeSpanSamples(spec, val_w),
-                      train_config, seed, run_dir, resume, hooks);
+  return TrainNet(spec, MakeSamples(spec, train_w), MakeSamples(spec, val_w), train_config, seed,
+                  run_dir, resume, hooks);
 }
 
 Mlp ToEngineMlp(torch::nn::Module& net, const std::vector<std::string>& names) {
@@ -205,17 +204,17 @@ Mlp ToEngineMlp(torch::nn::Module& net, const std::vector<std::string>& names) {
   return Mlp(std::move(layers));
 }
 
-SpanPredictorWeights SpanWeightsFromCheckpoint(const SpanModelSpec& spec, int input_dim,
-                                               const std::string& checkpoint,
-                                               const std::string& normalisation_file) {
+PredictorWeights WeightsFromCheckpoint(const ModelSpec& spec, int input_dim,
+                                       const std::string& checkpoint,
+                                       const std::string& normalisation_file) {
   const HeadLayout layout = LayoutOf(spec);
-  SpanNet net(input_dim, spec.network, layout);
+  Net net(input_dim, spec.network, layout);
   LoadCheckpointModel(checkpoint, net.ptr().get());
   const InputNormalisation norm = ReadInputNormalisation(normalisation_file);
   FS_THROW_UNLESS(norm.mean.size() == input_dim, normalisation_file, ": normalisation of ",
                   norm.mean.size(), " inputs, the net takes ", input_dim);
   const TimeBasis basis = MakeFutureBasis(spec.basis, spec.predicted, spec.seconds_per_step);
-  SpanPredictorWeights w;
+  PredictorWeights w;
   w.observed = spec.observed;
   w.predicted = spec.predicted;
   w.seconds_per_step = spec.seconds_per_step;
@@ -231,28 +230,27 @@ SpanPredictorWeights SpanWeightsFromCheckpoint(const SpanModelSpec& spec, int in
   return w;
 }
 
-void WriteSpanArtifact(const SpanExperimentConfig& c, const std::string& checkpoint,
-                       const std::string& normalisation_file, const std::string& artifact_path) {
-  const SpanPredictorWeights w = SpanWeightsFromCheckpoint(
-      SpanModelSpecOf(c), 2 * c.windows.observed, checkpoint, normalisation_file);
-  SpanPredictor::Save(artifact_path, w, config::ToYaml(c), c.seed);
+void WriteArtifact(const ExperimentConfig& c, const std::string& checkpoint,
+                   const std::string& normalisation_file, const std::string& artifact_path) {
+  const PredictorWeights w =
+      WeightsFromCheckpoint(ModelSpecOf(c), 2 * c.windows.observed, checkpoint, normalisation_file);
+  Predictor::Save(artifact_path, w, config::ToYaml(c), c.seed);
 }
 
-std::string ExportSpan(const std::string& run_dir) {
+std::string ExportRun(const std::string& run_dir) {
   const std::string config_path = run_dir + "/config.yaml";
   FS_THROW_UNLESS(fs::exists(config_path), run_dir, ": not a run directory (no config.yaml)");
-  const SpanExperimentConfig c =
-      config::LoadExperimentConfig<SpanExperimentConfig>(config_path, {});
+  const ExperimentConfig c = config::LoadExperimentConfig<ExperimentConfig>(config_path, {});
   RunPaths run{run_dir};
   const std::string ckpt =
       fs::exists(run.BestCheckpoint()) ? run.BestCheckpoint() : run.Checkpoint();
   FS_THROW_UNLESS(fs::exists(ckpt), run_dir, ": no checkpoint to export (train first)");
   const std::string out = run_dir + "/model.h5";
-  WriteSpanArtifact(c, ckpt, run_dir + "/normalisation.h5", out);
+  WriteArtifact(c, ckpt, run_dir + "/normalisation.h5", out);
   // Prove the artifact loads in the engine before reporting success.
-  (void)SpanPredictor::Load(out);
+  (void)Predictor::Load(out);
   log::Info("exported ", ckpt, " -> ", out);
   return out;
 }
 
-}  // namespace foresight
+}  // namespace foresight::span

@@ -20,41 +20,41 @@
 #include "training/span/config.h"
 #include "training/trainer.h"
 
-namespace foresight {
+namespace foresight::span {
 
 /// What shows a SPAN run in a directory: a metrics.csv without checkpoints (a run killed in
 /// epoch 1) holds nothing to resume, so a fresh start replaces it.
-inline const RunDirectoryRules kSpanRunRules{{"checkpoints/", "model.h5", "eval.json"}, true};
+inline const RunDirectoryRules kRunRules{{"checkpoints/", "model.h5", "eval.json"}, true};
 
 /// Trains (or resumes) into `run_dir`; writes the resolved config and the normalisation first.
 /// A fresh start (not `resume`) refuses a directory that already holds checkpoints, metrics.csv,
 /// model.h5 or eval.json. No training or validation windows is an Error naming the split keys.
-TrainingSummary TrainSpan(const SpanExperimentConfig& config, const std::string& run_dir,
-                          bool resume, const TrainHooks& hooks = {});
+TrainingSummary TrainRun(const ExperimentConfig& config, const std::string& run_dir, bool resume,
+                         const TrainHooks& hooks = {});
 
 /// Writes `run_dir`/model.h5 from the best checkpoint. @return the artifact path.
-std::string ExportSpan(const std::string& run_dir);
+std::string ExportRun(const std::string& run_dir);
 
 /// Writes the artifact of a SpanNet checkpoint at `checkpoint` (used by export and tests).
-void WriteSpanArtifact(const SpanExperimentConfig& config, const std::string& checkpoint,
-                       const std::string& normalisation_file, const std::string& artifact_path);
+void WriteArtifact(const ExperimentConfig& config, const std::string& checkpoint,
+                   const std::string& normalisation_file, const std::string& artifact_path);
 
 // ---------------------------------------------------------------- shared pieces
 
 /// Everything that fixes a SPAN net and its engine besides its weights.
-struct SpanModelSpec {
+struct ModelSpec {
   int observed = 0, predicted = 0;  ///< points per window
   double seconds_per_step = 0.4;    ///< s between points
   TrajectoryBasisConfig basis;
-  SpanNetConfig network;
+  NetConfig network;
 };
 
 /// The spec of a SPAN experiment (windows, data step, basis, network).
-SpanModelSpec SpanModelSpecOf(const SpanExperimentConfig& config);
+ModelSpec ModelSpecOf(const ExperimentConfig& config);
 /// The head layout of `spec` (basis size, R, u_param).
-HeadLayout LayoutOf(const SpanModelSpec& spec);
+HeadLayout LayoutOf(const ModelSpec& spec);
 /// Ego-frame inputs [N x 2p] and ridge targets [N x 2m] of `windows` (models/span/span_data.h).
-SpanSamples MakeSpanSamples(const SpanModelSpec& spec, const WindowSet& windows);
+Samples MakeSamples(const ModelSpec& spec, const WindowSet& windows);
 
 /// Per-feature input normalisation x' = (x - mean) / std, fitted on the training inputs.
 struct InputNormalisation {
@@ -72,22 +72,21 @@ InputNormalisation ReadInputNormalisation(const std::string& path);
 /// are any features [N x D] (D = 2p ego-frame points, or KTM features); targets [N x 2m].
 /// A fresh start fits and writes the normalisation; `resume` reads it back and continues from
 /// the last checkpoint. No training or validation samples is an Error.
-TrainingSummary TrainSpanNet(const SpanModelSpec& spec, const SpanSamples& train,
-                             const SpanSamples& val, const TrainConfig& train_config,
-                             std::int64_t seed, const std::string& run_dir, bool resume,
-                             const TrainHooks& hooks = {});
+TrainingSummary TrainNet(const ModelSpec& spec, const Samples& train, const Samples& val,
+                         const TrainConfig& train_config, std::int64_t seed,
+                         const std::string& run_dir, bool resume, const TrainHooks& hooks = {});
 
 /// MakeSpanSamples of both window sets, then TrainSpanNet. No windows is an Error.
-TrainingSummary TrainSpanOnWindows(const SpanModelSpec& spec, const WindowSet& train,
-                                   const WindowSet& val, const TrainConfig& train_config,
-                                   std::int64_t seed, const std::string& run_dir, bool resume,
-                                   const TrainHooks& hooks = {});
+TrainingSummary TrainOnWindows(const ModelSpec& spec, const WindowSet& train, const WindowSet& val,
+                               const TrainConfig& train_config, std::int64_t seed,
+                               const std::string& run_dir, bool resume,
+                               const TrainHooks& hooks = {});
 
 /// The engine weights of a SpanNet checkpoint with `input_dim` inputs and the normalisation of
 /// `normalisation_file`; the caller adds an input stage (KTM) if any and saves them.
-SpanPredictorWeights SpanWeightsFromCheckpoint(const SpanModelSpec& spec, int input_dim,
-                                               const std::string& checkpoint,
-                                               const std::string& normalisation_file);
+PredictorWeights WeightsFromCheckpoint(const ModelSpec& spec, int input_dim,
+                                       const std::string& checkpoint,
+                                       const std::string& normalisation_file);
 
 /// The engine's dense layers from the module's `names[i].weight` / `.bias` parameters (float).
 Mlp ToEngineMlp(torch::nn::Module& net, const std::vector<std::string>& names);
@@ -95,4 +94,4 @@ Mlp ToEngineMlp(torch::nn::Module& net, const std::vector<std::string>& names);
 /// A [N x D] double matrix as a float tensor [N, D].
 torch::Tensor ToFloatTensor(const Eigen::MatrixXd& m);
 
-}  // namespace foresight
+}  // namespace foresight::span

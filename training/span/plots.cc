@@ -7,11 +7,11 @@
 #include "inference/prediction/span_predictor.h"
 #include "training/image_io.h"
 
-namespace foresight {
+namespace foresight::span {
 
-void PlotSpanSamples(const std::string& artifact, const WindowSet& test, const SpanEvalConfig& ec,
-                     const std::string& png_path) {
-  const SpanPredictor model = SpanPredictor::Load(artifact);
+void PlotSamples(const std::string& artifact, const WindowSet& test, const EvalConfig& ec,
+                 const std::string& png_path) {
+  const Predictor model = Predictor::Load(artifact);
   auto ws = model.MakeWorkspace();
   auto dist = model.MakeDistribution();
   const int panels = std::min(ec.plot_tracks, test.size());
@@ -81,4 +81,4 @@ void PlotSpanSamples(const std::string& artifact, const WindowSet& test, const S
   WriteImage(png_path, image);
 }
 
-}  // namespace foresight
+}  // namespace foresight::span

@@ -4,17 +4,17 @@
 #include "inference/engine/artifact.h"
 #include "inference/prediction/span_predictor.h"
 
-namespace foresight {
+namespace foresight::span {
 
-LoadedSpanNet LoadSpanNetFromArtifact(const std::string& artifact) {
-  const Artifact art = Artifact::Open(artifact, kSpanModelType);
-  LoadedSpanNet out;
-  out.config = config::ExperimentConfigFromYaml<SpanExperimentConfig>(art.config_yaml(),
-                                                                      artifact + ":/config");
+LoadedNet LoadNetFromArtifact(const std::string& artifact) {
+  const Artifact art = Artifact::Open(artifact, kModelType);
+  LoadedNet out;
+  out.config =
+      config::ExperimentConfigFromYaml<ExperimentConfig>(art.config_yaml(), artifact + ":/config");
   out.layout.basis = out.config.basis.num_centres;
   out.layout.components = out.config.network.components;
   out.layout.u_param = out.config.network.u_param;
-  out.net = SpanNet(2 * out.config.windows.observed, out.config.network, out.layout);
+  out.net = Net(2 * out.config.windows.observed, out.config.network, out.layout);
   torch::NoGradGuard no_grad;
   for (auto& item : out.net->named_parameters()) {
     const std::string key = item.key();
@@ -30,4 +30,4 @@ LoadedSpanNet LoadSpanNetFromArtifact(const std::string& artifact) {
   return out;
 }
 
-}  // namespace foresight
+}  // namespace foresight::span

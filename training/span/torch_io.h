@@ -6,15 +6,15 @@
 #include "models/span/span_net.h"
 #include "training/span/config.h"
 
-namespace foresight {
+namespace foresight::span {
 
-struct LoadedSpanNet {
-  SpanExperimentConfig config;
+struct LoadedNet {
+  ExperimentConfig config;
   HeadLayout layout;
-  SpanNet net{nullptr};
+  Net net{nullptr};
 };
 
 /// Reads the config and the weights of `artifact` into a new SpanNet (eval mode).
-LoadedSpanNet LoadSpanNetFromArtifact(const std::string& artifact);
+LoadedNet LoadNetFromArtifact(const std::string& artifact);
 
-}  // namespace foresight
+}  // namespace foresight::span
