@@ -18,10 +18,10 @@ ExperimentRegistry BuiltinKinds() {
   r.Add(NavigationKind());
   r.Add(ManipulationKind());
 #ifdef FORESIGHT_WITH_TORCH
-  r.Add(GfcsKind());
-  r.Add(DiffeoKind());
-  r.Add(OtnetKind());
-  r.Add(ConstrainedKind());
+  r.Add(gfcs::Kind());
+  r.Add(imitation::Kind());
+  r.Add(otnet::Kind());
+  r.Add(constrained::Kind());
   r.SetDefault("span_predictor");
 #endif
   return r;

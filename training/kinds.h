@@ -31,18 +31,24 @@ void SetBenchStep(ExperimentKind* kind);
 }  // namespace span
 ExperimentKind NavigationKind();
 ExperimentKind ManipulationKind();
-#ifdef FORESIGHT_WITH_TORCH
-ExperimentKind GfcsKind();
-ExperimentKind DiffeoKind();
-ExperimentKind OtnetKind();
-ExperimentKind ConstrainedKind();
-#endif
+namespace gfcs {
+ExperimentKind Kind();
+}  // namespace gfcs
+namespace imitation {  // diffeomorphic templates
+ExperimentKind Kind();
+void SetBenchStep(ExperimentKind* kind);
+}  // namespace imitation
+namespace otnet {
+ExperimentKind Kind();
+void SetBenchStep(ExperimentKind* kind);
+}  // namespace otnet
+namespace constrained {
+ExperimentKind Kind();
+}  // namespace constrained
 
 // Each kind's bench step (SetBench), in its <method>/bench.cc (declared in every build: the
 // LibTorch kinds' libraries are built only with LibTorch).
 void SetManipulationBench(ExperimentKind* kind);
-void SetDiffeoBench(ExperimentKind* kind);
-void SetOtnetBench(ExperimentKind* kind);
 
 /// The config of a train request: the file, or `embedded_default` (named `default_name` in
 /// errors) when the request says "default".

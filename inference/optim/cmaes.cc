@@ -422,7 +422,7 @@ std::string CmaEsSummary::BriefReport() const {
 
 CmaEsSummary Minimize(const std::function<double(const Eigen::VectorXd&)>& f,
                       const Eigen::VectorXd& x0, const CmaEsOptions& options) {
-  FS_THROW_UNLESS(static_cast<bool>(f), "optim::Minimize: the cost function is empty");
+  FS_THROW_UNLESS(static_cast<bool>(f), "Minimize: the cost function is empty");
   CmaEs es(x0, options);
   Eigen::VectorXd costs(es.population());
   while (es.status() == CmaEsStatus::kRunning) {

@@ -10,7 +10,7 @@
 
 namespace foresight::span {
 
-// ---------------------------------------------------------------- span::Predictor
+// ---------------------------------------------------------------- Predictor
 
 Predictor Predictor::Load(const std::string& path) {
   const Artifact art = Artifact::Open(path, kModelType);

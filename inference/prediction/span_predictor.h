@@ -1,7 +1,7 @@
 #pragma once
 /// LibTorch-free engine of the SPAN pedestrian predictor (thesis ch 5; mixture head of ch 7).
 ///
-///   span::Predictor model = span::Predictor::Load("model.h5");   // immutable, share across
+///   Predictor model = Predictor::Load("model.h5");   // immutable, share across
 ///   threads auto ws = model.MakeWorkspace();                           // one per caller auto out
 ///   = model.MakeDistribution();                        // preallocated output model.Predict(past,
 ///   &ws, &out);                             // no allocation out.Position(t, &mean, &cov); // o(t)

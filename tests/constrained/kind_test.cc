@@ -21,8 +21,8 @@ namespace fs = std::filesystem;
 using testing::ExpectErrorContains;
 using testing::TempDir;
 
-ConstrainedConfig TinyConfig() {
-  return config::ExperimentConfigFromYaml<ConstrainedConfig>(
+constrained::ExperimentConfig TinyConfig() {
+  return config::ExperimentConfigFromYaml<constrained::ExperimentConfig>(
       "model: constrained\ndata: {source: synthetic, max_maps: 4, synthetic_tracks: 12}\n"
       "split: {by_scene: true, val_fraction: 0.25, test_fraction: 0.25}\n"
       "windows: {observed: 6, predicted: 6, stride: 3}\nbasis: {num_centres: 4}\n"
@@ -43,7 +43,7 @@ std::string Read(const std::string& path) {
 TEST(ConstrainedRun, InterruptedInTheFirstEpochResumesAndEvaluates) {
   const TempDir tmp;
   const std::string run = tmp.File("run");
-  const ConstrainedConfig c = TinyConfig();
+  const constrained::ExperimentConfig c = TinyConfig();
   std::atomic<bool> stop{true};
   EXPECT_FALSE(constrained::TrainConstrainedRun(c, run, false, &stop));
   EXPECT_FALSE(fs::exists(run + "/prior.h5"));
@@ -64,7 +64,7 @@ TEST(ConstrainedRun, InterruptedInTheFirstEpochResumesAndEvaluates) {
   const std::string csv = Read(run + "/tracks.csv");
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 8);
 
-  const ExperimentKind kind = ConstrainedKind();
+  const ExperimentKind kind = constrained::Kind();
   for (const char* o : {"map.kind=grid", "seed=3", "split.test_fraction=0.5", "windows.stride=1"})
     ExpectErrorContains([&] { kind.evaluate(run, {o}); }, {o, "train a new run"});
 }
@@ -72,13 +72,13 @@ TEST(ConstrainedRun, InterruptedInTheFirstEpochResumesAndEvaluates) {
 TEST(ConstrainedRun, ConfigRulesNameTheKey) {
   ExpectErrorContains(
       [] {
-        config::ExperimentConfigFromYaml<ConstrainedConfig>(
+        config::ExperimentConfigFromYaml<constrained::ExperimentConfig>(
             "model: constrained\nnetwork: {u_param: cholesky}\n", "bad.yaml");
       },
       {"bad.yaml", "network.u_param"});
   ExpectErrorContains(
       [] {
-        config::ExperimentConfigFromYaml<ConstrainedConfig>(
+        config::ExperimentConfigFromYaml<constrained::ExperimentConfig>(
             "model: constrained\nconstraint: {margin: 0}\n", "bad.yaml");
       },
       {"bad.yaml", "constraint.margin"});

@@ -19,8 +19,8 @@ namespace foresight {
 namespace {
 namespace fs = std::filesystem;
 
-DiffeoConfig Tiny(const std::vector<std::string>& overrides = {}) {
-  return config::ExperimentConfigFromYaml<DiffeoConfig>(
+imitation::ExperimentConfig Tiny(const std::vector<std::string>& overrides = {}) {
+  return config::ExperimentConfigFromYaml<imitation::ExperimentConfig>(
       "model: diffeo\ndata: {source: synthetic, synthetic_demos: 3, synthetic_points: 40, "
       "downsample: 1, held_out: [2]}\nflow: {spacing: 0.1, gamma: 200, cutoff_radius: 0.3, steps: "
       "4}\ntrain: {epochs: 3, batch_size: 32, progress: none}\neflow: {layers: 2, features: 8, "
@@ -31,18 +31,18 @@ DiffeoConfig Tiny(const std::vector<std::string>& overrides = {}) {
 
 TEST(DiffeoRun, ResumeAfterLosingTheLastArtifactsGivesTheSameModelsAndFigures) {
   const testing::TempDir dir;
-  const DiffeoConfig c = Tiny();
+  const imitation::ExperimentConfig c = Tiny();
   const std::string run = dir.File("run");
-  ASSERT_TRUE(TrainDiffeoRun(c, run, false, nullptr));
-  const std::string eval = EvaluateDiffeoRun(c, run);
+  ASSERT_TRUE(imitation::TrainRun(c, run, false, nullptr));
+  const std::string eval = imitation::EvaluateRun(c, run);
   const auto shape = imitation::LoadTemplate<2>(run + "/models/s_curve.h5");
   const auto eflow = imitation::EFlowModel::Load(run + "/models/s_curve.eflow.h5");
   // As if killed after the flow finished: the baseline's checkpoints and every artifact are gone.
   fs::remove_all(run + "/models");
   fs::remove_all(run + "/shapes/s_curve/eflow");
   fs::remove(run + "/eval.json");
-  ASSERT_TRUE(TrainDiffeoRun(c, run, true, nullptr));
-  EXPECT_EQ(EvaluateDiffeoRun(c, run), eval);
+  ASSERT_TRUE(imitation::TrainRun(c, run, true, nullptr));
+  EXPECT_EQ(imitation::EvaluateRun(c, run), eval);
   const auto shape2 = imitation::LoadTemplate<2>(run + "/models/s_curve.h5");
   const auto eflow2 = imitation::EFlowModel::Load(run + "/models/s_curve.eflow.h5");
   EXPECT_EQ(shape2.system.flow().weights(), shape.system.flow().weights());
@@ -50,15 +50,15 @@ TEST(DiffeoRun, ResumeAfterLosingTheLastArtifactsGivesTheSameModelsAndFigures) {
   const Eigen::Vector2d x(0.2, -0.1);
   EXPECT_EQ(eflow2.Velocity(x), eflow.Velocity(x));
   // A fresh start in the finished directory is refused (naming what is there).
-  testing::ExpectErrorContains([&] { TrainDiffeoRun(c, run, false, nullptr); }, {run});
+  testing::ExpectErrorContains([&] { imitation::TrainRun(c, run, false, nullptr); }, {run});
 }
 
 TEST(DiffeoRun, AnObstacleOnTheGoalIsRefused) {
   const testing::TempDir dir;
-  const DiffeoConfig c = Tiny({"obstacle.fraction=1.0"});
+  const imitation::ExperimentConfig c = Tiny({"obstacle.fraction=1.0"});
   const std::string run = dir.File("run");
-  ASSERT_TRUE(TrainDiffeoRun(c, run, false, nullptr));
-  testing::ExpectErrorContains([&] { EvaluateDiffeoRun(c, run); },
+  ASSERT_TRUE(imitation::TrainRun(c, run, false, nullptr));
+  testing::ExpectErrorContains([&] { imitation::EvaluateRun(c, run); },
                                {"s_curve", "covers the goal", "obstacle.fraction"});
 }
 

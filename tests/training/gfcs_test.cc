@@ -76,8 +76,8 @@ TEST(EnergyNet, TheEngineComputesWhatLibTorchTrained) {
 }
 
 /// The tiny self-supervised run of these tests (built-in Panda, generated scenes).
-GfcsTrainConfig TinyConfig() {
-  return config::ExperimentConfigFromYaml<GfcsTrainConfig>(
+gfcs::ExperimentConfig TinyConfig() {
+  return config::ExperimentConfigFromYaml<gfcs::ExperimentConfig>(
       "model: gfcs\nrobot: builtin\ntrain_problems: [{source: synthetic, synthetic_count: 3}]\n"
       "lattice: {spacing: 0.6}\nautoencoder: {encoding: 4, hidden: 8, train: {epochs: 3, "
       "batch_size: 2, progress: none}}\nenergy: {hidden: 16, layers: 2}\nloop: {passes: 2, "
@@ -96,24 +96,24 @@ std::vector<Eigen::MatrixXf> EnergyWeights(const std::string& artifact) {
 }
 
 TEST(GfcsLoop, AResumedRunEndsWithTheModelOfAnUninterruptedOne) {
-  const GfcsTrainConfig c = TinyConfig();
+  const gfcs::ExperimentConfig c = TinyConfig();
   testing::TempDir dir;
   const std::string whole = dir.File("whole"), broken = dir.File("broken");
-  ASSERT_TRUE(TrainGfcsRun(c, whole, false, nullptr));
+  ASSERT_TRUE(gfcs::TrainRun(c, whole, false, nullptr));
 
   // Stop the second run as soon as its loop has written a checkpoint (some solve, not chosen).
   std::atomic<bool> stop{false};
   std::thread watcher([&] {
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-    while (!fs::exists(LoopCheckpointPath(broken, 0)) &&
+    while (!fs::exists(gfcs::LoopCheckpointPath(broken, 0)) &&
            std::chrono::steady_clock::now() < deadline)
       std::this_thread::sleep_for(std::chrono::milliseconds(2));
     stop = true;
   });
-  const bool finished = TrainGfcsRun(c, broken, false, &stop);
+  const bool finished = gfcs::TrainRun(c, broken, false, &stop);
   watcher.join();
   EXPECT_FALSE(finished) << "the run was stopped before its end";
-  ASSERT_TRUE(TrainGfcsRun(c, broken, true, nullptr));
+  ASSERT_TRUE(gfcs::TrainRun(c, broken, true, nullptr));
 
   const auto a = EnergyWeights(whole + "/model.h5"), b = EnergyWeights(broken + "/model.h5");
   ASSERT_EQ(a.size(), b.size());
@@ -122,12 +122,12 @@ TEST(GfcsLoop, AResumedRunEndsWithTheModelOfAnUninterruptedOne) {
             std::string::npos);
 
   // A checkpoint from another config is refused with the key that differs.
-  GfcsTrainConfig other = c;
+  gfcs::ExperimentConfig other = c;
   other.loop.adam_steps = 5;
-  GfcsEncoding enc;
+  gfcs::Encoding enc;
   Mlp energy;
   testing::ExpectErrorContains(
-      [&] { LoadLoopResult(other, config::ToYaml(other), whole, &enc, &energy); },
+      [&] { gfcs::LoadLoopResult(other, config::ToYaml(other), whole, &enc, &energy); },
       {"another config", "adam_steps: 5"});
 }
 
@@ -138,7 +138,7 @@ int Shell(const std::string& command) {
 }
 
 TEST(GfcsLoop, TwoRanksShareTheSolvesAndEndWithTheModelOfOne) {
-  GfcsTrainConfig c = TinyConfig();
+  gfcs::ExperimentConfig c = TinyConfig();
   c.loop.threads = 1;
   c.autoencoder.train.threads = 1;
   testing::TempDir dir;
@@ -158,7 +158,7 @@ TEST(GfcsLoop, TwoRanksShareTheSolvesAndEndWithTheModelOfOne) {
       << testing::ReadText(d + "/r0.out") << testing::ReadText(d + "/r1.out");
   // Rank 1 solved its share (every other solve of a block) and kept its own checkpoint.
   EXPECT_NE(testing::ReadText(d + "/two/log.rank1.txt").find("solve 2/6"), std::string::npos);
-  EXPECT_TRUE(fs::exists(LoopCheckpointPath(d + "/two", 1)));
+  EXPECT_TRUE(fs::exists(gfcs::LoopCheckpointPath(d + "/two", 1)));
   const auto a = EnergyWeights(d + "/one/model.h5"), b = EnergyWeights(d + "/two/model.h5");
   ASSERT_EQ(a.size(), b.size());
   for (std::size_t i = 0; i < a.size(); ++i)
@@ -166,7 +166,7 @@ TEST(GfcsLoop, TwoRanksShareTheSolvesAndEndWithTheModelOfOne) {
 }
 
 TEST(GfcsLoop, TwoRanksKilledMidRunResumeToTheModelOfOne) {
-  GfcsTrainConfig c = TinyConfig();
+  gfcs::ExperimentConfig c = TinyConfig();
   c.loop.threads = 1;
   c.autoencoder.train.threads = 1;
   c.loop.passes = 4;  // 12 solves, 6 blocks
@@ -203,7 +203,7 @@ TEST(GfcsLoop, TwoRanksKilledMidRunResumeToTheModelOfOne) {
 TEST(GfcsConfig, HeldOutProblemsMayNotOverlapTheTrainingOnes) {
   testing::ExpectErrorContains(
       [] {
-        (void)config::ExperimentConfigFromYaml<GfcsTrainConfig>(
+        (void)config::ExperimentConfigFromYaml<gfcs::ExperimentConfig>(
             "model: gfcs\ntrain_problems: [{family: box_panda, first: 1, last: 50}]\n"
             "eval: {problems: [{family: box_panda, first: 40, last: 60}]}\n",
             "overlap.yaml");
@@ -211,7 +211,7 @@ TEST(GfcsConfig, HeldOutProblemsMayNotOverlapTheTrainingOnes) {
       {"overlap.yaml", "eval.problems", "overlaps"});
   testing::ExpectErrorContains(
       [] {
-        (void)config::ExperimentConfigFromYaml<GfcsTrainConfig>(
+        (void)config::ExperimentConfigFromYaml<gfcs::ExperimentConfig>(
             "model: gfcs\ngfcs: {commands: 1}\n", "one.yaml");
       },
       {"one.yaml", "gfcs.commands"});

@@ -3,9 +3,9 @@
 #include "core/error.h"
 #include "core/layer_widths.h"
 
-namespace foresight {
+namespace foresight::constrained {
 
-void ConstrainedConfig::Validate(const std::string& source) const {
+void ExperimentConfig::Validate(const std::string& source) const {
   FS_THROW_UNLESS(model == "constrained", source, ": model: '", model, "', expected 'constrained'");
   data.Validate(source);
   FS_THROW_UNLESS(network.u_param == UParam::kDiagonal, source,
@@ -26,4 +26,4 @@ void ConstrainedConfig::Validate(const std::string& source) const {
   CheckLayerWidths(naive.hidden, source, "naive.hidden");
 }
 
-}  // namespace foresight
+}  // namespace foresight::constrained

@@ -16,9 +16,9 @@
 #include "models/span/span_config.h"
 #include "training/train_config.h"
 
-namespace foresight {
+namespace foresight::constrained {
 
-struct ConstrainedSplitConfig {
+struct SplitConfig {
   bool by_scene = false;       ///< whole scenes (map-level) or tracks within each scene
   double val_fraction = 0.1;   ///< validation share (model selection; never the test)
   double test_fraction = 0.2;  ///< test share (thesis: 80:20)
@@ -33,7 +33,7 @@ struct ConstrainedSplitConfig {
   }
 };
 
-struct ConstrainedMapConfig {
+struct MapConfig {
   occupancy::RasterMapKind kind = occupancy::RasterMapKind::kFastBhm;
   double sample_step = 0.1;  ///< labelled points every this many m (cells for occ_traj)
   double spacing = 0.25;     ///< Fast-BHM inducing-point spacing
@@ -110,7 +110,7 @@ struct ConstraintConfig {
   }
 };
 
-struct ConstrainedEvalConfig {
+struct EvalConfig {
   int max_windows = 0;           ///< evaluate at most this many test windows (0: all)
   int accuracy_windows = 20;     ///< windows whose C is checked against Monte Carlo
   int accuracy_samples = 20000;  ///< Monte Carlo samples per component and window
@@ -134,22 +134,22 @@ struct ConstrainedEvalConfig {
   }
 };
 
-struct ConstrainedConfig {
+struct ExperimentConfig {
   std::string model = "constrained";
   std::int64_t seed = 0;
   MapTracksConfig data;
-  ConstrainedSplitConfig split;
+  SplitConfig split;
   WindowConfig windows{10, 15, 1};
-  ConstrainedMapConfig map;
+  MapConfig map;
   span::TrajectoryBasisConfig basis;
   span::NetConfig network;
   TrainConfig train;
   KtmConfig ktm;
   NaiveConfig naive;
   ConstraintConfig constraint;
-  ConstrainedEvalConfig eval;
+  EvalConfig eval;
 
-  ConstrainedConfig() {
+  ExperimentConfig() {
     network.components = 2;  // thesis: R = 2
     network.u_param = UParam::kDiagonal;
   }
@@ -176,4 +176,4 @@ struct ConstrainedConfig {
   void Validate(const std::string& source) const;
 };
 
-}  // namespace foresight
+}  // namespace foresight::constrained

@@ -26,7 +26,7 @@ SceneWindows MakeSceneWindows(const std::vector<MapScene>& scenes, const WindowC
   return out;
 }
 
-ConstrainedData LoadConstrainedData(const ConstrainedConfig& c) {
+ConstrainedData LoadConstrainedData(const ExperimentConfig& c) {
   ConstrainedData d;
   const int length = c.windows.observed + c.windows.predicted;
   const std::vector<MapScene> scenes = LoadMapScenes(c.data, length, &d.report);

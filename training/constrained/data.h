@@ -26,7 +26,7 @@ struct ConstrainedData {
 
 /// Loads (or generates) the scenes, splits them and cuts the windows. No training, validation or
 /// test windows is an Error naming the keys that control them.
-ConstrainedData LoadConstrainedData(const ConstrainedConfig& c);
+ConstrainedData LoadConstrainedData(const ExperimentConfig& c);
 
 /// Windows of every track of `scenes`, tagged with their scene.
 SceneWindows MakeSceneWindows(const std::vector<MapScene>& scenes, const WindowConfig& windows);

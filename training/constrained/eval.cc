@@ -27,7 +27,7 @@
 namespace foresight::constrained {
 namespace fs = std::filesystem;
 
-RunArtifacts ArtifactsOf(const ConstrainedConfig& c, const std::string& run_dir) {
+RunArtifacts ArtifactsOf(const ExperimentConfig& c, const std::string& run_dir) {
   RunArtifacts a;
   a.prior = run_dir + "/prior.h5";
   if (c.ktm.enabled) a.ktm = run_dir + "/ktm.h5";
@@ -36,7 +36,7 @@ RunArtifacts ArtifactsOf(const ConstrainedConfig& c, const std::string& run_dir)
   return a;
 }
 
-bool FitSceneMaps(const ConstrainedConfig& c, const std::vector<MapScene>& scenes,
+bool FitSceneMaps(const ExperimentConfig& c, const std::vector<MapScene>& scenes,
                   const std::string& run_dir, const std::atomic<bool>* interrupt) {
   fs::create_directories(run_dir + "/maps");
   for (const MapScene& s : scenes) {
@@ -164,7 +164,7 @@ Eigen::MatrixX2d Rows(const Eigen::MatrixXd& rows, int k, int n) {
 
 }  // namespace
 
-std::string EvaluateConstrained(const ConstrainedConfig& c, const ConstrainedData& d,
+std::string EvaluateConstrained(const ExperimentConfig& c, const ConstrainedData& d,
                                 const std::string& run_dir) {
   const RunArtifacts art = ArtifactsOf(c, run_dir);
   for (const std::string& a : {art.prior, art.ktm, art.naive})

@@ -23,16 +23,16 @@ struct RunArtifacts {
   std::string prior, ktm, naive;  ///< empty when the baseline is disabled
   std::string maps_dir;           ///< fitted maps: <maps_dir>/<scene>.h5 (SceneMapFile)
 };
-RunArtifacts ArtifactsOf(const ConstrainedConfig& c, const std::string& run_dir);
+RunArtifacts ArtifactsOf(const ExperimentConfig& c, const std::string& run_dir);
 
 /// Fits the occupancy map of every scene in `scenes` whose artifact is missing (run_dir/maps/).
 /// @return false when `interrupt` was set between two scenes (the maps written so far are kept).
-bool FitSceneMaps(const ConstrainedConfig& c, const std::vector<MapScene>& scenes,
+bool FitSceneMaps(const ExperimentConfig& c, const std::vector<MapScene>& scenes,
                   const std::string& run_dir, const std::atomic<bool>* interrupt = nullptr);
 
 /// Evaluates; writes `run_dir`/eval.json, tracks.csv and plots/ (when eval.plot_windows > 0).
 /// Missing artifacts are Errors naming them. @return the eval.json text.
-std::string EvaluateConstrained(const ConstrainedConfig& c, const ConstrainedData& d,
+std::string EvaluateConstrained(const ExperimentConfig& c, const ConstrainedData& d,
                                 const std::string& run_dir);
 
 }  // namespace foresight::constrained

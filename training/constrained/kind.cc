@@ -7,9 +7,9 @@
 #include "training/kinds.h"
 #include "training/trainer.h"
 
-namespace foresight {
+namespace foresight::constrained {
 
-ExperimentKind ConstrainedKind() {
+ExperimentKind Kind() {
   ExperimentKind k;
   k.tag = "constrained";
   k.summary =
@@ -17,25 +17,25 @@ ExperimentKind ConstrainedKind() {
       "collision chance constraint by SLSQP, vs KTM, CV, naive network (ch 7)";
   k.configs = "configs/constrained/*.yaml";
   k.resumable = true;
-  k.reference = [] { return config::ReferenceTable<ConstrainedConfig>(); };
+  k.reference = [] { return config::ReferenceTable<ExperimentConfig>(); };
   k.train = [](const TrainRequest& req) {
     FS_THROW_UNLESS(req.config != "default" && !req.config.empty(),
                     "constrained has no embedded default config; name one "
                     "(configs/constrained/*.yaml)");
-    const auto c = config::LoadExperimentConfig<ConstrainedConfig>(req.config, req.overrides);
+    const auto c = config::LoadExperimentConfig<ExperimentConfig>(req.config, req.overrides);
     bool done = false;
     {
       const ScopedInterruptFlag interrupt;
-      done = constrained::TrainConstrainedRun(c, req.run_dir, req.resume, interrupt.flag());
+      done = TrainConstrainedRun(c, req.run_dir, req.resume, interrupt.flag());
     }
     if (!done) Fail("interrupted; continue with --resume --run-dir ", req.run_dir);
     std::cout << "wrote " << req.run_dir << "/prior.h5\n";
     if (req.evaluate) {
-      constrained::EvaluateConstrainedRun(c, req.run_dir);
+      EvaluateConstrainedRun(c, req.run_dir);
       std::cout << "wrote " << req.run_dir << "/eval.json\n";
     }
   };
-  k.export_run = constrained::ExportConstrainedRun;
+  k.export_run = ExportConstrainedRun;
   k.evaluate = [](const std::string& run_dir, const std::vector<std::string>& overrides) {
     // The split is the run's: another seed, data, split or windows section would score training
     // tracks as test (data.root only says where the same files are).
@@ -48,11 +48,11 @@ ExperimentKind ConstrainedKind() {
                       "' would change the split, windows or maps the run was trained with; train a "
                       "new run");
     }
-    const auto c = LoadRunConfig<ConstrainedConfig>(run_dir, overrides);
-    return constrained::EvaluateConstrainedRun(c, run_dir);
+    const auto c = LoadRunConfig<ExperimentConfig>(run_dir, overrides);
+    return EvaluateConstrainedRun(c, run_dir);
   };
   k.no_step_hint = "its projection times are in eval.json (solve_time_ms, check_time_ms)";
   return k;
 }
 
-}  // namespace foresight
+}  // namespace foresight::constrained

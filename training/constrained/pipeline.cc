@@ -18,7 +18,7 @@ namespace {
 
 const RunDirectoryRules kConstrainedRunRules{{"prior", "prior.h5", "eval.json"}, true};
 
-LearnerSpec SpecOf(const ConstrainedConfig& c, double seconds_per_step) {
+LearnerSpec SpecOf(const ExperimentConfig& c, double seconds_per_step) {
   LearnerSpec s;
   s.observed = c.windows.observed;
   s.predicted = c.windows.predicted;
@@ -32,7 +32,7 @@ LearnerSpec SpecOf(const ConstrainedConfig& c, double seconds_per_step) {
 
 }  // namespace
 
-bool TrainConstrainedRun(const ConstrainedConfig& c, const std::string& run_dir, bool resume,
+bool TrainConstrainedRun(const ExperimentConfig& c, const std::string& run_dir, bool resume,
                          const std::atomic<bool>* interrupt) {
   const std::string yaml = config::ToYaml(c);
   StartRunDirectory(run_dir, yaml, resume, kConstrainedRunRules);
@@ -74,7 +74,7 @@ bool TrainConstrainedRun(const ConstrainedConfig& c, const std::string& run_dir,
 }
 
 std::string ExportConstrainedRun(const std::string& run_dir) {
-  const auto c = LoadRunConfig<ConstrainedConfig>(run_dir, {});
+  const auto c = LoadRunConfig<ExperimentConfig>(run_dir, {});
   const ConstrainedData d = LoadConstrainedData(c);
   const LearnerSpec spec = SpecOf(c, d.train.windows.seconds_per_step);
   const RunArtifacts art = ArtifactsOf(c, run_dir);
@@ -89,7 +89,7 @@ std::string ExportConstrainedRun(const std::string& run_dir) {
   return art.prior;
 }
 
-std::string EvaluateConstrainedRun(const ConstrainedConfig& c, const std::string& run_dir) {
+std::string EvaluateConstrainedRun(const ExperimentConfig& c, const std::string& run_dir) {
   return EvaluateConstrained(c, LoadConstrainedData(c), run_dir);
 }
 

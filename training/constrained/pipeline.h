@@ -17,12 +17,12 @@ namespace foresight::constrained {
 
 /// Trains every learner, exports the artifacts and fits the test scenes' maps. @return false when
 /// interrupted (resume continues).
-bool TrainConstrainedRun(const ConstrainedConfig& c, const std::string& run_dir, bool resume,
+bool TrainConstrainedRun(const ExperimentConfig& c, const std::string& run_dir, bool resume,
                          const std::atomic<bool>* interrupt);
 /// Writes the run's artifacts (prior.h5, ktm.h5, naive.h5) from each learner's best checkpoint.
 /// @return the prior's path.
 std::string ExportConstrainedRun(const std::string& run_dir);
 /// Evaluates the run's artifacts with `c` (the run's config, overrides applied); writes eval.json.
-std::string EvaluateConstrainedRun(const ConstrainedConfig& c, const std::string& run_dir);
+std::string EvaluateConstrainedRun(const ExperimentConfig& c, const std::string& run_dir);
 
 }  // namespace foresight::constrained

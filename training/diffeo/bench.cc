@@ -25,10 +25,8 @@
 #include "training/diffeo/config.h"
 #include "training/kinds.h"
 
-namespace foresight {
+namespace foresight::imitation {
 namespace {
-
-using namespace imitation;  // NOLINT: a benchmark of the imitation engine
 
 struct DiffeoBenchOptions {
   std::string data_root;
@@ -121,7 +119,7 @@ std::vector<Row> Imitation(const DiffeoBenchOptions& a, const ImitationSystem<D>
 
 Row Composed2d(const DiffeoBenchOptions& a, const ImitationSystem<2>& s) {
   // A disc between the middle of the grid and the goal, mapped as the evaluation does.
-  const DiffeoObstacleConfig o;
+  const ObstacleConfig o;
   const RbfGrid<2>& g = s.flow().grid();
   Vec<2> mid = g.spec().lower;
   for (int k = 0; k < 2; ++k) mid[k] += 0.5 * g.spec().spacing * (g.spec().counts[k] - 1);
@@ -167,7 +165,7 @@ std::vector<Row> CSpace(const DiffeoBenchOptions& a, const TemplateArtifact<3>& 
   // imitation system and the obstacle are both active (a random configuration is mostly neither).
   const auto targets = Points<3>(art.system.flow().grid(), 64);
   // A 15 cm ball's map at the middle of those targets, for timing.
-  const DiffeoObstacleConfig o;
+  const ObstacleConfig o;
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
   for (const Vec<3>& t : targets) centre += tn.ToWorld(t) / static_cast<double>(targets.size());
   const double r = 0.075, margin = 0.1, spacing = 0.05;
@@ -240,6 +238,6 @@ void RunDiffeoBench(const BenchRequest& req, const DiffeoBenchOptions& a) {
 
 }  // namespace
 
-void SetDiffeoBench(ExperimentKind* kind) { SetBench<DiffeoBenchOptions>(kind, RunDiffeoBench); }
+void SetBenchStep(ExperimentKind* kind) { SetBench<DiffeoBenchOptions>(kind, RunDiffeoBench); }
 
-}  // namespace foresight
+}  // namespace foresight::imitation

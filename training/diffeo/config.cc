@@ -4,9 +4,9 @@
 
 #include "core/error.h"
 
-namespace foresight {
+namespace foresight::imitation {
 
-void DiffeoConfig::Validate(const std::string& source) const {
+void ExperimentConfig::Validate(const std::string& source) const {
   FS_THROW_UNLESS(model == "diffeo", source, ": model: '", model, "', expected 'diffeo'");
   FS_THROW_UNLESS(!data.shapes.empty(), source, ": data.shapes: empty list (name shapes or [all])");
   FS_THROW_UNLESS(data.task == "push_box" || data.task == "lift_box", source, ": data.task: '",
@@ -42,4 +42,4 @@ void DiffeoConfig::Validate(const std::string& source) const {
   }
 }
 
-}  // namespace foresight
+}  // namespace foresight::imitation

@@ -11,12 +11,12 @@
 #include "core/config.h"
 #include "training/train_config.h"
 
-namespace foresight {
+namespace foresight::imitation {
 
 enum class DemoSource { kLasa, kSynthetic, kTaskSpace };
 
 /// Where the demonstrations come from and how they are prepared.
-struct DiffeoDataConfig {
+struct DataConfig {
   DemoSource source = DemoSource::kSynthetic;
   std::string
       root;  ///< data root (lasa: <root>/lasa_handwriting); empty: $FORESIGHT_DATA, ../shared/data
@@ -61,7 +61,7 @@ struct DiffeoDataConfig {
 };
 
 /// The imitation transform psi_i: RBF field on a grid of inducing states, integrated by Euler.
-struct DiffeoFlowConfig {
+struct FlowConfig {
   // Defaults: 19 x 19 = 361 states over [-0.65, 0.65]^2 (thesis: 720; wider kernels gave lower
   // Frechet distances on the synthetic family); gamma * cutoff^2 = 18, so the truncated kernel is
   // 1.5e-8 at the cut-off and the Euler map stays exactly invertible.
@@ -96,7 +96,7 @@ struct DiffeoFlowConfig {
 };
 
 /// Euclideanizing Flows (Rana et al. 2020), the baseline, trained the same way.
-struct DiffeoEflowConfig {
+struct EflowConfig {
   bool enabled = true;
   // Defaults of the authors' implementation on the same [-0.5, 0.5] normalisation: 10 layers,
   // 200 features, length scale 0.45 (bandwidth 1 / 0.45).
@@ -125,7 +125,7 @@ struct DiffeoEflowConfig {
 };
 
 /// The obstacle placed on the demonstrations, its occupancy map and the avoidance transforms.
-struct DiffeoObstacleConfig {
+struct ObstacleConfig {
   bool enabled = true;
   double fraction = 0.5;  ///< centre: the first training demo's point at this share of its length
   /// Radius: 2-D in normalised units; task space in metres (thesis: a 15 cm diameter cylinder).
@@ -177,7 +177,7 @@ struct DiffeoObstacleConfig {
 };
 
 /// A user bias toward a point (thesis "Infinitesimal Generators for User-Specified Bias").
-struct DiffeoBiasConfig {
+struct BiasConfig {
   bool enabled = false;
   std::vector<double> target;  ///< the point (normalised units), dimension of the demos
   double region = 0.25;        ///< samples within this distance of the target
@@ -195,7 +195,7 @@ struct DiffeoBiasConfig {
   }
 };
 
-struct DiffeoEvalConfig {
+struct EvalConfig {
   double dt = 0.01;  ///< rollout step (s, normalised time of the fitted system)
   int max_steps = 4000;
   double goal_tolerance = 0.01;    ///< normalised units
@@ -223,11 +223,11 @@ struct DiffeoEvalConfig {
   }
 };
 
-struct DiffeoConfig {
+struct ExperimentConfig {
   std::string model = "diffeo";
   std::int64_t seed = 1;
-  DiffeoDataConfig data;
-  DiffeoFlowConfig flow;
+  DataConfig data;
+  FlowConfig flow;
   TrainConfig train = [] {
     TrainConfig t;
     t.epochs = 300;
@@ -238,10 +238,10 @@ struct DiffeoConfig {
     return t;
   }();
   double val_fraction = 0.15;  ///< share of the training samples that stop training early
-  DiffeoEflowConfig eflow;
-  DiffeoObstacleConfig obstacle;
-  DiffeoBiasConfig bias;
-  DiffeoEvalConfig eval;
+  EflowConfig eflow;
+  ObstacleConfig obstacle;
+  BiasConfig bias;
+  EvalConfig eval;
 
   template <class A>
   void Serialize(A* a) {
@@ -262,4 +262,4 @@ struct DiffeoConfig {
   void Validate(const std::string& source) const;
 };
 
-}  // namespace foresight
+}  // namespace foresight::imitation

@@ -7,10 +7,10 @@
 #include "datasets/lasa.h"
 #include "datasets/synthetic_demos.h"
 
-namespace foresight {
+namespace foresight::imitation {
 namespace {
 
-PreparedDemos Prepare(const DiffeoConfig& c, const DemoSet& raw) {
+PreparedDemos Prepare(const ExperimentConfig& c, const DemoSet& raw) {
   PreparedDemos p;
   p.name = raw.name;
   p.spread = CheckDemonstrations(raw, c.data.goal_tolerance);
@@ -32,7 +32,7 @@ PreparedDemos Prepare(const DiffeoConfig& c, const DemoSet& raw) {
 
 }  // namespace
 
-std::vector<PreparedDemos> LoadDiffeoDemos(const DiffeoConfig& c) {
+std::vector<PreparedDemos> LoadDemos(const ExperimentConfig& c) {
   std::vector<DemoSet> sets;
   switch (c.data.source) {
     case DemoSource::kLasa: {
@@ -77,4 +77,4 @@ void StackDemos(const DemoSet& set, const std::vector<int>& ids, Eigen::MatrixXd
   }
 }
 
-}  // namespace foresight
+}  // namespace foresight::imitation

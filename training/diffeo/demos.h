@@ -8,7 +8,7 @@
 #include "datasets/demonstrations.h"
 #include "training/diffeo/config.h"
 
-namespace foresight {
+namespace foresight::imitation {
 
 /// One shape (or task) ready to train on: every demo normalised by the training demos' goal and
 /// extent (x_n = (x - offset) * scale, goal at the origin), downsampled as configured.
@@ -23,10 +23,10 @@ struct PreparedDemos {
 /// Reads the demonstrations the config names (every LASA shape asked for, one synthetic family,
 /// or one task-space task), checks them (CheckDemonstrations with data.goal_tolerance: differing
 /// dimensions, NaN, no common goal are Errors naming the set and demo) and prepares them.
-std::vector<PreparedDemos> LoadDiffeoDemos(const DiffeoConfig& c);
+std::vector<PreparedDemos> LoadDemos(const ExperimentConfig& c);
 
 /// Positions and velocities [d x n] of the given demos, concatenated.
 void StackDemos(const DemoSet& set, const std::vector<int>& ids, Eigen::MatrixXd* positions,
                 Eigen::MatrixXd* velocities);
 
-}  // namespace foresight
+}  // namespace foresight::imitation

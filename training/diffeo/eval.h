@@ -20,22 +20,22 @@
 #include "training/diffeo/config.h"
 #include "training/diffeo/demos.h"
 
-namespace foresight {
+namespace foresight::imitation {
 
 /// Named figures of one shape, in the order they are written to eval.json.
-using DiffeoScores = std::vector<std::pair<std::string, double>>;
+using Scores = std::vector<std::pair<std::string, double>>;
 
 /// Evaluates one prepared shape with its artifacts (template, and EFlow when eflow_path is not
 /// empty); draws plots/<name>.png when `plot_dir` is not empty.
-DiffeoScores EvaluatePlanarShape(const DiffeoConfig& c, const PreparedDemos& demos,
-                                 const std::string& template_path, const std::string& eflow_path,
-                                 const std::string& plot_dir);
+Scores EvaluatePlanarShape(const ExperimentConfig& c, const PreparedDemos& demos,
+                           const std::string& template_path, const std::string& eflow_path,
+                           const std::string& plot_dir);
 /// The same for a task-space set on the JACO arm (C-space rollouts, body-ball MCD).
-DiffeoScores EvaluateTaskSpaceShape(const DiffeoConfig& c, const PreparedDemos& demos,
-                                    const std::string& template_path, const std::string& eflow_path,
-                                    const std::string& plot_dir);
+Scores EvaluateTaskSpaceShape(const ExperimentConfig& c, const PreparedDemos& demos,
+                              const std::string& template_path, const std::string& eflow_path,
+                              const std::string& plot_dir);
 
 /// eval.json: {"shapes": {name: {...}}, "mean": {...}} (mean over shapes of every figure).
-std::string DiffeoEvalJson(const std::vector<std::pair<std::string, DiffeoScores>>& shapes);
+std::string EvalJson(const std::vector<std::pair<std::string, Scores>>& shapes);
 
-}  // namespace foresight
+}  // namespace foresight::imitation

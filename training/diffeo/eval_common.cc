@@ -4,10 +4,10 @@
 #include <map>
 #include <sstream>
 
-namespace foresight {
+namespace foresight::imitation {
 
 void AddPathScores(const std::string& prefix, const PathSet& paths, const PreparedDemos& demos,
-                   int resample, DiffeoScores* s, const std::vector<int>& ids, double scale) {
+                   int resample, Scores* s, const std::vector<int>& ids, double scale) {
   double sum = 0, held_sum = 0, reached = 0;
   int held = 0;
   const int n = static_cast<int>(paths.paths.size());
@@ -15,9 +15,8 @@ void AddPathScores(const std::string& prefix, const PathSet& paths, const Prepar
     const int demo = ids.empty() ? k : ids[static_cast<std::size_t>(k)];
     const Eigen::MatrixXd& ref = demos.demos.demos[static_cast<std::size_t>(demo)].position;
     const double f =
-        imitation::DiscreteFrechet(
-            imitation::ResampleByArcLength(paths.paths[static_cast<std::size_t>(k)], resample),
-            imitation::ResampleByArcLength(ref, resample)) *
+        DiscreteFrechet(ResampleByArcLength(paths.paths[static_cast<std::size_t>(k)], resample),
+                        ResampleByArcLength(ref, resample)) *
         scale;
     sum += f;
     if (std::find(demos.held_out.begin(), demos.held_out.end(), demo) != demos.held_out.end()) {
@@ -40,7 +39,7 @@ void WriteNumber(std::ostringstream& o, double v) {
 }
 }  // namespace
 
-std::string DiffeoEvalJson(const std::vector<std::pair<std::string, DiffeoScores>>& shapes) {
+std::string EvalJson(const std::vector<std::pair<std::string, Scores>>& shapes) {
   std::ostringstream o;
   o << std::setprecision(6);
   o << "{\n  \"shapes\": {";
@@ -70,4 +69,4 @@ std::string DiffeoEvalJson(const std::vector<std::pair<std::string, DiffeoScores
   return o.str();
 }
 
-}  // namespace foresight
+}  // namespace foresight::imitation

@@ -19,7 +19,7 @@
 #include "training/diffeo/demos.h"
 #include "training/diffeo/eval.h"
 
-namespace foresight {
+namespace foresight::imitation {
 
 /// Rolled-out paths [d x n_k] with whether each reached the goal.
 struct PathSet {
@@ -28,7 +28,7 @@ struct PathSet {
 };
 
 template <int D>
-PathSet ToPaths(const std::vector<imitation::Rollout<D>>& rollouts) {
+PathSet ToPaths(const std::vector<Rollout<D>>& rollouts) {
   PathSet p;
   for (const auto& r : rollouts) {
     p.paths.push_back(r.path);
@@ -38,7 +38,7 @@ PathSet ToPaths(const std::vector<imitation::Rollout<D>>& rollouts) {
 }
 
 template <int D>
-double ReachRate(const std::vector<imitation::Rollout<D>>& rollouts) {
+double ReachRate(const std::vector<Rollout<D>>& rollouts) {
   if (rollouts.empty()) return 0;
   double n = 0;
   for (const auto& r : rollouts) n += (r.reached && r.finite) ? 1 : 0;
@@ -50,12 +50,11 @@ double ReachRate(const std::vector<imitation::Rollout<D>>& rollouts) {
 /// and is compared with it after both are resampled to `resample` points by arc length.
 /// `scale` converts to the reported unit (1: normalised; 1 / norm.scale: data units).
 void AddPathScores(const std::string& prefix, const PathSet& paths, const PreparedDemos& demos,
-                   int resample, DiffeoScores* s, const std::vector<int>& ids = {},
-                   double scale = 1.0);
+                   int resample, Scores* s, const std::vector<int>& ids = {}, double scale = 1.0);
 
 /// g^D starts on a regular grid over the demonstrations' box grown by `margin` on every side.
 template <int D>
-std::vector<imitation::Vec<D>> GridStarts(const DemoSet& set, int g, double margin) {
+std::vector<Vec<D>> GridStarts(const DemoSet& set, int g, double margin) {
   Eigen::Matrix<double, D, 1> lo = Eigen::Matrix<double, D, 1>::Constant(1e300), hi = -lo;
   for (const Demonstration& d : set.demos) {
     lo = lo.cwiseMin(d.position.rowwise().minCoeff());
@@ -63,11 +62,11 @@ std::vector<imitation::Vec<D>> GridStarts(const DemoSet& set, int g, double marg
   }
   lo.array() -= margin;
   hi.array() += margin;
-  std::vector<imitation::Vec<D>> out;
+  std::vector<Vec<D>> out;
   int total = 1;
   for (int a = 0; a < D; ++a) total *= g;
   for (int k = 0; k < total; ++k) {
-    imitation::Vec<D> p;
+    Vec<D> p;
     int r = k;
     for (int a = 0; a < D; ++a) {
       p[a] = lo[a] + (hi[a] - lo[a]) * (r % g) / (g - 1.0);
@@ -80,9 +79,8 @@ std::vector<imitation::Vec<D>> GridStarts(const DemoSet& set, int g, double marg
 
 /// The starts outside an obstacle.
 template <int D, class Obstacle>
-std::vector<imitation::Vec<D>> FreeOf(const std::vector<imitation::Vec<D>>& starts,
-                                      const Obstacle& o) {
-  std::vector<imitation::Vec<D>> out;
+std::vector<Vec<D>> FreeOf(const std::vector<Vec<D>>& starts, const Obstacle& o) {
+  std::vector<Vec<D>> out;
   for (const auto& p : starts)
     if (o.SignedDistance(p) > 0) out.push_back(p);
   return out;
@@ -93,48 +91,43 @@ template <class Obstacle>
 double MaxDepth(const PathSet& paths, const Obstacle& o, double scale = 1.0) {
   double worst = 0;
   for (const Eigen::MatrixXd& p : paths.paths)
-    worst = std::max(worst, imitation::MaxCollisionDepth(p, o, 0.0));
+    worst = std::max(worst, MaxCollisionDepth(p, o, 0.0));
   return worst * scale;
 }
 
 /// The occupancy map of an obstacle: a Hilbert map on a grid around it, fitted on a lattice of
 /// labelled samples (exact signed distance <= 0 is occupied).
 template <int D>
-imitation::OccupancyField<D> FitObstacleMap(
-    const DiffeoObstacleConfig& o,
-    const std::function<double(const imitation::Vec<D>&)>& signed_distance,
-    const imitation::Vec<D>& lo_in, const imitation::Vec<D>& hi_in, const std::string& source) {
-  const imitation::Vec<D> lo = lo_in.array() - o.sample_margin;
-  const imitation::Vec<D> hi = hi_in.array() + o.sample_margin;
+OccupancyField<D> FitObstacleMap(const ObstacleConfig& o,
+                                 const std::function<double(const Vec<D>&)>& signed_distance,
+                                 const Vec<D>& lo_in, const Vec<D>& hi_in,
+                                 const std::string& source) {
+  const Vec<D> lo = lo_in.array() - o.sample_margin;
+  const Vec<D> hi = hi_in.array() + o.sample_margin;
   Eigen::Matrix<double, D, Eigen::Dynamic> points;
   std::vector<std::uint8_t> occupied;
   // Labels from the obstacle grown by map_inflate: a margin between the map's boundary and the
   // exact obstacle the metrics use.
-  imitation::SampleObstacleOccupancy<D>(
-      [&](const imitation::Vec<D>& p) { return signed_distance(p) - o.map_inflate; }, lo, hi,
-      o.sample_spacing, &points, &occupied);
-  const imitation::RbfGrid<D> grid(
-      imitation::RbfGrid<D>::Covering(lo, hi, 0.0, o.map_spacing, o.map_gamma, o.map_cutoff),
-      source + ": obstacle map");
-  return imitation::FitOccupancyField<D>(grid, points, occupied, o.map_l2,
-                                         source + ": obstacle map");
+  SampleObstacleOccupancy<D>([&](const Vec<D>& p) { return signed_distance(p) - o.map_inflate; },
+                             lo, hi, o.sample_spacing, &points, &occupied);
+  const RbfGrid<D> grid(RbfGrid<D>::Covering(lo, hi, 0.0, o.map_spacing, o.map_gamma, o.map_cutoff),
+                        source + ": obstacle map");
+  return FitOccupancyField<D>(grid, points, occupied, o.map_l2, source + ": obstacle map");
 }
 
 /// The same for a ball-shaped 2-D obstacle given by its centre and radius.
 template <int D>
-imitation::OccupancyField<D> FitObstacleMap(
-    const DiffeoObstacleConfig& o,
-    const std::function<double(const imitation::Vec<D>&)>& signed_distance,
-    const imitation::Vec<D>& centre, double radius, const std::string& source) {
-  return FitObstacleMap<D>(o, signed_distance, imitation::Vec<D>(centre.array() - radius),
-                           imitation::Vec<D>(centre.array() + radius), source);
+OccupancyField<D> FitObstacleMap(const ObstacleConfig& o,
+                                 const std::function<double(const Vec<D>&)>& signed_distance,
+                                 const Vec<D>& centre, double radius, const std::string& source) {
+  return FitObstacleMap<D>(o, signed_distance, Vec<D>(centre.array() - radius),
+                           Vec<D>(centre.array() + radius), source);
 }
 
 /// Largest |grad p| and spectral norm of Hess p of a map on a lattice over [lo, hi].
 template <int D>
-std::pair<double, double> MapSlopes(const imitation::OccupancyField<D>& field,
-                                    const imitation::Vec<D>& lo, const imitation::Vec<D>& hi,
-                                    double spacing) {
+std::pair<double, double> MapSlopes(const OccupancyField<D>& field, const Vec<D>& lo,
+                                    const Vec<D>& hi, double spacing) {
   auto ws = field.MakeWorkspace();
   std::array<int, D> n{};
   int total = 1;
@@ -143,9 +136,9 @@ std::pair<double, double> MapSlopes(const imitation::OccupancyField<D>& field,
     total *= n[a];
   }
   double g = 0, h = 0;
-  imitation::OccupancyValue<D> v;
+  OccupancyValue<D> v;
   for (int k = 0; k < total; ++k) {
-    imitation::Vec<D> y;
+    Vec<D> y;
     int r = k;
     for (int a = 0; a < D; ++a) {
       y[a] = lo[a] + (hi[a] - lo[a]) * (r % n[a]) / (n[a] - 1.0);
@@ -161,7 +154,7 @@ std::pair<double, double> MapSlopes(const imitation::OccupancyField<D>& field,
 
 /// The Euler step of an obstacle flow: obstacle.step, or less where the map is steeper, so that
 /// h ||Hess p|| <= 0.5 (each step a contraction-perturbed identity: invertible).
-inline double ObstacleStep(const DiffeoObstacleConfig& o, double max_hessian) {
+inline double ObstacleStep(const ObstacleConfig& o, double max_hessian) {
   return std::min(o.step, 0.5 / std::max(max_hessian, 1e-12));
 }
 
@@ -171,22 +164,21 @@ inline int ObstacleSteps(double time, double h) {
 }
 
 template <int D>
-imitation::OuterTransform<D> ObstacleOuter(const imitation::OccupancyField<D>& field, double time,
-                                           double h) {
-  imitation::OuterTransform<D> t;
-  t.type = imitation::OuterTransform<D>::Type::kObstacle;
-  imitation::FlowSettings<D> fs;
+OuterTransform<D> ObstacleOuter(const OccupancyField<D>& field, double time, double h) {
+  OuterTransform<D> t;
+  t.type = OuterTransform<D>::Type::kObstacle;
+  FlowSettings<D> fs;
   fs.time = time;
   fs.steps = ObstacleSteps(time, h);
-  t.obstacle = imitation::ObstacleTransform<D>(field, fs);
+  t.obstacle = ObstacleTransform<D>(field, fs);
   return t;
 }
 
 /// Whether psi_o^-1(psi_o(y)) = y (to 1e-8) on a lattice of spacing `spacing` over [lo, hi]: the
 /// settings keep the Euler map invertible there.
 template <int D>
-bool ObstacleInvertible(const imitation::ObstacleTransform<D>& t, const imitation::Vec<D>& lo,
-                        const imitation::Vec<D>& hi, double spacing) {
+bool ObstacleInvertible(const ObstacleTransform<D>& t, const Vec<D>& lo, const Vec<D>& hi,
+                        double spacing) {
   auto ws = t.MakeWorkspace();
   std::array<int, D> n{};
   int total = 1;
@@ -195,13 +187,13 @@ bool ObstacleInvertible(const imitation::ObstacleTransform<D>& t, const imitatio
     total *= n[a];
   }
   for (int k = 0; k < total; ++k) {
-    imitation::Vec<D> y;
+    Vec<D> y;
     int r = k;
     for (int a = 0; a < D; ++a) {
       y[a] = lo[a] + (hi[a] - lo[a]) * (r % n[a]) / (n[a] - 1.0);
       r /= n[a];
     }
-    imitation::Vec<D> back;
+    Vec<D> back;
     if (!t.Inverse(t.Forward(y, ws.get()), ws.get(), &back) || (back - y).norm() > 1e-8)
       return false;
   }
@@ -210,20 +202,19 @@ bool ObstacleInvertible(const imitation::ObstacleTransform<D>& t, const imitatio
 
 /// The bias transform toward `target`: samples on a lattice within bias.region of it.
 template <int D>
-imitation::RbfFlow<D> FitBias(const DiffeoBiasConfig& b, const imitation::RbfGridSpec<D>& spec,
-                              const imitation::Vec<D>& target) {
-  std::vector<imitation::Vec<D>> samples;
-  const imitation::RbfGrid<D> grid(spec, "bias grid");
+RbfFlow<D> FitBias(const BiasConfig& b, const RbfGridSpec<D>& spec, const Vec<D>& target) {
+  std::vector<Vec<D>> samples;
+  const RbfGrid<D> grid(spec, "bias grid");
   for (int t = 0; t < grid.size(); ++t)
     if ((grid.Centre(t) - target).norm() <= b.region) samples.push_back(grid.Centre(t));
   FS_THROW_UNLESS(samples.size() >= 2, "bias.region (", b.region,
                   ") holds fewer than 2 inducing states around the target");
   Eigen::Matrix<double, D, Eigen::Dynamic> m(D, static_cast<Eigen::Index>(samples.size()));
   for (std::size_t i = 0; i < samples.size(); ++i) m.col(static_cast<Eigen::Index>(i)) = samples[i];
-  imitation::FlowSettings<D> fs;
+  FlowSettings<D> fs;
   fs.time = b.time;
   fs.steps = b.steps;
-  return imitation::FitBiasTransform<D>(grid, m, target, 1e-6, fs);
+  return FitBiasTransform<D>(grid, m, target, 1e-6, fs);
 }
 
 /// Where the obstacle goes: the point at arc-length share `fraction` of the first training
@@ -252,4 +243,4 @@ inline double ClosestApproach(const PathSet& paths, const Eigen::VectorXd& targe
   return best;
 }
 
-}  // namespace foresight
+}  // namespace foresight::imitation

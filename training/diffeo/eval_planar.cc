@@ -17,13 +17,12 @@
 #include "training/diffeo/eval_common.h"
 #include "training/diffeo/plots.h"
 
-namespace foresight {
+namespace foresight::imitation {
 namespace {
 
-using namespace imitation;  // NOLINT: the imitation engine throughout this file
 using V2 = Vec<2>;
 
-RolloutSettings Rollouts(const DiffeoConfig& c) {
+RolloutSettings Rollouts(const ExperimentConfig& c) {
   RolloutSettings r;
   r.dt = c.eval.dt;
   r.max_steps = c.eval.max_steps;
@@ -61,9 +60,9 @@ bool AllReached(const std::vector<Rollout<2>>& paths) {
 
 }  // namespace
 
-DiffeoScores EvaluatePlanarShape(const DiffeoConfig& c, const PreparedDemos& demos,
-                                 const std::string& template_path, const std::string& eflow_path,
-                                 const std::string& plot_dir) {
+Scores EvaluatePlanarShape(const ExperimentConfig& c, const PreparedDemos& demos,
+                           const std::string& template_path, const std::string& eflow_path,
+                           const std::string& plot_dir) {
   const TemplateArtifact<2> art = LoadTemplate<2>(template_path);
   const ImitationSystem<2>& system = art.system;
   const V2 goal = system.goal();
@@ -72,7 +71,7 @@ DiffeoScores EvaluatePlanarShape(const DiffeoConfig& c, const PreparedDemos& dem
   std::vector<V2> starts;
   for (const Demonstration& d : demos.demos.demos) starts.push_back(d.position.col(0));
 
-  DiffeoScores s;
+  Scores s;
   PlanarPicture pic;
   pic.demos = &demos.demos;
   // ---- imitation ------------------------------------------------------------------------------
@@ -235,4 +234,4 @@ DiffeoScores EvaluatePlanarShape(const DiffeoConfig& c, const PreparedDemos& dem
   return s;
 }
 
-}  // namespace foresight
+}  // namespace foresight::imitation

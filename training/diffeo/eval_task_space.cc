@@ -19,10 +19,8 @@
 #include "training/diffeo/eval.h"
 #include "training/diffeo/eval_common.h"
 
-namespace foresight {
+namespace foresight::imitation {
 namespace {
-
-using namespace imitation;  // NOLINT: the imitation engine throughout this file
 
 /// A C-space path: joint configurations and the end-effector path, and whether it reached.
 struct ArmPath {
@@ -121,9 +119,9 @@ PathSet Normalised(const std::vector<ArmPath>& paths, const TaskNormalisation& t
 
 }  // namespace
 
-DiffeoScores EvaluateTaskSpaceShape(const DiffeoConfig& c, const PreparedDemos& demos,
-                                    const std::string& template_path, const std::string& eflow_path,
-                                    const std::string& plot_dir) {
+Scores EvaluateTaskSpaceShape(const ExperimentConfig& c, const PreparedDemos& demos,
+                              const std::string& template_path, const std::string& eflow_path,
+                              const std::string& plot_dir) {
   (void)plot_dir;  // no picture of the arm yet
   const TemplateArtifact<3> art = LoadTemplate<3>(template_path);
   const SerialChain chain =
@@ -153,7 +151,7 @@ DiffeoScores EvaluateTaskSpaceShape(const DiffeoConfig& c, const PreparedDemos& 
                     " starts at ", x0.transpose(), " m, which the arm does not reach");
     starts.push_back(q);
   }
-  DiffeoScores s;
+  Scores s;
   // ---- imitation pulled back to C-space ------------------------------------------------------
   std::vector<ArmPath> imit;
   for (const ArmVector& q : starts) imit.push_back(FromRollout(RollOutCSpace(plain, q, roll)));
@@ -331,4 +329,4 @@ DiffeoScores EvaluateTaskSpaceShape(const DiffeoConfig& c, const PreparedDemos& 
   return s;
 }
 
-}  // namespace foresight
+}  // namespace foresight::imitation

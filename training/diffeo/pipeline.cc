@@ -11,21 +11,21 @@
 #include "training/kinds.h"
 #include "training/run_dir.h"
 
-namespace foresight {
+namespace foresight::imitation {
 namespace fs = std::filesystem;
 
 namespace {
 const RunDirectoryRules kDiffeoRunRules{{"shapes", "models", "eval.json"}, true};
 }  // namespace
 
-bool TrainDiffeoRun(const DiffeoConfig& c, const std::string& run_dir, bool resume,
-                    const std::atomic<bool>* interrupt) {
+bool TrainRun(const ExperimentConfig& c, const std::string& run_dir, bool resume,
+              const std::atomic<bool>* interrupt) {
   StartRunDirectory(run_dir, config::ToYaml(c), resume, kDiffeoRunRules);
-  const std::vector<PreparedDemos> sets = LoadDiffeoDemos(c);
+  const std::vector<PreparedDemos> sets = LoadDemos(c);
   log::Info(resume ? "resuming" : "starting", " diffeomorphic templates in ", run_dir, ": ",
             sets.size(), " shape(s), seed ", c.seed);
   for (const PreparedDemos& d : sets) {
-    const DiffeoShapePaths paths(run_dir, d.name);
+    const ShapePaths paths(run_dir, d.name);
     if (resume && ShapeExported(c, paths)) {
       log::Info(d.name, ": already exported, skipped");
       continue;
@@ -40,21 +40,21 @@ bool TrainDiffeoRun(const DiffeoConfig& c, const std::string& run_dir, bool resu
   return true;
 }
 
-std::string ExportDiffeoRun(const std::string& run_dir) {
-  const auto c = LoadRunConfig<DiffeoConfig>(run_dir, {});
+std::string ExportRun(const std::string& run_dir) {
+  const auto c = LoadRunConfig<ExperimentConfig>(run_dir, {});
   std::string first;
-  for (const PreparedDemos& d : LoadDiffeoDemos(c)) {
-    const DiffeoShapePaths paths(run_dir, d.name);
+  for (const PreparedDemos& d : LoadDemos(c)) {
+    const ShapePaths paths(run_dir, d.name);
     ExportShape(c, d, paths);
     if (first.empty()) first = paths.Template();
   }
   return first;
 }
 
-std::string EvaluateDiffeoRun(const DiffeoConfig& c, const std::string& run_dir) {
-  std::vector<std::pair<std::string, DiffeoScores>> shapes;
-  for (const PreparedDemos& d : LoadDiffeoDemos(c)) {
-    const DiffeoShapePaths paths(run_dir, d.name);
+std::string EvaluateRun(const ExperimentConfig& c, const std::string& run_dir) {
+  std::vector<std::pair<std::string, Scores>> shapes;
+  for (const PreparedDemos& d : LoadDemos(c)) {
+    const ShapePaths paths(run_dir, d.name);
     FS_THROW_UNLESS(fs::exists(paths.Template()), run_dir, ": ", paths.Template(),
                     " is missing; train (or export) the run first");
     const std::string eflow = c.eflow.enabled ? paths.Eflow() : "";
@@ -64,9 +64,9 @@ std::string EvaluateDiffeoRun(const DiffeoConfig& c, const std::string& run_dir)
                                     ? EvaluateTaskSpaceShape(c, d, paths.Template(), eflow, plots)
                                     : EvaluatePlanarShape(c, d, paths.Template(), eflow, plots));
   }
-  const std::string json = DiffeoEvalJson(shapes);
+  const std::string json = EvalJson(shapes);
   WriteFileAtomically(run_dir + "/eval.json", json);
   return json;
 }
 
-}  // namespace foresight
+}  // namespace foresight::imitation

@@ -13,15 +13,15 @@
 
 #include "training/diffeo/config.h"
 
-namespace foresight {
+namespace foresight::imitation {
 
 /// Trains and exports every shape. @return false when interrupted (resume continues).
-bool TrainDiffeoRun(const DiffeoConfig& c, const std::string& run_dir, bool resume,
-                    const std::atomic<bool>* interrupt);
+bool TrainRun(const ExperimentConfig& c, const std::string& run_dir, bool resume,
+              const std::atomic<bool>* interrupt);
 /// Writes every shape's artifacts from its best checkpoints (run_dir/models/). @return the first
 /// shape's template (the only one for single-shape runs).
-std::string ExportDiffeoRun(const std::string& run_dir);
+std::string ExportRun(const std::string& run_dir);
 /// Evaluates the run's artifacts; writes run_dir/eval.json (and plots). @return its text.
-std::string EvaluateDiffeoRun(const DiffeoConfig& c, const std::string& run_dir);
+std::string EvaluateRun(const ExperimentConfig& c, const std::string& run_dir);
 
-}  // namespace foresight
+}  // namespace foresight::imitation

@@ -6,7 +6,7 @@
 #include "core/error.h"
 #include "training/image_io.h"
 
-namespace foresight {
+namespace foresight::imitation {
 namespace {
 
 constexpr int kSize = 560;
@@ -88,4 +88,4 @@ void DrawPlanar(const PlanarPicture& pic, const std::string& png) {
   WriteImage(png, out);
 }
 
-}  // namespace foresight
+}  // namespace foresight::imitation

@@ -9,11 +9,11 @@
 #include "datasets/demonstrations.h"
 #include "training/diffeo/eval_common.h"
 
-namespace foresight {
+namespace foresight::imitation {
 
 struct PlanarPicture {
-  const DemoSet* demos = nullptr;                                    ///< normalised demonstrations
-  std::function<imitation::Vec<2>(const imitation::Vec<2>&)> field;  ///< f_i, drawn as arrows
+  const DemoSet* demos = nullptr;              ///< normalised demonstrations
+  std::function<Vec<2>(const Vec<2>&)> field;  ///< f_i, drawn as arrows
   PathSet rollouts, eflow, avoid, eflow_repulsor, biased;
   Eigen::VectorXd obstacle_centre;  ///< empty: no obstacle
   double obstacle_radius = 0;
@@ -22,4 +22,4 @@ struct PlanarPicture {
 /// Two panels side by side (imitation | obstacle, when there is one) written to `png`.
 void DrawPlanar(const PlanarPicture& picture, const std::string& png);
 
-}  // namespace foresight
+}  // namespace foresight::imitation

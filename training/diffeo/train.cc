@@ -13,9 +13,8 @@
 #include "models/imitation/flow_net.h"
 #include "training/trainer.h"
 
-namespace foresight {
+namespace foresight::imitation {
 namespace fs = std::filesystem;
-using namespace imitation;  // NOLINT: the imitation learners and engines throughout this file
 
 namespace {
 
@@ -30,7 +29,7 @@ torch::Tensor Rows(const Eigen::MatrixXd& m) {
 
 /// The grid of inducing states over the training demonstrations (grown by flow.margin).
 template <int D>
-RbfGridSpec<D> ShapeGrid(const DiffeoConfig& c, const Eigen::MatrixXd& positions) {
+RbfGridSpec<D> ShapeGrid(const ExperimentConfig& c, const Eigen::MatrixXd& positions) {
   const Vec<D> lo = positions.rowwise().minCoeff(), hi = positions.rowwise().maxCoeff();
   return RbfGrid<D>::Covering(lo, hi, c.flow.margin, c.flow.spacing, c.flow.gamma,
                               c.flow.cutoff_radius);
@@ -73,7 +72,7 @@ struct ShapeData {
   int dimension = 2;
 };
 
-ShapeData Prepare(const DiffeoConfig& c, const PreparedDemos& d) {
+ShapeData Prepare(const ExperimentConfig& c, const PreparedDemos& d) {
   ShapeData s;
   s.dimension = d.demos.dimension;
   StackDemos(d.demos, d.train, &s.positions, &s.velocities);
@@ -105,14 +104,14 @@ ShapeData Prepare(const DiffeoConfig& c, const PreparedDemos& d) {
   return s;
 }
 
-RbfFlowNet MakeFlowNet(const DiffeoConfig& c, const ShapeData& s) {
+RbfFlowNet MakeFlowNet(const ExperimentConfig& c, const ShapeData& s) {
   const torch::Tensor centres = s.dimension == 2 ? Centres<2>(ShapeGrid<2>(c, s.positions))
                                                  : Centres<3>(ShapeGrid<3>(c, s.positions));
   return RbfFlowNet(centres, c.flow.gamma, c.flow.cutoff_radius, c.flow.time, c.flow.steps,
                     s.initial_speed);
 }
 
-EFlowNet MakeEflowNet(const DiffeoConfig& c, const ShapeData& s) {
+EFlowNet MakeEflowNet(const ExperimentConfig& c, const ShapeData& s) {
   EFlowNetOptions o;
   o.dimension = s.dimension;
   o.layers = c.eflow.layers;
@@ -142,8 +141,8 @@ bool TrainModel(std::shared_ptr<VelocityModel> model, const ShapeData& s, const 
 }
 
 template <int D>
-void ExportFlow(const DiffeoConfig& c, const PreparedDemos& d, const ShapeData& s, RbfFlowNet& net,
-                const std::string& path) {
+void ExportFlow(const ExperimentConfig& c, const PreparedDemos& d, const ShapeData& s,
+                RbfFlowNet& net, const std::string& path) {
   const RbfGrid<D> grid(ShapeGrid<D>(c, s.positions), d.name + ": flow grid");
   FlowSettings<D> settings;
   settings.time = c.flow.time;
@@ -166,11 +165,11 @@ void ExportFlow(const DiffeoConfig& c, const PreparedDemos& d, const ShapeData& 
 
 }  // namespace
 
-bool ShapeExported(const DiffeoConfig& c, const DiffeoShapePaths& paths) {
+bool ShapeExported(const ExperimentConfig& c, const ShapePaths& paths) {
   return fs::exists(paths.Template()) && (!c.eflow.enabled || fs::exists(paths.Eflow()));
 }
 
-bool TrainShape(const DiffeoConfig& c, const PreparedDemos& demos, const DiffeoShapePaths& paths,
+bool TrainShape(const ExperimentConfig& c, const PreparedDemos& demos, const ShapePaths& paths,
                 bool resume, const std::atomic<bool>* interrupt) {
   const ShapeData s = Prepare(c, demos);
   const auto seed = static_cast<std::uint64_t>(c.seed);
@@ -184,7 +183,7 @@ bool TrainShape(const DiffeoConfig& c, const PreparedDemos& demos, const DiffeoS
                     interrupt, demos.name + " eflow");
 }
 
-void ExportShape(const DiffeoConfig& c, const PreparedDemos& demos, const DiffeoShapePaths& paths) {
+void ExportShape(const ExperimentConfig& c, const PreparedDemos& demos, const ShapePaths& paths) {
   const ShapeData s = Prepare(c, demos);
   fs::create_directories(fs::path(paths.Template()).parent_path());
   RbfFlowNet flow = MakeFlowNet(c, s);
@@ -204,4 +203,4 @@ void ExportShape(const DiffeoConfig& c, const PreparedDemos& demos, const Diffeo
       .Save(paths.Eflow(), config::ToYaml(c), c.seed);
 }
 
-}  // namespace foresight
+}  // namespace foresight::imitation

@@ -10,11 +10,11 @@
 #include "training/diffeo/config.h"
 #include "training/diffeo/demos.h"
 
-namespace foresight {
+namespace foresight::imitation {
 
 /// Where one shape's files live in a run directory.
-struct DiffeoShapePaths {
-  DiffeoShapePaths(std::string run, std::string shape)
+struct ShapePaths {
+  ShapePaths(std::string run, std::string shape)
       : run_dir(std::move(run)), name(std::move(shape)) {}
   std::string run_dir, name;
   std::string FlowDir() const { return run_dir + "/shapes/" + name + "/flow"; }
@@ -24,13 +24,13 @@ struct DiffeoShapePaths {
 };
 
 /// Whether every artifact of the shape exists (a resumed run skips it).
-bool ShapeExported(const DiffeoConfig& c, const DiffeoShapePaths& paths);
+bool ShapeExported(const ExperimentConfig& c, const ShapePaths& paths);
 /// Trains the shape's networks (continuing their checkpoints when `resume` and they exist).
 /// @return false when interrupted.
-bool TrainShape(const DiffeoConfig& c, const PreparedDemos& demos, const DiffeoShapePaths& paths,
+bool TrainShape(const ExperimentConfig& c, const PreparedDemos& demos, const ShapePaths& paths,
                 bool resume, const std::atomic<bool>* interrupt);
 /// Writes the artifacts from the best checkpoints; refuses a flow that is not invertible on the
 /// grid and the demonstrations (CheckInvertible with flow.inverse_tolerance), naming the settings.
-void ExportShape(const DiffeoConfig& c, const PreparedDemos& demos, const DiffeoShapePaths& paths);
+void ExportShape(const ExperimentConfig& c, const PreparedDemos& demos, const ShapePaths& paths);
 
-}  // namespace foresight
+}  // namespace foresight::imitation

@@ -4,9 +4,9 @@
 
 #include "core/error.h"
 
-namespace foresight {
+namespace foresight::gfcs {
 
-void GfcsTrainConfig::Validate(const std::string& path) const {
+void ExperimentConfig::Validate(const std::string& path) const {
   FS_THROW_UNLESS(model == "gfcs", path, ": model: '", model, "', expected 'gfcs'");
   FS_THROW_UNLESS(!robot.empty(), path, ": robot: empty (a folder or 'builtin')");
   FS_THROW_UNLESS(!train_problems.empty(), path, ": train_problems: empty list");
@@ -54,4 +54,4 @@ void GfcsTrainConfig::Validate(const std::string& path) const {
                   ") is below fabric.dt (", fabric.dt, ")");
 }
 
-}  // namespace foresight
+}  // namespace foresight::gfcs

@@ -16,10 +16,10 @@
 #include "training/manipulation/config.h"
 #include "training/train_config.h"
 
-namespace foresight {
+namespace foresight::gfcs {
 
 /// The autoencoder that reduces the basis-point distances to the context's encoding.
-struct GfcsAutoencoderConfig {
+struct AutoencoderConfig {
   int encoding = 300;  ///< thesis: 300
   int hidden = 512;    ///< one hidden layer each side
   double val_fraction = 0.1;
@@ -44,7 +44,7 @@ struct GfcsAutoencoderConfig {
 };
 
 /// E_theta(x_c, y): an MLP with `layers` hidden ReLU layers of `hidden` units (thesis 800 x 3).
-struct GfcsEnergyNetConfig {
+struct EnergyNetConfig {
   int hidden = 800;
   int layers = 3;
 
@@ -56,7 +56,7 @@ struct GfcsEnergyNetConfig {
 };
 
 /// The self-supervised loop (thesis Algorithm "Self-supervised GFCS").
-struct GfcsLoopConfig {
+struct LoopConfig {
   int passes = 2;        ///< passes over the training problems
   int buffer = 200;      ///< positives kept (oldest dropped first)
   int train_every = 25;  ///< n_train: solves between training rounds
@@ -101,7 +101,7 @@ struct GfcsLoopConfig {
 
 /// Evaluation on held-out problems: GFCS with the uniform and the learned sampler at equal budget,
 /// plus baselines (the plan harness's methods).
-struct GfcsEvalConfig {
+struct EvalConfig {
   std::vector<ManipulationProblemsConfig> problems = [] {
     ManipulationProblemsConfig p;
     p.first = 51;
@@ -131,7 +131,7 @@ struct GfcsEvalConfig {
 };
 
 /// Where the data lives.
-struct GfcsDataConfig {
+struct DataConfig {
   std::string root;  ///< empty: $FORESIGHT_DATA, else ../shared/data
 
   template <class A>
@@ -142,10 +142,10 @@ struct GfcsDataConfig {
   }
 };
 
-struct GfcsTrainConfig {
+struct ExperimentConfig {
   std::string model = "gfcs";
   std::int64_t seed = 0;
-  GfcsDataConfig data;
+  DataConfig data;
   std::string robot = "franka_panda";  ///< folder under the data root, or "builtin"
   std::vector<ManipulationProblemsConfig> train_problems = [] {
     ManipulationProblemsConfig p;
@@ -157,11 +157,11 @@ struct GfcsTrainConfig {
   manipulation::GfcsParams
       gfcs;  ///< commands, top_m, penalty, sigma0, threads (batches: see loop/eval)
   manipulation::BpsLattice lattice;
-  GfcsAutoencoderConfig autoencoder;
-  GfcsEnergyNetConfig energy;
-  GfcsLoopConfig loop;
+  AutoencoderConfig autoencoder;
+  EnergyNetConfig energy;
+  LoopConfig loop;
   manipulation::SgldParams sampler;  ///< the learned sampler at inference (thesis 200 x 50)
-  GfcsEvalConfig eval;
+  EvalConfig eval;
 
   template <class A>
   void Serialize(A* a) {
@@ -189,8 +189,8 @@ struct GfcsTrainConfig {
 
 /// The harness config of one held-out problem set (methods: uniform and learned GFCS at each
 /// budget, then the baselines), the learned sampler read from `energy_model`.
-ManipulationExperimentConfig GfcsEvalPlanConfig(const GfcsTrainConfig& c,
-                                                const ManipulationProblemsConfig& problems,
-                                                const std::string& energy_model);
+ManipulationExperimentConfig EvalPlanConfig(const ExperimentConfig& c,
+                                            const ManipulationProblemsConfig& problems,
+                                            const std::string& energy_model);
 
-}  // namespace foresight
+}  // namespace foresight::gfcs

@@ -18,7 +18,7 @@
 #include "training/distributed.h"
 #include "training/run_dir.h"
 
-namespace foresight {
+namespace foresight::gfcs {
 namespace fs = std::filesystem;
 using manipulation::EnergyModel;
 using manipulation::JointVector;
@@ -55,7 +55,7 @@ std::int64_t GetInt(const std::string& s, std::size_t* at) {
 /// What one rank contributes to a block: its solves and their positives.
 struct BlockResult {
   int solves = 0, solved = 0, dropped = 0, sampler_failures = 0;
-  std::vector<GfcsPositive> positives;
+  std::vector<Positive> positives;
 };
 
 std::string Pack(const BlockResult& r) {
@@ -65,7 +65,7 @@ std::string Pack(const BlockResult& r) {
   PutInt(&s, r.dropped);
   PutInt(&s, r.sampler_failures);
   PutInt(&s, static_cast<std::int64_t>(r.positives.size()));
-  for (const GfcsPositive& p : r.positives) {
+  for (const Positive& p : r.positives) {
     PutInt(&s, p.problem);
     PutInt(&s, p.solve);
     float cost = p.cost;
@@ -85,7 +85,7 @@ BlockResult Unpack(const std::string& s) {
   r.sampler_failures = static_cast<int>(GetInt(s, &at));
   const std::int64_t n = GetInt(s, &at);
   for (std::int64_t i = 0; i < n; ++i) {
-    GfcsPositive p;
+    Positive p;
     p.problem = static_cast<int>(GetInt(s, &at));
     p.solve = static_cast<int>(GetInt(s, &at));
     FS_THROW_UNLESS(at + sizeof(float) <= s.size(), "gfcs loop: truncated gather message");
@@ -125,7 +125,7 @@ torch::Tensor Read(torch::serialize::InputArchive* a, const std::string& key) {
 // --- Positives <-> the buffer tensors of a checkpoint --------------------------------------------
 
 void WritePositives(torch::serialize::OutputArchive* a, const std::string& key,
-                    const std::vector<GfcsPositive>& list, int dim) {
+                    const std::vector<Positive>& list, int dim) {
   std::vector<std::int64_t> problem, solve;
   torch::Tensor cost = torch::zeros({static_cast<std::int64_t>(list.size())}, torch::kFloat32);
   torch::Tensor u = torch::zeros({static_cast<std::int64_t>(list.size()), dim}, torch::kFloat32);
@@ -141,10 +141,10 @@ void WritePositives(torch::serialize::OutputArchive* a, const std::string& key,
   a->write(key + ".u", u);
 }
 
-std::vector<GfcsPositive> ReadPositives(torch::serialize::InputArchive* a, const std::string& key) {
+std::vector<Positive> ReadPositives(torch::serialize::InputArchive* a, const std::string& key) {
   const torch::Tensor problem = Read(a, key + ".problem"), solve = Read(a, key + ".solve"),
                       cost = Read(a, key + ".cost"), u = Read(a, key + ".u");
-  std::vector<GfcsPositive> out(static_cast<std::size_t>(problem.size(0)));
+  std::vector<Positive> out(static_cast<std::size_t>(problem.size(0)));
   for (std::size_t i = 0; i < out.size(); ++i) {
     const auto k = static_cast<std::int64_t>(i);
     out[i].problem = static_cast<int>(problem[k].item<std::int64_t>());
@@ -215,13 +215,13 @@ struct LoopState {
   int rank_next = 0;    ///< this rank's next solve (>= block_start)
   int solves = 0, solved = 0, rounds = 0, dropped = 0, sampler_failures = 0;
   double last_loss = 0;
-  std::vector<GfcsPositive> buffer;
+  std::vector<Positive> buffer;
   BlockResult pending;  ///< this rank's results in the current block
 };
 
-int CommandSize(const GfcsTrainConfig& c) { return manipulation::kDof * (c.gfcs.commands - 1); }
+int CommandSize(const ExperimentConfig& c) { return manipulation::kDof * (c.gfcs.commands - 1); }
 
-EnergyNet MakeNet(const GfcsTrainConfig& c, int context_size) {
+EnergyNet MakeNet(const ExperimentConfig& c, int context_size) {
   return EnergyNet(context_size, CommandSize(c), c.energy.hidden, c.energy.layers);
 }
 
@@ -237,9 +237,9 @@ Eigen::VectorXf Normalise(const Eigen::VectorXd& q, const manipulation::JointLim
 
 class Loop {
  public:
-  Loop(const GfcsTrainConfig& c, const std::string& config_yaml,
-       const manipulation::RobotModel& robot, const GfcsEncoding& encoding,
-       const std::vector<GfcsTrainingProblem>& problems, const std::string& run_dir)
+  Loop(const ExperimentConfig& c, const std::string& config_yaml,
+       const manipulation::RobotModel& robot, const Encoding& encoding,
+       const std::vector<TrainingProblem>& problems, const std::string& run_dir)
       : c_(c),
         yaml_(config_yaml),
         robot_(robot),
@@ -250,7 +250,7 @@ class Loop {
         net_(MakeNet(c, static_cast<int>(problems.front().context.size()))),
         adam_(net_->parameters(), torch::optim::AdamOptions(c.loop.learning_rate)) {}
 
-  GfcsLoopStats Run(bool resume, const std::atomic<bool>* interrupt);
+  LoopStats Run(bool resume, const std::atomic<bool>* interrupt);
   Mlp Energy() const { return net_->net()->ToMlp(); }
 
  private:
@@ -265,17 +265,17 @@ class Loop {
   void TrainRound();
   std::string Where(int s) const;
 
-  const GfcsTrainConfig& c_;
+  const ExperimentConfig& c_;
   const std::string& yaml_;
   const manipulation::RobotModel& robot_;
-  const GfcsEncoding& encoding_;
-  const std::vector<GfcsTrainingProblem>& problems_;
+  const Encoding& encoding_;
+  const std::vector<TrainingProblem>& problems_;
   std::string run_dir_;
   std::shared_ptr<dist::Group> group_;
   EnergyNet net_;
   torch::optim::Adam adam_;
   LoopState st_;
-  GfcsLoopStats stats_;
+  LoopStats stats_;
   std::unique_ptr<EnergyModel> engine_;
   std::unique_ptr<manipulation::LearnedSampler> sampler_;
   int walk_from_ = 0;  ///< where this invocation's walk over the current block starts
@@ -283,7 +283,7 @@ class Loop {
 };
 
 std::string Loop::Where(int s) const {
-  const GfcsTrainingProblem& p = problems_[static_cast<std::size_t>(s) % problems_.size()];
+  const TrainingProblem& p = problems_[static_cast<std::size_t>(s) % problems_.size()];
   return p.family + " #" + std::to_string(p.problem.index);
 }
 
@@ -352,7 +352,7 @@ void Loop::Deserialize(const std::string& bytes, const std::string& source) {
   st_.buffer = ReadPositives(&a, "buffer");
   st_.pending.positives = ReadPositives(&a, "pending");
   for (const auto* list : {&st_.buffer, &st_.pending.positives})
-    for (const GfcsPositive& p : *list)
+    for (const Positive& p : *list)
       FS_THROW_UNLESS(p.problem >= 0 && p.problem < static_cast<int>(problems_.size()) &&
                           p.u.size() == CommandSize(c_),
                       source, ": a positive of problem ", p.problem, " (", p.u.size(),
@@ -426,7 +426,7 @@ void Loop::RebuildSampler() {
 }
 
 void Loop::Solve(int s) {
-  const GfcsTrainingProblem& p = problems_[static_cast<std::size_t>(s) % problems_.size()];
+  const TrainingProblem& p = problems_[static_cast<std::size_t>(s) % problems_.size()];
   const auto started = std::chrono::steady_clock::now();
   const manipulation::Fabric fabric(robot_, p.problem.world, c_.fabric);
   manipulation::GfcsParams params = c_.gfcs;
@@ -462,7 +462,7 @@ void Loop::Solve(int s) {
   const std::size_t before = st_.pending.positives.size();
   for (const manipulation::GfcsCandidate& cand : sol.top) {
     if (c_.loop.reached_only && !cand.reached) continue;
-    GfcsPositive pos;
+    Positive pos;
     pos.problem = static_cast<int>(static_cast<std::size_t>(s) % problems_.size());
     pos.solve = s;
     pos.cost = static_cast<float>(cand.cost);
@@ -483,18 +483,18 @@ void Loop::Solve(int s) {
 void Loop::FinishBlock(int block_end) {
   // Every rank's results, merged in solve order: the buffer does not depend on the rank count.
   const std::vector<std::string> parts = group_->AllGatherBytes(Pack(st_.pending));
-  std::vector<GfcsPositive> fresh;
+  std::vector<Positive> fresh;
   for (const std::string& part : parts) {
     BlockResult r = Unpack(part);
     st_.solves += r.solves;
     st_.solved += r.solved;
     st_.dropped += r.dropped;
     st_.sampler_failures += r.sampler_failures;
-    for (GfcsPositive& p : r.positives) fresh.push_back(std::move(p));
+    for (Positive& p : r.positives) fresh.push_back(std::move(p));
   }
   std::stable_sort(fresh.begin(), fresh.end(),
-                   [](const GfcsPositive& a, const GfcsPositive& b) { return a.solve < b.solve; });
-  for (GfcsPositive& p : fresh) st_.buffer.push_back(std::move(p));
+                   [](const Positive& a, const Positive& b) { return a.solve < b.solve; });
+  for (Positive& p : fresh) st_.buffer.push_back(std::move(p));
   if (st_.buffer.size() > static_cast<std::size_t>(c_.loop.buffer))
     st_.buffer.erase(st_.buffer.begin(),
                      st_.buffer.end() - static_cast<std::ptrdiff_t>(c_.loop.buffer));
@@ -534,7 +534,7 @@ void Loop::TrainRound() {
         for (std::size_t i = static_cast<std::size_t>(t); i < mine.size();
              i += static_cast<std::size_t>(threads)) {
           const int j = mine[i];
-          const GfcsPositive& pos = st_.buffer[static_cast<std::size_t>(j)];
+          const Positive& pos = st_.buffer[static_cast<std::size_t>(j)];
           std::mt19937_64 rng(StreamSeed(c_.seed, kNegativeStream, round, pos.solve * 64 + j));
           manipulation::SgldResult r;
           try {
@@ -597,7 +597,7 @@ void Loop::TrainRound() {
   torch::Tensor ctx = torch::empty({b_total, context_size}, torch::kFloat32);
   torch::Tensor u_all = torch::empty({b_total, 1 + n_neg, dim}, torch::kFloat32);
   for (int j = 0; j < b_total; ++j) {
-    const GfcsPositive& pos = st_.buffer[static_cast<std::size_t>(j)];
+    const Positive& pos = st_.buffer[static_cast<std::size_t>(j)];
     ctx[j] = ToTensor(problems_[static_cast<std::size_t>(pos.problem)].context);
     u_all[j][0] = ToTensor(pos.u);
     const Eigen::MatrixXf& neg = negatives[static_cast<std::size_t>(j)];
@@ -635,7 +635,7 @@ void Loop::TrainRound() {
             c_.loop.adam_steps, " Adam steps, mean InfoNCE ", st_.last_loss);
 }
 
-GfcsLoopStats Loop::Run(bool resume, const std::atomic<bool>* interrupt) {
+LoopStats Loop::Run(bool resume, const std::atomic<bool>* interrupt) {
   torch::set_num_threads(c_.loop.threads);
   Resume(resume);
   if (resume && st_.block_start + st_.rounds > 0)
@@ -688,7 +688,7 @@ GfcsLoopStats Loop::Run(bool resume, const std::atomic<bool>* interrupt) {
 
 }  // namespace
 
-std::string GfcsLoopStats::ToJson() const {
+std::string LoopStats::ToJson() const {
   std::ostringstream os;
   os << "{\"solves\": " << solves << ", \"solved\": " << solved
      << ", \"success_rate\": " << (solves ? static_cast<double>(solved) / solves : 0.0)
@@ -704,9 +704,9 @@ std::string LoopCheckpointPath(const std::string& run_dir, int rank) {
   return run_dir + "/checkpoints/loop" + (rank ? ".rank" + std::to_string(rank) : "") + ".pt";
 }
 
-manipulation::EnergyModelParts MakeEnergyParts(const GfcsTrainConfig& c,
+manipulation::EnergyModelParts MakeEnergyParts(const ExperimentConfig& c,
                                                const manipulation::RobotModel& robot,
-                                               const GfcsEncoding& encoding, const Mlp& energy) {
+                                               const Encoding& encoding, const Mlp& energy) {
   manipulation::EnergyModelParts p;
   p.lattice = c.lattice;
   p.bps_mean = encoding.bps_mean;
@@ -720,23 +720,22 @@ manipulation::EnergyModelParts MakeEnergyParts(const GfcsTrainConfig& c,
   return p;
 }
 
-GfcsLoopStats RunSelfSupervisedLoop(const GfcsTrainConfig& c, const std::string& config_yaml,
-                                    const manipulation::RobotModel& robot,
-                                    const GfcsEncoding& encoding,
-                                    const std::vector<GfcsTrainingProblem>& problems,
-                                    const std::string& run_dir, bool resume,
-                                    const std::atomic<bool>* interrupt, Mlp* energy) {
+LoopStats RunSelfSupervisedLoop(const ExperimentConfig& c, const std::string& config_yaml,
+                                const manipulation::RobotModel& robot, const Encoding& encoding,
+                                const std::vector<TrainingProblem>& problems,
+                                const std::string& run_dir, bool resume,
+                                const std::atomic<bool>* interrupt, Mlp* energy) {
   FS_THROW_UNLESS(!problems.empty(), run_dir, ": no valid training problems");
   fs::create_directories(run_dir + "/checkpoints");
   torch::manual_seed(static_cast<std::uint64_t>(c.seed));
   Loop loop(c, config_yaml, robot, encoding, problems, run_dir);
-  const GfcsLoopStats stats = loop.Run(resume, interrupt);
+  const LoopStats stats = loop.Run(resume, interrupt);
   *energy = loop.Energy();
   return stats;
 }
 
-void LoadLoopResult(const GfcsTrainConfig& c, const std::string& config_yaml,
-                    const std::string& run_dir, GfcsEncoding* encoding, Mlp* energy) {
+void LoadLoopResult(const ExperimentConfig& c, const std::string& config_yaml,
+                    const std::string& run_dir, Encoding* encoding, Mlp* energy) {
   const std::string path = LoopCheckpointPath(run_dir, 0);
   FS_THROW_UNLESS(fs::exists(path), run_dir,
                   ": no loop checkpoint (the run has not started its loop; continue it with train "
@@ -761,4 +760,4 @@ void LoadLoopResult(const GfcsTrainConfig& c, const std::string& config_yaml,
   *energy = net->net()->ToMlp();
 }
 
-}  // namespace foresight
+}  // namespace foresight::gfcs

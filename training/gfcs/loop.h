@@ -29,30 +29,30 @@
 #include "models/gfcs/gfcs_nets.h"
 #include "training/gfcs/config.h"
 
-namespace foresight {
+namespace foresight::gfcs {
 
 /// A training problem with its context (encoded once, after the autoencoder).
-struct GfcsTrainingProblem {
+struct TrainingProblem {
   std::string family;
   manipulation::ManipulationProblem problem;
   Eigen::VectorXf context;
 };
 
 /// The problem encoding fixed before the loop: BPS normalisation and the trained encoder.
-struct GfcsEncoding {
+struct Encoding {
   Eigen::VectorXf bps_mean, bps_std;
   Mlp encoder;
 };
 
 /// One positive: a command sequence (normalised to [-1, 1]) that solved `problem`.
-struct GfcsPositive {
+struct Positive {
   int problem = 0;  ///< index into the training problems
   int solve = 0;    ///< the solve that produced it
   float cost = 0;   ///< GFCOP cost (s)
   Eigen::VectorXf u;
 };
 
-struct GfcsLoopStats {
+struct LoopStats {
   int solves = 0, solved = 0, rounds = 0;
   double last_loss = 0;
   double solve_seconds = 0, negative_seconds = 0, train_seconds = 0;  ///< this invocation
@@ -63,24 +63,23 @@ struct GfcsLoopStats {
 };
 
 /// Energy model parts of a network state (for the engine: sampler, negatives, export).
-manipulation::EnergyModelParts MakeEnergyParts(const GfcsTrainConfig& c,
+manipulation::EnergyModelParts MakeEnergyParts(const ExperimentConfig& c,
                                                const manipulation::RobotModel& robot,
-                                               const GfcsEncoding& encoding, const Mlp& energy);
+                                               const Encoding& encoding, const Mlp& energy);
 
 /// Runs (or resumes: `resume` and a checkpoint exist) the loop in `run_dir` over `problems`
 /// (contexts filled). @return the final network as engine weights in `*energy`.
-GfcsLoopStats RunSelfSupervisedLoop(const GfcsTrainConfig& c, const std::string& config_yaml,
-                                    const manipulation::RobotModel& robot,
-                                    const GfcsEncoding& encoding,
-                                    const std::vector<GfcsTrainingProblem>& problems,
-                                    const std::string& run_dir, bool resume,
-                                    const std::atomic<bool>* interrupt, Mlp* energy);
+LoopStats RunSelfSupervisedLoop(const ExperimentConfig& c, const std::string& config_yaml,
+                                const manipulation::RobotModel& robot, const Encoding& encoding,
+                                const std::vector<TrainingProblem>& problems,
+                                const std::string& run_dir, bool resume,
+                                const std::atomic<bool>* interrupt, Mlp* energy);
 
 /// The final energy network and the encoding of a loop checkpoint (for export).
-void LoadLoopResult(const GfcsTrainConfig& c, const std::string& config_yaml,
-                    const std::string& run_dir, GfcsEncoding* encoding, Mlp* energy);
+void LoadLoopResult(const ExperimentConfig& c, const std::string& config_yaml,
+                    const std::string& run_dir, Encoding* encoding, Mlp* energy);
 
 /// The loop checkpoint of `rank` in `run_dir`.
 std::string LoopCheckpointPath(const std::string& run_dir, int rank);
 
-}  // namespace foresight
+}  // namespace foresight::gfcs

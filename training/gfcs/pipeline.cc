@@ -23,7 +23,7 @@
 #include "training/run_dir.h"
 #include "training/trainer.h"
 
-namespace foresight {
+namespace foresight::gfcs {
 namespace fs = std::filesystem;
 using namespace manipulation;  // NOLINT: this file is the gfcs pipeline
 
@@ -33,7 +33,7 @@ namespace {
 const RunDirectoryRules kGfcsRunRules{{"checkpoints", "autoencoder", "model.h5"}, true};
 
 /// The harness config that loads the robot and one problem set.
-ManipulationExperimentConfig HarnessConfig(const GfcsTrainConfig& c,
+ManipulationExperimentConfig HarnessConfig(const ExperimentConfig& c,
                                            const ManipulationProblemsConfig& set) {
   ManipulationExperimentConfig mc;
   mc.seed = c.seed;
@@ -50,9 +50,9 @@ std::string SetName(const ManipulationProblemsConfig& set) {
 }
 
 /// The training problems whose start and goal are valid for the robot model (others skipped).
-std::vector<GfcsTrainingProblem> LoadTrainingProblems(const GfcsTrainConfig& c,
-                                                      const RobotModel& robot) {
-  std::vector<GfcsTrainingProblem> out;
+std::vector<TrainingProblem> LoadTrainingProblems(const ExperimentConfig& c,
+                                                  const RobotModel& robot) {
+  std::vector<TrainingProblem> out;
   for (const ManipulationProblemsConfig& set : c.train_problems) {
     int skipped = 0;
     for (ManipulationProblem& p : LoadExperimentProblems(HarnessConfig(c, set), robot)) {
@@ -104,16 +104,14 @@ torch::Tensor RowsToTensor(const std::vector<Eigen::VectorXf>& rows) {
 
 /// BPS distances of the training worlds, their normalisation, and the autoencoder (trained by the
 /// trainer in run_dir/autoencoder, resumable). `*interrupted` when the trainer was stopped.
-GfcsEncoding TrainEncoding(const GfcsTrainConfig& c, const RobotModel& robot,
-                           const std::vector<GfcsTrainingProblem>& problems,
-                           const std::string& run_dir, bool resume,
-                           const std::atomic<bool>* interrupt, bool* interrupted) {
+Encoding TrainEncoding(const ExperimentConfig& c, const RobotModel& robot,
+                       const std::vector<TrainingProblem>& problems, const std::string& run_dir,
+                       bool resume, const std::atomic<bool>* interrupt, bool* interrupted) {
   CheckLatticeCovers(c.lattice, ReachBox(robot), "lattice");
   std::vector<Eigen::VectorXf> bps;
-  for (const GfcsTrainingProblem& p : problems)
-    bps.push_back(EncodeBps(p.problem.world, c.lattice));
+  for (const TrainingProblem& p : problems) bps.push_back(EncodeBps(p.problem.world, c.lattice));
   const Eigen::Index n_r = bps.front().size();
-  GfcsEncoding enc;
+  Encoding enc;
   enc.bps_mean = Eigen::VectorXf::Zero(n_r);
   for (const auto& b : bps) enc.bps_mean += b;
   enc.bps_mean /= static_cast<float>(bps.size());
@@ -164,8 +162,8 @@ GfcsEncoding TrainEncoding(const GfcsTrainConfig& c, const RobotModel& robot,
 }
 
 /// Fills the problems' contexts [q0, qd0, qg, encoding] with the engine's own encoder.
-void EncodeProblems(const GfcsTrainConfig& c, const RobotModel& robot, const GfcsEncoding& enc,
-                    std::vector<GfcsTrainingProblem>* problems) {
+void EncodeProblems(const ExperimentConfig& c, const RobotModel& robot, const Encoding& enc,
+                    std::vector<TrainingProblem>* problems) {
   const int context = 3 * kDof + enc.encoder.output_size();
   const int command = kDof * (c.gfcs.commands - 1);
   // Energy weights do not enter the context: a placeholder layer of the right width.
@@ -173,7 +171,7 @@ void EncodeProblems(const GfcsTrainConfig& c, const RobotModel& robot, const Gfc
   placeholder.weight = Eigen::MatrixXf::Zero(1, context + command);
   placeholder.bias = Eigen::VectorXf::Zero(1);
   const EnergyModel model(MakeEnergyParts(c, robot, enc, Mlp({placeholder})));
-  for (GfcsTrainingProblem& p : *problems) {
+  for (TrainingProblem& p : *problems) {
     GfcsQuery q;
     q.start = p.problem.start;
     q.goal = p.problem.goal;
@@ -181,13 +179,13 @@ void EncodeProblems(const GfcsTrainConfig& c, const RobotModel& robot, const Gfc
   }
 }
 
-void WriteArtifact(const GfcsTrainConfig& c, const RobotModel& robot, const GfcsEncoding& enc,
+void WriteArtifact(const ExperimentConfig& c, const RobotModel& robot, const Encoding& enc,
                    const Mlp& energy, const std::string& yaml, const std::string& path) {
   EnergyModel(MakeEnergyParts(c, robot, enc, energy)).Save(path, yaml, c.seed);
   (void)EnergyModel::Load(path);  // the engine loads what was written
 }
 
-RobotModel LoadRobot(const GfcsTrainConfig& c) {
+RobotModel LoadRobot(const ExperimentConfig& c) {
   FS_THROW_UNLESS(!c.train_problems.empty(), "gfcs: train_problems is empty");
   return LoadExperimentRobot(HarnessConfig(c, c.train_problems.front()));
 }
@@ -243,9 +241,9 @@ std::string BudgetLabel(int batches) {
 
 }  // namespace
 
-ManipulationExperimentConfig GfcsEvalPlanConfig(const GfcsTrainConfig& c,
-                                                const ManipulationProblemsConfig& problems,
-                                                const std::string& energy_model) {
+ManipulationExperimentConfig EvalPlanConfig(const ExperimentConfig& c,
+                                            const ManipulationProblemsConfig& problems,
+                                            const std::string& energy_model) {
   ManipulationExperimentConfig mc = HarnessConfig(c, problems);
   mc.gfcs.batch_size = c.eval.batch_size;
   mc.methods.clear();
@@ -264,8 +262,8 @@ ManipulationExperimentConfig GfcsEvalPlanConfig(const GfcsTrainConfig& c,
   return mc;
 }
 
-bool TrainGfcsRun(const GfcsTrainConfig& c, const std::string& run_dir, bool resume,
-                  const std::atomic<bool>* interrupt, bool check_eval_sets) {
+bool TrainRun(const ExperimentConfig& c, const std::string& run_dir, bool resume,
+              const std::atomic<bool>* interrupt, bool check_eval_sets) {
   const std::string yaml = config::ToYaml(c);
   const auto group = dist::DefaultGroup();
   if (group->rank() == 0) {
@@ -282,19 +280,18 @@ bool TrainGfcsRun(const GfcsTrainConfig& c, const std::string& run_dir, bool res
   if (check_eval_sets)
     for (const ManipulationProblemsConfig& set : c.eval.problems)
       (void)LoadExperimentProblems(HarnessConfig(c, set), robot);
-  std::vector<GfcsTrainingProblem> problems = LoadTrainingProblems(c, robot);
+  std::vector<TrainingProblem> problems = LoadTrainingProblems(c, robot);
   FS_THROW_UNLESS(!problems.empty(), run_dir, ": no training problem has a valid start and goal");
   if (c.loop.shuffle) {
     std::mt19937_64 rng(static_cast<std::uint64_t>(c.seed) + 11);
     std::shuffle(problems.begin(), problems.end(), rng);
   }
   bool interrupted = false;
-  const GfcsEncoding enc =
-      TrainEncoding(c, robot, problems, run_dir, resume, interrupt, &interrupted);
+  const Encoding enc = TrainEncoding(c, robot, problems, run_dir, resume, interrupt, &interrupted);
   if (interrupted) return false;
   EncodeProblems(c, robot, enc, &problems);
   Mlp energy;
-  const GfcsLoopStats stats =
+  const LoopStats stats =
       RunSelfSupervisedLoop(c, yaml, robot, enc, problems, run_dir, resume, interrupt, &energy);
   if (group->rank() == 0)
     WriteFileAtomically(run_dir + "/loop_summary.json", stats.ToJson() + "\n");
@@ -306,10 +303,10 @@ bool TrainGfcsRun(const GfcsTrainConfig& c, const std::string& run_dir, bool res
   return true;
 }
 
-std::string ExportGfcsRun(const std::string& run_dir) {
-  const auto c = config::LoadExperimentConfig<GfcsTrainConfig>(run_dir + "/config.yaml");
+std::string ExportRun(const std::string& run_dir) {
+  const auto c = config::LoadExperimentConfig<ExperimentConfig>(run_dir + "/config.yaml");
   const std::string yaml = config::ToYaml(c);
-  GfcsEncoding enc;
+  Encoding enc;
   Mlp energy;
   LoadLoopResult(c, yaml, run_dir, &enc, &energy);
   const std::string path = run_dir + "/" + kGfcsArtifact;
@@ -317,7 +314,7 @@ std::string ExportGfcsRun(const std::string& run_dir) {
   return path;
 }
 
-std::string EvaluateGfcsRun(const GfcsTrainConfig& c, const std::string& run_dir) {
+std::string EvaluateRun(const ExperimentConfig& c, const std::string& run_dir) {
   const std::string artifact = run_dir + "/" + kGfcsArtifact;
   FS_THROW_UNLESS(fs::exists(artifact), run_dir, ": no ", kGfcsArtifact,
                   " (the run is not finished; continue it with train --resume)");
@@ -329,7 +326,7 @@ std::string EvaluateGfcsRun(const GfcsTrainConfig& c, const std::string& run_dir
     const std::string dir = run_dir + "/eval/" + std::to_string(i) + "_" + SetName(set);
     fs::create_directories(dir);
     log::Info("evaluating on ", SetName(set), " problems ", set.first, "-", set.last, " -> ", dir);
-    const PlanReport report = RunPlanExperiment(GfcsEvalPlanConfig(c, set, artifact), dir);
+    const PlanReport report = RunPlanExperiment(EvalPlanConfig(c, set, artifact), dir);
     os << "    {\"set\": " << JsonString(SetName(set)) << ", \"first\": " << set.first
        << ", \"last\": " << set.last << ", \"problems\": " << report.problems
        << ", \"invalid_problems\": " << report.invalid_problems.size()
@@ -386,4 +383,4 @@ std::string EvaluateGfcsRun(const GfcsTrainConfig& c, const std::string& run_dir
   return os.str();
 }
 
-}  // namespace foresight
+}  // namespace foresight::gfcs

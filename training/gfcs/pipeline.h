@@ -10,7 +10,7 @@
 
 #include "training/gfcs/config.h"
 
-namespace foresight {
+namespace foresight::gfcs {
 
 /// Files of a gfcs run directory (a resumable kind).
 inline constexpr const char* kGfcsArtifact = "model.h5";
@@ -19,15 +19,15 @@ inline constexpr const char* kGfcsArtifact = "model.h5";
 /// when interrupted (the checkpoints stay valid).
 /// With `check_eval_sets` the held-out sets are loaded first, so a missing file fails before the
 /// loop rather than after it (off for runs that will not be evaluated).
-bool TrainGfcsRun(const GfcsTrainConfig& c, const std::string& run_dir, bool resume,
-                  const std::atomic<bool>* interrupt, bool check_eval_sets = true);
+bool TrainRun(const ExperimentConfig& c, const std::string& run_dir, bool resume,
+              const std::atomic<bool>* interrupt, bool check_eval_sets = true);
 
 /// Writes run_dir/model.h5 from the loop's last checkpoint. @return its path.
-std::string ExportGfcsRun(const std::string& run_dir);
+std::string ExportRun(const std::string& run_dir);
 
 /// Held-out evaluation of run_dir/model.h5: run_dir/eval/<set>/ (the plan harness's files) and
 /// run_dir/eval.json (per family and method: success, lengths, LDJ, times; the learned-minus-
 /// uniform paired cost difference with its 95 % bootstrap interval). @return eval.json's text.
-std::string EvaluateGfcsRun(const GfcsTrainConfig& c, const std::string& run_dir);
+std::string EvaluateRun(const ExperimentConfig& c, const std::string& run_dir);
 
-}  // namespace foresight
+}  // namespace foresight::gfcs

@@ -23,11 +23,10 @@
 #include "models/otnet/otnet_net.h"
 #include "training/kinds.h"
 
-namespace foresight {
+namespace foresight::otnet {
 
 namespace {
 
-using namespace otnet;  // NOLINT: a benchmark of the OTNet engine
 using bench::Clock;
 using bench::Median;
 
@@ -236,6 +235,6 @@ void RunOtnetBench(const BenchRequest& req, const OtnetBenchOptions& a) {
 
 }  // namespace
 
-void SetOtnetBench(ExperimentKind* kind) { SetBench<OtnetBenchOptions>(kind, RunOtnetBench); }
+void SetBenchStep(ExperimentKind* kind) { SetBench<OtnetBenchOptions>(kind, RunOtnetBench); }
 
-}  // namespace foresight
+}  // namespace foresight::otnet

@@ -3,9 +3,9 @@
 #include "core/error.h"
 #include "core/layer_widths.h"
 
-namespace foresight {
+namespace foresight::otnet {
 
-void OtnetConfig::Validate(const std::string& source) const {
+void ExperimentConfig::Validate(const std::string& source) const {
   FS_THROW_UNLESS(model == "otnet", source, ": model: '", model, "', expected 'otnet'");
   FS_THROW_UNLESS(data.val_fraction > 0 && data.test_fraction > 0, source,
                   ": data.val_fraction and data.test_fraction must be > 0 (maps are chosen on "
@@ -31,4 +31,4 @@ void OtnetConfig::Validate(const std::string& source) const {
   }
 }
 
-}  // namespace foresight
+}  // namespace foresight::otnet

@@ -12,14 +12,14 @@
 #include "core/config.h"
 #include "training/train_config.h"
 
-namespace foresight {
+namespace foresight::otnet {
 
-enum class OtnetSource { kOccTraj, kSynthetic };
-enum class OtnetFamily { kNormal, kLaplace };
+enum class Source { kOccTraj, kSynthetic };
+enum class Family { kNormal, kLaplace };
 enum class BadWaypoints { kDrop, kError };
 
-struct OtnetDataConfig {
-  OtnetSource source = OtnetSource::kSynthetic;
+struct DataConfig {
+  Source source = Source::kSynthetic;
   std::string root;   ///< occ_traj: <root>/occ_traj120; empty: $FORESIGHT_DATA, ../shared/data
   int map_size = 40;  ///< maps are map_size x map_size cells
   int max_maps = 0;   ///< occ_traj: use the first n ids (sorted) before splitting; 0: all
@@ -36,8 +36,8 @@ struct OtnetDataConfig {
   void Serialize(A* a) {
     using config::Range;
     a->VisitEnum("source", &source,
-                 config::EnumNames<OtnetSource>{{OtnetSource::kOccTraj, "occ_traj"},
-                                                {OtnetSource::kSynthetic, "synthetic"}},
+                 config::EnumNames<Source>{{Source::kOccTraj, "occ_traj"},
+                                           {Source::kSynthetic, "synthetic"}},
                  "occ_traj (../shared/data/occ_traj120) or synthetic rooms and corridors");
     a->Visit("root", &root, Range::Any(), "data root; empty: $FORESIGHT_DATA, else ../shared/data");
     a->Visit("map_size", &map_size, Range::Closed(8, 4096), "maps are map_size x map_size cells");
@@ -61,7 +61,7 @@ struct OtnetDataConfig {
   }
 };
 
-struct OtnetModelConfig {
+struct ModelConfig {
   // Map encoding: S_H = exp(-delta_H^2 / (2 l_H)); thesis: l_H = 50 and all training maps.
   double length_scale = 50;  ///< l_H (squared cells)
   /// Representative maps: 0 = every training map (thesis); n > 0 = n training maps chosen by
@@ -78,7 +78,7 @@ struct OtnetModelConfig {
   int components = 4;
   std::vector<int> hidden{256, 256};
   double dropout = 0.0;
-  OtnetFamily family = OtnetFamily::kNormal;
+  Family family = Family::kNormal;
 
   template <class A>
   void Serialize(A* a) {
@@ -92,14 +92,14 @@ struct OtnetModelConfig {
     a->Visit("components", &components, Range::Closed(1, 64), "Q, mixture components");
     a->Visit("hidden", &hidden, Range::Any(), "hidden layer widths of the MLP");
     a->Visit("dropout", &dropout, Range::Closed(0, 0.95), "dropout after each hidden layer");
-    a->VisitEnum("family", &family,
-                 config::EnumNames<OtnetFamily>{{OtnetFamily::kNormal, "normal"},
-                                                {OtnetFamily::kLaplace, "laplace"}},
-                 "mean-field component family");
+    a->VisitEnum(
+        "family", &family,
+        config::EnumNames<Family>{{Family::kNormal, "normal"}, {Family::kLaplace, "laplace"}},
+        "mean-field component family");
   }
 };
 
-struct OtnetEvalConfig {
+struct EvalConfig {
   int generated = 100;           ///< trajectories generated per test map
   int points = 100;              ///< resampling of every trajectory (thesis: 100)
   int max_attempts = 5000;       ///< samples drawn at most per map (collision rejection)
@@ -128,7 +128,7 @@ struct OtnetEvalConfig {
 
 /// Generate on sections of a real occupancy map (thesis Fig. TransferEx): each section is
 /// rasterised to map_size x map_size cells (p(occupied) >= threshold is occupied).
-struct OtnetTransferConfig {
+struct TransferConfig {
   std::string occupancy_artifact;  ///< an occupancy-map artifact (model.h5); empty: no transfer
   std::vector<double> sections;    ///< x_min, y_min, side (m) per section, flat
   std::vector<double> starts;      ///< start points (cells of the section), x, y pairs, flat
@@ -152,11 +152,11 @@ struct OtnetTransferConfig {
   }
 };
 
-struct OtnetConfig {
+struct ExperimentConfig {
   std::string model = "otnet";
   std::int64_t seed = 0;
-  OtnetDataConfig data;
-  OtnetModelConfig otnet;
+  DataConfig data;
+  ModelConfig otnet;
   TrainConfig train = [] {
     TrainConfig t;
     t.epochs = 100;
@@ -166,8 +166,8 @@ struct OtnetConfig {
     t.progress = ProgressStyle::kNone;
     return t;
   }();
-  OtnetEvalConfig eval;
-  OtnetTransferConfig transfer;
+  EvalConfig eval;
+  TransferConfig transfer;
 
   template <class A>
   void Serialize(A* a) {
@@ -183,4 +183,4 @@ struct OtnetConfig {
   void Validate(const std::string& source) const;
 };
 
-}  // namespace foresight
+}  // namespace foresight::otnet

@@ -38,11 +38,11 @@ void LogSplit(const char* name, const OtnetSplit& s) {
 
 }  // namespace
 
-OtnetData LoadOtnetData(const OtnetConfig& c) {
+OtnetData LoadOtnetData(const ExperimentConfig& c) {
   const double val = c.data.val_fraction, test = c.data.test_fraction;
   const auto seed = static_cast<std::uint64_t>(c.seed);
   OtnetData d;
-  if (c.data.source == OtnetSource::kSynthetic) {
+  if (c.data.source == Source::kSynthetic) {
     SyntheticRoomsOptions o;
     o.size = c.data.map_size;
     o.maps = c.data.synthetic_maps;
@@ -103,7 +103,7 @@ OtnetData LoadOtnetData(const OtnetConfig& c) {
   return d;
 }
 
-TrajectoryBasis MakeBasis(const OtnetConfig& c) {
+TrajectoryBasis MakeBasis(const ExperimentConfig& c) {
   return TrajectoryBasis(c.otnet.basis, c.otnet.basis_gamma, c.otnet.ridge);
 }
 
@@ -149,7 +149,7 @@ std::vector<int> ChooseDatabase(const std::vector<MapTrajectories>& maps, int da
   return chosen;
 }
 
-MapEncoder MakeEncoder(const OtnetConfig& c, const std::vector<MapTrajectories>& train) {
+MapEncoder MakeEncoder(const ExperimentConfig& c, const std::vector<MapTrajectories>& train) {
   std::vector<BinaryGrid> database;
   for (int i : ChooseDatabase(train, c.otnet.database_size)) database.push_back(train[i].map);
   return MapEncoder(std::move(database), c.otnet.length_scale);

@@ -33,14 +33,14 @@ struct OtnetData {
 /// Reads Occ-Traj120 (or generates the synthetic maps) and splits by map (SplitMaps with the
 /// config's seed; synthetic maps by layout family). Logs the split sizes and every dropped
 /// trajectory count. Error when a split has no trajectories.
-OtnetData LoadOtnetData(const OtnetConfig& c);
+OtnetData LoadOtnetData(const ExperimentConfig& c);
 
-TrajectoryBasis MakeBasis(const OtnetConfig& c);
+TrajectoryBasis MakeBasis(const ExperimentConfig& c);
 
 /// Indices into `maps` of the representative database: all (database_size 0 or >= maps), else a
 /// greedy farthest-point (k-centre) subset under delta_H, starting from map 0.
 std::vector<int> ChooseDatabase(const std::vector<MapTrajectories>& maps, int database_size);
-MapEncoder MakeEncoder(const OtnetConfig& c, const std::vector<MapTrajectories>& train);
+MapEncoder MakeEncoder(const ExperimentConfig& c, const std::vector<MapTrajectories>& train);
 
 /// A split as the network sees it: phi per map, and per trajectory its map's row and its weights.
 struct EncodedSplit {

@@ -156,7 +156,7 @@ double MinimumDistance(const Eigen::MatrixX2d& generated,
   return best;
 }
 
-Scores ScoreSplit(const OtnetConfig& c, const OtnetModel& model, const OtnetSplit& train,
+Scores ScoreSplit(const ExperimentConfig& c, const OtnetModel& model, const OtnetSplit& train,
                   const OtnetSplit& split, const std::string& prefix, const std::string& plot_png) {
   const int points = c.eval.points;
   const Eigen::VectorXd taus = UniformTaus(points);
@@ -309,8 +309,8 @@ Scores ScoreSplit(const OtnetConfig& c, const OtnetModel& model, const OtnetSpli
   return out;
 }
 
-std::string EvaluateOtnet(const OtnetConfig& c, const OtnetData& d, const std::string& artifact,
-                          const std::string& plot_dir) {
+std::string EvaluateOtnet(const ExperimentConfig& c, const OtnetData& d,
+                          const std::string& artifact, const std::string& plot_dir) {
   const OtnetModel model = OtnetModel::Load(artifact);
   FS_THROW_UNLESS(model.basis().size() == c.otnet.basis, artifact, ": basis ", model.basis().size(),
                   " differs from the config's otnet.basis ", c.otnet.basis);

@@ -36,11 +36,11 @@ Eigen::Vector2d NearestFreeCentre(const BinaryGrid& g, const Eigen::Vector2d& p)
 
 /// Scores of OTNet and the baselines on `split` (keys prefixed with `prefix`). `train` gives the
 /// k-NN database and the mean trajectory. When plot_png is not empty, draws the first maps.
-Scores ScoreSplit(const OtnetConfig& c, const OtnetModel& model, const OtnetSplit& train,
+Scores ScoreSplit(const ExperimentConfig& c, const OtnetModel& model, const OtnetSplit& train,
                   const OtnetSplit& split, const std::string& prefix, const std::string& plot_png);
 
 /// Scores the validation and the test maps; transfer (when configured); returns eval.json's text.
-std::string EvaluateOtnet(const OtnetConfig& c, const OtnetData& d, const std::string& artifact,
-                          const std::string& plot_dir);
+std::string EvaluateOtnet(const ExperimentConfig& c, const OtnetData& d,
+                          const std::string& artifact, const std::string& plot_dir);
 
 }  // namespace foresight::otnet

@@ -17,7 +17,7 @@ namespace {
 const RunDirectoryRules kOtnetRunRules{{"checkpoints", "model.h5", "eval.json"}, true};
 }  // namespace
 
-bool TrainOtnetRun(const OtnetConfig& c, const std::string& run_dir, bool resume,
+bool TrainOtnetRun(const ExperimentConfig& c, const std::string& run_dir, bool resume,
                    const std::atomic<bool>* interrupt) {
   StartRunDirectory(run_dir, config::ToYaml(c), resume, kOtnetRunRules);
   log::Info(resume ? "resuming" : "starting", " OTNet in ", run_dir, ", seed ", c.seed);
@@ -28,11 +28,11 @@ bool TrainOtnetRun(const OtnetConfig& c, const std::string& run_dir, bool resume
 }
 
 std::string ExportOtnetRun(const std::string& run_dir) {
-  const auto c = LoadRunConfig<OtnetConfig>(run_dir, {});
+  const auto c = LoadRunConfig<ExperimentConfig>(run_dir, {});
   return ExportOtnet(c, PrepareOtnet(c), run_dir);
 }
 
-std::string EvaluateOtnetRun(const OtnetConfig& c, const std::string& run_dir) {
+std::string EvaluateOtnetRun(const ExperimentConfig& c, const std::string& run_dir) {
   const std::string artifact = run_dir + "/model.h5";
   FS_THROW_UNLESS(fs::exists(artifact), run_dir, ": model.h5 is missing; train (or export) first");
   const OtnetData d = LoadOtnetData(c);

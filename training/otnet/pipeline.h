@@ -13,11 +13,11 @@
 namespace foresight::otnet {
 
 /// Trains and exports. @return false when interrupted (resume continues).
-bool TrainOtnetRun(const OtnetConfig& c, const std::string& run_dir, bool resume,
+bool TrainOtnetRun(const ExperimentConfig& c, const std::string& run_dir, bool resume,
                    const std::atomic<bool>* interrupt);
 /// Writes run_dir/model.h5 from the best checkpoint. @return its path.
 std::string ExportOtnetRun(const std::string& run_dir);
 /// Evaluates run_dir/model.h5; writes run_dir/eval.json (and plots). @return its text.
-std::string EvaluateOtnetRun(const OtnetConfig& c, const std::string& run_dir);
+std::string EvaluateOtnetRun(const ExperimentConfig& c, const std::string& run_dir);
 
 }  // namespace foresight::otnet

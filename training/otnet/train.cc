@@ -13,11 +13,11 @@ namespace fs = std::filesystem;
 
 namespace {
 
-MixtureFamily Family(const OtnetConfig& c) {
-  return c.otnet.family == OtnetFamily::kLaplace ? MixtureFamily::kLaplace : MixtureFamily::kNormal;
+MixtureFamily MixtureFamilyOf(const ExperimentConfig& c) {
+  return c.otnet.family == Family::kLaplace ? MixtureFamily::kLaplace : MixtureFamily::kNormal;
 }
 
-OtnetNet MakeNet(const OtnetConfig& c, const OtnetPrepared& p) {
+OtnetNet MakeNet(const ExperimentConfig& c, const OtnetPrepared& p) {
   torch::manual_seed(static_cast<std::uint64_t>(c.seed));
   OtnetNetOptions o;
   o.inputs = p.encoder.size();
@@ -25,7 +25,7 @@ OtnetNet MakeNet(const OtnetConfig& c, const OtnetPrepared& p) {
   o.components = c.otnet.components;
   o.weights = p.basis.weights();
   o.dropout = c.otnet.dropout;
-  o.family = Family(c);
+  o.family = MixtureFamilyOf(c);
   return OtnetNet(o);
 }
 
@@ -54,7 +54,7 @@ torch::Tensor Indices(const std::vector<std::int64_t>& v) {
 
 }  // namespace
 
-OtnetPrepared PrepareOtnet(const OtnetConfig& c) {
+OtnetPrepared PrepareOtnet(const ExperimentConfig& c) {
   OtnetPrepared p;
   p.data = LoadOtnetData(c);
   p.basis = MakeBasis(c);
@@ -68,7 +68,7 @@ OtnetPrepared PrepareOtnet(const OtnetConfig& c) {
   return p;
 }
 
-bool TrainOtnet(const OtnetConfig& c, const OtnetPrepared& p, const std::string& run_dir,
+bool TrainOtnet(const ExperimentConfig& c, const OtnetPrepared& p, const std::string& run_dir,
                 bool resume, const std::atomic<bool>* interrupt) {
   const OtnetNormalisation n = Normalisation(p);
   OtnetNet net = MakeNet(c, p);
@@ -87,14 +87,16 @@ bool TrainOtnet(const OtnetConfig& c, const OtnetPrepared& p, const std::string&
   return summary.reason != TerminationReason::kInterrupted;
 }
 
-std::string ExportOtnet(const OtnetConfig& c, const OtnetPrepared& p, const std::string& run_dir) {
+std::string ExportOtnet(const ExperimentConfig& c, const OtnetPrepared& p,
+                        const std::string& run_dir) {
   const std::string best = RunPaths{run_dir}.BestCheckpoint();
   FS_THROW_UNLESS(fs::exists(best), run_dir, ": ", best, " is missing; train the run first");
   OtnetNet net = MakeNet(c, p);
   LoadCheckpointModel(best, net.get());
   net->eval();
   const OtnetNormalisation norm = Normalisation(p);
-  OtnetModel model(p.encoder, p.basis, ExportMlp(net, norm), Family(c), c.otnet.components);
+  OtnetModel model(p.encoder, p.basis, ExportMlp(net, norm), MixtureFamilyOf(c),
+                   c.otnet.components);
   // The engine clamps log-scales where training did (in standardised units).
   model.SetLogScaleOffset(norm.weight_std.array().log().matrix());
   const std::string path = run_dir + "/model.h5";

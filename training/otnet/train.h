@@ -16,12 +16,13 @@ struct OtnetPrepared {
   MapEncoder encoder;
   EncodedSplit train, val;
 };
-OtnetPrepared PrepareOtnet(const OtnetConfig& c);
+OtnetPrepared PrepareOtnet(const ExperimentConfig& c);
 
 /// Trains in run_dir (checkpoints/, metrics.csv). @return false when interrupted.
-bool TrainOtnet(const OtnetConfig& c, const OtnetPrepared& p, const std::string& run_dir,
+bool TrainOtnet(const ExperimentConfig& c, const OtnetPrepared& p, const std::string& run_dir,
                 bool resume, const std::atomic<bool>* interrupt);
 /// Writes run_dir/model.h5 from the best checkpoint. @return its path.
-std::string ExportOtnet(const OtnetConfig& c, const OtnetPrepared& p, const std::string& run_dir);
+std::string ExportOtnet(const ExperimentConfig& c, const OtnetPrepared& p,
+                        const std::string& run_dir);
 
 }  // namespace foresight::otnet

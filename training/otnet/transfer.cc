@@ -63,9 +63,9 @@ BinaryGrid RasteriseSection(const foresight::occupancy::Map& map, double x_min, 
   return g;
 }
 
-Scores TransferToOccupancyMap(const OtnetConfig& c, const OtnetModel& model,
+Scores TransferToOccupancyMap(const ExperimentConfig& c, const OtnetModel& model,
                               const OtnetSplit& train, const std::string& plot_png) {
-  const OtnetTransferConfig& t = c.transfer;
+  const TransferConfig& t = c.transfer;
   FS_THROW_UNLESS(!t.sections.empty() && t.sections.size() % 3 == 0,
                   "transfer.sections: ", t.sections.size(),
                   " numbers; expected x_min, y_min, side per section");

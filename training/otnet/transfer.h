@@ -26,7 +26,7 @@ std::vector<Eigen::Vector2d> BorderOpenings(const BinaryGrid& g, int count);
 
 /// Generates on every configured section and start; figures transfer_* (acceptance rate, sections
 /// without edges are an Error naming the section); draws plot_png when not empty.
-Scores TransferToOccupancyMap(const OtnetConfig& c, const OtnetModel& model,
+Scores TransferToOccupancyMap(const ExperimentConfig& c, const OtnetModel& model,
                               const OtnetSplit& train, const std::string& plot_png);
 
 }  // namespace foresight::otnet
