@@ -9,6 +9,15 @@
 #include "inference/engine/artifact.h"
 
 namespace foresight {
+namespace {
+
+/// The top-level `model:` of a config tree; without one, an Error: `source` then `missing`.
+std::string ModelTagOf(const YAML::Node& root, const std::string& source, const char* missing) {
+  FS_THROW_UNLESS(root.IsMap() && root["model"] && root["model"].IsScalar(), source, missing);
+  return root["model"].as<std::string>();
+}
+
+}  // namespace
 
 bool ExperimentKind::Matches(const std::string& model_tag) const {
   return tag_is_prefix ? model_tag.rfind(tag, 0) == 0 : model_tag == tag;
@@ -64,10 +73,10 @@ const ExperimentKind& ExperimentRegistry::ForRun(const std::string& run_dir) con
 const ExperimentKind& ExperimentRegistry::ForArtifact(const std::string& artifact) const {
   const Artifact a = Artifact::Open(artifact, "");
   const YAML::Node config = config::ParseYaml(a.config_yaml(), artifact + ":/config");
-  FS_THROW_UNLESS(
-      config.IsMap() && config["model"] && config["model"].IsScalar(), artifact,
-      ": the config stored in the artifact has no 'model:' (artifact of an older build?)");
-  return ForModel(config["model"].as<std::string>(), artifact + ":/config");
+  return ForModel(ModelTagOf(config, artifact,
+                             ": the config stored in the artifact has no 'model:' (artifact of an "
+                             "older build?)"),
+                  artifact + ":/config");
 }
 
 const ExperimentKind& ExperimentRegistry::ForBenchTarget(BenchRequest* request) const {
@@ -133,11 +142,9 @@ std::string BenchArtifact(const BenchRequest& req, const std::string& in_run) {
 }
 
 std::string ModelTagOfFile(const std::string& path) {
-  const YAML::Node root = config::LoadYamlFile(path);
-  FS_THROW_UNLESS(
-      root.IsMap() && root["model"] && root["model"].IsScalar(), path,
+  return ModelTagOf(
+      config::LoadYamlFile(path), path,
       ": key 'model' is missing: a config names its experiment kind in a top-level 'model:'");
-  return root["model"].as<std::string>();
 }
 
 }  // namespace foresight
