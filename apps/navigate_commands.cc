@@ -25,14 +25,14 @@ struct NavigateArgs {
   int episodes = 0;
 };
 
-void PrintTable(const std::vector<MethodSummary>& rows) {
+void PrintTable(const std::vector<nav::MethodSummary>& rows) {
   std::cout << std::left << std::setw(12) << "method" << std::right << std::setw(9) << "success"
             << std::setw(9) << "no-coll" << std::setw(9) << "TTG s" << std::setw(9) << "DOC s"
             << std::setw(10) << "min gap" << std::setw(11) << "cycle med" << std::setw(11)
             << "cycle p99" << std::setw(9) << "failed"
             << "\n";
   std::cout << std::fixed << std::setprecision(2);
-  for (const MethodSummary& m : rows)
+  for (const nav::MethodSummary& m : rows)
     std::cout << std::left << std::setw(12) << m.method << std::right << std::setw(9)
               << m.success_rate << std::setw(9) << m.collision_free_rate << std::setw(9)
               << m.ttg_mean << std::setw(9) << m.doc_mean << std::setw(10) << m.min_clearance
@@ -57,22 +57,22 @@ void AddNavigateCommand(CLI::App* app) {
       ->check(CLI::Range(1, 100000));
   nav->callback([args] {
     const bool embedded = args->config == "default";
-    const NavigationExperimentConfig c =
-        embedded ? config::ExperimentConfigFromYaml<NavigationExperimentConfig>(
-                       kEmbeddedNavigationConfig, "<embedded configs/navigation/sim1.yaml>",
-                       args->overrides)
-                 : config::LoadExperimentConfig<NavigationExperimentConfig>(args->config,
-                                                                            args->overrides);
+    const nav::ExperimentConfig c =
+        embedded
+            ? config::ExperimentConfigFromYaml<nav::ExperimentConfig>(
+                  kEmbeddedNavigationConfig, "<embedded configs/navigation/sim1.yaml>",
+                  args->overrides)
+            : config::LoadExperimentConfig<nav::ExperimentConfig>(args->config, args->overrides);
     const std::string out =
         !args->run_dir.empty()
             ? args->run_dir
             : "runs/navigate_" +
                   (embedded ? std::string("sim1") : fs::path(args->config).stem().string());
-    StartRunDirectory(out, config::ToYaml(c), false, kNavigationRunRules);
-    const bool needs_predictor = c.Uses(NavigationMethod::kSpan);
+    StartRunDirectory(out, config::ToYaml(c), false, nav::kRunRules);
+    const bool needs_predictor = c.Uses(nav::Method::kSpan);
     if (needs_predictor && !fs::exists(c.predictor.artifact)) {
 #ifdef FORESIGHT_WITH_TORCH
-      EnsureNavigationPredictor(c, kEmbeddedNavigationPredictorConfig);
+      nav::EnsurePredictor(c, kEmbeddedNavigationPredictorConfig);
       log::SetFile(out + "/log.txt");  // the predictor's training logged into its own run directory
 #else
       Fail("predictor.artifact: ", c.predictor.artifact,
@@ -83,7 +83,7 @@ void AddNavigateCommand(CLI::App* app) {
     const int episodes = args->episodes > 0 ? args->episodes : c.episodes;
     std::cout << "navigating " << c.scenario.name << ": " << episodes << " episodes x "
               << c.methods.size() << " methods -> " << out << "\n";
-    const std::vector<MethodSummary> rows = RunNavigation(c, out, episodes);
+    const std::vector<nav::MethodSummary> rows = nav::RunNavigation(c, out, episodes);
     PrintTable(rows);
     std::cout << "wrote " << out << "/summary.json, episodes.csv, paths.png"
               << (c.video.enabled ? ", episode.avi" : "") << "\n";

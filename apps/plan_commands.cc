@@ -29,12 +29,12 @@ std::string Format(const manipulation::Stat& s) {
   return os.str();
 }
 
-void PrintTable(const PlanReport& report) {
+void PrintTable(const manipulation::PlanReport& report) {
   std::cout << std::left << std::setw(18) << "method" << std::right << std::setw(9) << "success"
             << std::setw(14) << "EE length" << std::setw(14) << "C-space len" << std::setw(14)
             << "time s" << std::setw(14) << "EE-LDJ" << std::setw(14) << "C-space LDJ"
             << "\n";
-  for (const PlanMethodResult& m : report.methods) {
+  for (const manipulation::PlanMethodResult& m : report.methods) {
     const manipulation::MetricSummary& s = m.summary;
     std::cout << std::left << std::setw(18) << m.method << std::right << std::setw(8) << std::fixed
               << std::setprecision(0) << 100 * s.success_rate << "%" << std::setw(14)
@@ -78,22 +78,23 @@ void AddPlanCommand(CLI::App* app) {
       overrides.push_back("problems.first=" + std::to_string(first));
       overrides.push_back("problems.last=" + std::to_string(last));
     }
-    const ManipulationExperimentConfig c =
+    const manipulation::ExperimentConfig c =
         embedded
-            ? config::ExperimentConfigFromYaml<ManipulationExperimentConfig>(
+            ? config::ExperimentConfigFromYaml<manipulation::ExperimentConfig>(
                   kEmbeddedManipulationConfig, "<embedded configs/manipulation/synthetic.yaml>",
                   overrides)
-            : config::LoadExperimentConfig<ManipulationExperimentConfig>(args->config, overrides);
+            : config::LoadExperimentConfig<manipulation::ExperimentConfig>(args->config, overrides);
     const std::string out =
         !args->run_dir.empty() ? args->run_dir
                                : "runs/plan_" + (embedded ? std::string("synthetic")
                                                           : fs::path(args->config).stem().string());
-    StartRunDirectory(out, config::ToYaml(c), false, kManipulationRunRules);
+    StartRunDirectory(out, config::ToYaml(c), false, manipulation::kRunRules);
     std::cout << "planning "
-              << (c.problems.source == ProblemSource::kSynthetic ? std::string("synthetic scenes")
-                                                                 : c.problems.family)
+              << (c.problems.source == manipulation::ProblemSource::kSynthetic
+                      ? std::string("synthetic scenes")
+                      : c.problems.family)
               << " with " << c.methods.size() << " methods -> " << out << "\n";
-    const PlanReport report = RunPlanExperiment(c, out);
+    const manipulation::PlanReport report = manipulation::RunPlanExperiment(c, out);
     PrintTable(report);
     if (!report.invalid_problems.empty())
       std::cout

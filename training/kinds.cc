@@ -15,8 +15,8 @@ ExperimentRegistry BuiltinKinds() {
 #ifdef FORESIGHT_WITH_TORCH
   r.Add(directional::Kind());
 #endif
-  r.Add(NavigationKind());
-  r.Add(ManipulationKind());
+  r.Add(nav::Kind());
+  r.Add(manipulation::Kind());
 #ifdef FORESIGHT_WITH_TORCH
   r.Add(gfcs::Kind());
   r.Add(imitation::Kind());

@@ -29,8 +29,13 @@ namespace span {
 ExperimentKind Kind(const std::string& embedded_default);
 void SetBenchStep(ExperimentKind* kind);
 }  // namespace span
-ExperimentKind NavigationKind();
-ExperimentKind ManipulationKind();
+namespace nav {  // closed-loop navigation episodes
+ExperimentKind Kind();
+}  // namespace nav
+namespace manipulation {  // the manipulation planning harness
+ExperimentKind Kind();
+void SetBenchStep(ExperimentKind* kind);
+}  // namespace manipulation
 namespace gfcs {
 ExperimentKind Kind();
 }  // namespace gfcs
@@ -45,10 +50,6 @@ void SetBenchStep(ExperimentKind* kind);
 namespace constrained {
 ExperimentKind Kind();
 }  // namespace constrained
-
-// Each kind's bench step (SetBench), in its <method>/bench.cc (declared in every build: the
-// LibTorch kinds' libraries are built only with LibTorch).
-void SetManipulationBench(ExperimentKind* kind);
 
 /// The config of a train request: the file, or `embedded_default` (named `default_name` in
 /// errors) when the request says "default".

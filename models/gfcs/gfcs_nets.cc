@@ -2,7 +2,7 @@
 
 #include "core/error.h"
 
-namespace foresight {
+namespace foresight::gfcs {
 
 DenseReluNetImpl::DenseReluNetImpl(const std::vector<int>& sizes) {
   FS_THROW_UNLESS(sizes.size() >= 2, "DenseReluNet: needs an input and an output size, got ",
@@ -82,4 +82,4 @@ torch::Tensor BpsAutoencoderImpl::forward(const torch::Tensor& x) {
   return decoder_->forward(encoder_->forward(x));
 }
 
-}  // namespace foresight
+}  // namespace foresight::gfcs

@@ -7,7 +7,7 @@
 
 #include "inference/engine/dense.h"
 
-namespace foresight {
+namespace foresight::gfcs {
 
 /// Dense layers with ReLU between them and none after the last (the engine's Mlp semantics).
 class DenseReluNetImpl : public torch::nn::Module {
@@ -56,4 +56,4 @@ class BpsAutoencoderImpl : public torch::nn::Module {
 };
 TORCH_MODULE(BpsAutoencoder);
 
-}  // namespace foresight
+}  // namespace foresight::gfcs

@@ -77,6 +77,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   LoadBoth<foresight::span::ExperimentConfig>(text, path, overrides);
   LoadBoth<foresight::occupancy::ExperimentConfig>(text, path, overrides);
   LoadBoth<foresight::directional::ExperimentConfig>(text, path, overrides);
-  LoadBoth<foresight::NavigationExperimentConfig>(text, path, overrides);
+  LoadBoth<foresight::nav::ExperimentConfig>(text, path, overrides);
   return 0;
 }

@@ -13,8 +13,8 @@
 namespace foresight {
 namespace {
 
-NavigationExperimentConfig SmallConfig(const testing::TempDir& dir) {
-  NavigationExperimentConfig c;
+nav::ExperimentConfig SmallConfig(const testing::TempDir& dir) {
+  nav::ExperimentConfig c;
   c.scenario = Sim2Scenario();
   for (auto& g : c.scenario.groups) g.count = 2;
   c.scenario.extent = {-6, 6, -6, 6};
@@ -41,10 +41,10 @@ NavigationExperimentConfig SmallConfig(const testing::TempDir& dir) {
 
 TEST(NavigationRun, EveryMethodRunsAnEpisodeAndTheSummaryHasItsKeys) {
   testing::TempDir dir;
-  const NavigationExperimentConfig c = SmallConfig(dir);
-  const std::vector<MethodSummary> s = RunNavigation(c, dir.path(), 1);
+  const nav::ExperimentConfig c = SmallConfig(dir);
+  const std::vector<nav::MethodSummary> s = nav::RunNavigation(c, dir.path(), 1);
   ASSERT_EQ(s.size(), 3u) << "a methods list without orca is unchanged";
-  for (const MethodSummary& m : s) {
+  for (const nav::MethodSummary& m : s) {
     EXPECT_EQ(m.episodes, 1);
     EXPECT_GE(m.cycle_ms_median, 0.0);
   }
@@ -87,14 +87,14 @@ TEST(NavigationRun, EveryMethodRunsAnEpisodeAndTheSummaryHasItsKeys) {
 
 TEST(NavigationRun, OrcaIsTheFourthMethod) {
   testing::TempDir dir;
-  NavigationExperimentConfig c = SmallConfig(dir);
+  nav::ExperimentConfig c = SmallConfig(dir);
   c.methods = {"orca", "reactive"};
   c.video.method = "orca";
   c.video.enabled = false;
-  c.map.kind = NavigationMapKind::kGrid;  // the map is not what this test is about
-  EXPECT_EQ(ParseNavigationMethod("orca", "test"), NavigationMethod::kOrca);
-  EXPECT_STREQ(MethodName(NavigationMethod::kOrca), "orca");
-  const std::vector<MethodSummary> s = RunNavigation(c, dir.path(), 1);
+  c.map.kind = nav::MapKind::kGrid;  // the map is not what this test is about
+  EXPECT_EQ(nav::ParseMethod("orca", "test"), nav::Method::kOrca);
+  EXPECT_STREQ(nav::MethodName(nav::Method::kOrca), "orca");
+  const std::vector<nav::MethodSummary> s = nav::RunNavigation(c, dir.path(), 1);
   ASSERT_EQ(s.size(), 2u);
   EXPECT_EQ(s[0].method, "orca");
   EXPECT_EQ(s[0].success_rate, 1.0) << "ORCA crosses a nearly empty square";
@@ -110,90 +110,90 @@ TEST(NavigationRun, RobotCausedContactFollowsItsDefinition) {
   const Eigen::Vector2d robot(0, 0), ped(0.7, 0);  // overlapping: radius sum 0.8
   const double r = 0.8;
   // Driving into the pedestrian: the robot's fault.
-  EXPECT_TRUE(RobotCausedContact(robot, {0.5, 0}, ped, r, false));
+  EXPECT_TRUE(nav::RobotCausedContact(robot, {0.5, 0}, ped, r, false));
   // Driving at 60 degrees off the normal: closing at 0.5 cos 60 = 0.25 m/s > 0.05: still.
-  EXPECT_TRUE(RobotCausedContact(robot, {0.25, 0.433}, ped, r, false));
+  EXPECT_TRUE(nav::RobotCausedContact(robot, {0.25, 0.433}, ped, r, false));
   // Moving almost tangentially (closing at 0.04 m/s) or away: not.
-  EXPECT_FALSE(RobotCausedContact(robot, {0.04, 0.8}, ped, r, false));
-  EXPECT_FALSE(RobotCausedContact(robot, {-0.5, 0}, ped, r, false));
+  EXPECT_FALSE(nav::RobotCausedContact(robot, {0.04, 0.8}, ped, r, false));
+  EXPECT_FALSE(nav::RobotCausedContact(robot, {-0.5, 0}, ped, r, false));
   // Standing still (|v| < 0.05) while run into: not, even with a tiny velocity toward it.
-  EXPECT_FALSE(RobotCausedContact(robot, {0.049, 0}, ped, r, false));
+  EXPECT_FALSE(nav::RobotCausedContact(robot, {0.049, 0}, ped, r, false));
   // A pedestrian that just appeared inside the robot's disc: never.
-  EXPECT_FALSE(RobotCausedContact(robot, {0.5, 0}, ped, r, true));
+  EXPECT_FALSE(nav::RobotCausedContact(robot, {0.5, 0}, ped, r, true));
   // No overlap: no contact at all.
-  EXPECT_FALSE(RobotCausedContact(robot, {0.5, 0}, {0.81, 0}, r, false));
+  EXPECT_FALSE(nav::RobotCausedContact(robot, {0.5, 0}, {0.81, 0}, r, false));
   // Only the robot's own velocity counts (the pedestrian's is not an argument): the rule holds in
   // any frame orientation.
   const double a = 2.1;
   const Eigen::Vector2d turned(0.7 * std::cos(a), 0.7 * std::sin(a));
-  EXPECT_TRUE(RobotCausedContact(robot, 0.5 * turned.normalized(), turned, r, false));
-  EXPECT_FALSE(RobotCausedContact(robot, -0.5 * turned.normalized(), turned, r, false));
+  EXPECT_TRUE(nav::RobotCausedContact(robot, 0.5 * turned.normalized(), turned, r, false));
+  EXPECT_FALSE(nav::RobotCausedContact(robot, -0.5 * turned.normalized(), turned, r, false));
 }
 
 TEST(NavigationRun, WilsonIntervalMatchesHandComputedValues) {
   // (p + z^2/2n -+ z sqrt(p(1-p)/n + z^2/4n^2)) / (1 + z^2/n) with z = 1.96, n = 20.
-  RateInterval i = WilsonInterval(0, 20);
+  nav::RateInterval i = nav::WilsonInterval(0, 20);
   EXPECT_EQ(i.lo, 0.0);
   EXPECT_NEAR(i.hi, 0.161, 5e-4);
-  i = WilsonInterval(20, 20);
+  i = nav::WilsonInterval(20, 20);
   EXPECT_NEAR(i.lo, 0.839, 5e-4);
   EXPECT_EQ(i.hi, 1.0);
-  i = WilsonInterval(10, 20);
+  i = nav::WilsonInterval(10, 20);
   EXPECT_NEAR(i.lo, 0.299, 5e-4);
   EXPECT_NEAR(i.hi, 0.701, 5e-4);
   // k = 3, n = 40 by hand: centre (0.075 + 0.048020) / 1.096040 = 0.112241, half-width
   // 1.96 sqrt(0.0017344 + 0.00060025) / 1.096040 = 0.086405.
-  i = WilsonInterval(3, 40);
+  i = nav::WilsonInterval(3, 40);
   EXPECT_NEAR(i.lo, 0.025836, 1e-5);
   EXPECT_NEAR(i.hi, 0.198646, 1e-5);
   // No episodes: no information.
-  i = WilsonInterval(0, 0);
+  i = nav::WilsonInterval(0, 0);
   EXPECT_EQ(i.lo, 0.0);
   EXPECT_EQ(i.hi, 1.0);
 }
 
 TEST(NavigationRun, EpisodesAreDeterministicForReplayFreeMethods) {
   testing::TempDir dir;
-  NavigationExperimentConfig c = SmallConfig(dir);
+  nav::ExperimentConfig c = SmallConfig(dir);
   c.methods = {"reactive"};
-  const NavigationResources res = PrepareNavigation(c, dir.path());
-  const EpisodeResult a = RunEpisode(c, res, NavigationMethod::kReactive, 0),
-                      b = RunEpisode(c, res, NavigationMethod::kReactive, 0);
+  const nav::Resources res = nav::PrepareNavigation(c, dir.path());
+  const nav::EpisodeResult a = nav::RunEpisode(c, res, nav::Method::kReactive, 0),
+                           b = nav::RunEpisode(c, res, nav::Method::kReactive, 0);
   EXPECT_EQ(a.path, b.path);
   EXPECT_EQ(a.doc, b.doc);
 }
 
 TEST(NavigationRun, BadScenesAndArtifactsAreClearErrors) {
   testing::TempDir dir;
-  NavigationExperimentConfig c = SmallConfig(dir);
+  nav::ExperimentConfig c = SmallConfig(dir);
   c.methods = {"reactive"};
   // A goal inside a wall.
-  NavigationExperimentConfig bad = c;
+  nav::ExperimentConfig bad = c;
   bad.scenario.walls = {{0, -6, 0, 6}};
   bad.scenario.robot_goal = {0.0, 4.5};
-  testing::ExpectErrorContains([&] { RunNavigation(bad, dir.path(), 1); }, {"robot_goal"});
+  testing::ExpectErrorContains([&] { nav::RunNavigation(bad, dir.path(), 1); }, {"robot_goal"});
   // A wall across the whole square: the goal is unreachable.
   bad.scenario.robot_goal = {4.5, 4.5};
-  testing::ExpectErrorContains([&] { RunNavigation(bad, dir.path(), 1); },
+  testing::ExpectErrorContains([&] { nav::RunNavigation(bad, dir.path(), 1); },
                                {"robot_goal", "unreachable"});
   // A start in collision with the border.
   bad = c;
   bad.scenario.robot_start = {-5.9, -4.5, 0};
-  testing::ExpectErrorContains([&] { RunNavigation(bad, dir.path(), 1); }, {"robot_start"});
+  testing::ExpectErrorContains([&] { nav::RunNavigation(bad, dir.path(), 1); }, {"robot_start"});
   // No pedestrians in a simulated scene.
   bad = c;
   bad.scenario.groups.clear();
-  EXPECT_THROW(RunNavigation(bad, dir.path(), 1), Error);
+  EXPECT_THROW(nav::RunNavigation(bad, dir.path(), 1), Error);
   // A map artifact where the predictor belongs, and the predictor where the map belongs.
   bad = c;
   bad.methods = {"span"};
-  RunNavigation(c, dir.path(), 1);  // writes map.h5
+  nav::RunNavigation(c, dir.path(), 1);  // writes map.h5
   bad.predictor.artifact = dir.File("map.h5");
-  testing::ExpectErrorContains([&] { PrepareNavigation(bad, dir.path()); },
+  testing::ExpectErrorContains([&] { nav::PrepareNavigation(bad, dir.path()); },
                                {"map.h5", "span_predictor"});
   bad = c;
   bad.map.artifact = c.predictor.artifact;
-  EXPECT_THROW(PrepareNavigation(bad, dir.path()), Error);
+  EXPECT_THROW(nav::PrepareNavigation(bad, dir.path()), Error);
   // A predictor that observes every 0.15 s cannot be fed at dt = 0.1 s.
   bad = c;
   bad.methods = {"span"};
@@ -202,18 +202,18 @@ TEST(NavigationRun, BadScenesAndArtifactsAreClearErrors) {
   spec.seconds_per_step = 0.15;
   bad.predictor.artifact = dir.File("odd.h5");
   testing::WriteRandomSpanArtifact(bad.predictor.artifact, spec);
-  testing::ExpectErrorContains([&] { PrepareNavigation(bad, dir.path()); },
+  testing::ExpectErrorContains([&] { nav::PrepareNavigation(bad, dir.path()); },
                                {"odd.h5", "multiple of dt"});
   bad = c;
   bad.methods = {"teleport"};
-  testing::ExpectErrorContains([&] { PrepareNavigation(bad, dir.path()); },
+  testing::ExpectErrorContains([&] { nav::PrepareNavigation(bad, dir.path()); },
                                {"methods", "teleport"});
 }
 
 TEST(NavigationRun, SummaryMetricsFollowTheirDefinitions) {
   auto episode = [](bool reached, double ttg, double doc, double clear, std::vector<double> ms,
                     double robot_doc = 0) {
-    EpisodeResult r;
+    nav::EpisodeResult r;
     r.method = "span";
     r.reached = reached;
     r.ttg = ttg;
@@ -223,12 +223,12 @@ TEST(NavigationRun, SummaryMetricsFollowTheirDefinitions) {
     r.cycle_ms = std::move(ms);
     return r;
   };
-  std::vector<EpisodeResult> results = {episode(true, 20, 0.0, 0.2, {1, 2, 3}),
-                                        episode(false, 90, 0.5, -0.1, {4, 5}, 0.3),
-                                        episode(true, 30, 0.2, 0.05, {6})};
+  std::vector<nav::EpisodeResult> results = {episode(true, 20, 0.0, 0.2, {1, 2, 3}),
+                                             episode(false, 90, 0.5, -0.1, {4, 5}, 0.3),
+                                             episode(true, 30, 0.2, 0.05, {6})};
   results.push_back(results[0]);
   results.back().method = "reactive";  // other methods are not mixed in
-  const MethodSummary m = Summarise("span", results);
+  const nav::MethodSummary m = nav::Summarise("span", results);
   EXPECT_EQ(m.episodes, 3);
   EXPECT_DOUBLE_EQ(m.success_rate, 2.0 / 3);
   EXPECT_DOUBLE_EQ(m.collision_free_rate, 1.0 / 3);
@@ -248,14 +248,14 @@ TEST(NavigationRun, SummaryMetricsFollowTheirDefinitions) {
   EXPECT_DOUBLE_EQ(m.robot_caused_doc_mean, 0.1);
   EXPECT_EQ(m.robot_caused_collision_free, 2);  // the 0.2 s of DOC in episode 3 were not caused
   EXPECT_DOUBLE_EQ(m.robot_caused_collision_free_rate, 2.0 / 3);
-  EXPECT_EQ(m.success_rate_ci.lo, WilsonInterval(2, 3).lo);
-  EXPECT_EQ(m.success_and_collision_free_rate_ci.hi, WilsonInterval(1, 3).hi);
-  EXPECT_EQ(m.robot_caused_collision_free_rate_ci.hi, WilsonInterval(2, 3).hi);
+  EXPECT_EQ(m.success_rate_ci.lo, nav::WilsonInterval(2, 3).lo);
+  EXPECT_EQ(m.success_and_collision_free_rate_ci.hi, nav::WilsonInterval(1, 3).hi);
+  EXPECT_EQ(m.robot_caused_collision_free_rate_ci.hi, nav::WilsonInterval(2, 3).hi);
   // None reached: TTG is null in the JSON, never NaN.
-  NavigationExperimentConfig c;
+  nav::ExperimentConfig c;
   c.scenario.name = "a\"b";
   const std::string json =
-      SummaryJson(c, 1, {Summarise("span", {episode(false, 90, 0, 0.1, {1})})});
+      nav::SummaryJson(c, 1, {nav::Summarise("span", {episode(false, 90, 0, 0.1, {1})})});
   EXPECT_NE(json.find("\"ttg_mean\": null"), std::string::npos) << json;
   EXPECT_EQ(json.find("nan"), std::string::npos);
   EXPECT_EQ(json.find("inf"), std::string::npos);

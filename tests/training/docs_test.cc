@@ -30,11 +30,11 @@ TEST(Docs, ConfigReferenceIsCurrent) {
 TEST(Docs, ShippedNavigationConfigsLoad) {
   const std::string src = std::getenv("FORESIGHT_SOURCE_DIR");
   for (const char* name : {"sim1", "sim2", "dataset"}) {
-    const NavigationExperimentConfig c = config::LoadExperimentConfig<NavigationExperimentConfig>(
+    const nav::ExperimentConfig c = config::LoadExperimentConfig<nav::ExperimentConfig>(
         src + "/configs/navigation/" + name + ".yaml");
     EXPECT_EQ(c.scenario.name, name);
     EXPECT_EQ(c.methods.size(), 4u);
-    EXPECT_TRUE(c.Uses(NavigationMethod::kOrca)) << name;
+    EXPECT_TRUE(c.Uses(nav::Method::kOrca)) << name;
     EXPECT_GE(c.episodes, 20);
   }
   for (const char* name : {"predictor", "predictor_thor"})

@@ -35,15 +35,16 @@ TEST(InfoNce, MatchesTheDefinitionPerPositive) {
     for (int k = 0; k < 7; ++k) denominator += std::exp(-neg[j][k].item<double>());
     expected += -std::log(std::exp(-pos[j].item<double>()) / denominator) / 5;
   }
-  EXPECT_NEAR(InfoNceLoss(pos, neg).item<double>(), expected, 1e-12);
+  EXPECT_NEAR(gfcs::InfoNceLoss(pos, neg).item<double>(), expected, 1e-12);
   // Lower positive energy is better: the loss falls when E+ falls.
-  EXPECT_LT(InfoNceLoss(pos - 1, neg).item<double>(), InfoNceLoss(pos, neg).item<double>());
+  EXPECT_LT(gfcs::InfoNceLoss(pos - 1, neg).item<double>(),
+            gfcs::InfoNceLoss(pos, neg).item<double>());
 }
 
 TEST(EnergyNet, TheEngineComputesWhatLibTorchTrained) {
   torch::manual_seed(5);
   const int encoding = 6, commands = 14, context = 21 + encoding;
-  EnergyNet net(context, commands, 32, 3);
+  gfcs::EnergyNet net(context, commands, 32, 3);
   manipulation::EnergyModelParts parts;
   parts.lattice.spacing = 1.0;
   const int n_r = parts.lattice.size();
@@ -70,7 +71,7 @@ TEST(EnergyNet, TheEngineComputesWhatLibTorchTrained) {
   for (int k = 0; k < 9; ++k) EXPECT_NEAR(energy[k], e[0][k].item<float>(), 1e-5) << k;
 
   // The round trip through engine weights keeps the network.
-  EnergyNet copy(context, commands, 32, 3);
+  gfcs::EnergyNet copy(context, commands, 32, 3);
   copy->net()->LoadMlp(parts.energy);
   EXPECT_TRUE(torch::allclose(copy->forward(ctx, u), e));
 }

@@ -12,22 +12,23 @@ void ExperimentConfig::Validate(const std::string& path) const {
   FS_THROW_UNLESS(!train_problems.empty(), path, ": train_problems: empty list");
   FS_THROW_UNLESS(gfcs.commands >= 2, path, ": gfcs.commands: ", gfcs.commands,
                   ", the learned sampler needs at least one intermediate command (2)");
-  const auto check_set = [&](const ManipulationProblemsConfig& p, const std::string& key) {
+  const auto check_set = [&](const manipulation::ProblemsConfig& p, const std::string& key) {
     FS_THROW_UNLESS(p.first <= p.last, path, ": ", key, ": first (", p.first, ") is after last (",
                     p.last, ")");
-    FS_THROW_UNLESS(p.source != ProblemSource::kMotionBenchMaker || !p.family.empty(), path, ": ",
-                    key, ".family: empty");
-    if (p.source == ProblemSource::kSynthetic) p.scene.Validate(path + ": " + key + ".scene");
+    FS_THROW_UNLESS(p.source != manipulation::ProblemSource::kMotionBenchMaker || !p.family.empty(),
+                    path, ": ", key, ".family: empty");
+    if (p.source == manipulation::ProblemSource::kSynthetic)
+      p.scene.Validate(path + ": " + key + ".scene");
   };
   for (std::size_t i = 0; i < train_problems.size(); ++i)
     check_set(train_problems[i], "train_problems[" + std::to_string(i) + "]");
   for (std::size_t i = 0; i < eval.problems.size(); ++i)
     check_set(eval.problems[i], "eval.problems[" + std::to_string(i) + "]");
   // Held-out means held out: no MotionBenchMaker problem both trains and tests.
-  for (const ManipulationProblemsConfig& t : train_problems)
-    for (const ManipulationProblemsConfig& e : eval.problems)
-      if (t.source == ProblemSource::kMotionBenchMaker &&
-          e.source == ProblemSource::kMotionBenchMaker && t.family == e.family)
+  for (const manipulation::ProblemsConfig& t : train_problems)
+    for (const manipulation::ProblemsConfig& e : eval.problems)
+      if (t.source == manipulation::ProblemSource::kMotionBenchMaker &&
+          e.source == manipulation::ProblemSource::kMotionBenchMaker && t.family == e.family)
         FS_THROW_UNLESS(t.last < e.first || e.last < t.first, path, ": eval.problems: ", e.family,
                         " ", e.first, "-", e.last, " overlaps the training problems ", t.first, "-",
                         t.last);
@@ -41,9 +42,9 @@ void ExperimentConfig::Validate(const std::string& path) const {
     FS_THROW_UNLESS(budgets.insert(b).second, path, ": eval.batches: ", b, " listed twice");
   }
   std::set<std::string> names;
-  for (const PlanMethodConfig& m : eval.baselines) {
-    FS_THROW_UNLESS(m.kind != PlanMethodKind::kGfcs, path, ": eval.baselines: '", m.name,
-                    "' is GFCS (GFCS rows come from eval.batches)");
+  for (const manipulation::PlanMethodConfig& m : eval.baselines) {
+    FS_THROW_UNLESS(m.kind != manipulation::PlanMethodKind::kGfcs, path, ": eval.baselines: '",
+                    m.name, "' is GFCS (GFCS rows come from eval.batches)");
     FS_THROW_UNLESS(names.insert(m.name).second, path, ": eval.baselines: '", m.name,
                     "' listed twice");
     FS_THROW_UNLESS(

@@ -102,15 +102,16 @@ struct LoopConfig {
 /// Evaluation on held-out problems: GFCS with the uniform and the learned sampler at equal budget,
 /// plus baselines (the plan harness's methods).
 struct EvalConfig {
-  std::vector<ManipulationProblemsConfig> problems = [] {
-    ManipulationProblemsConfig p;
+  std::vector<manipulation::ProblemsConfig> problems = [] {
+    manipulation::ProblemsConfig p;
     p.first = 51;
     p.last = 75;
-    return std::vector<ManipulationProblemsConfig>{p};
+    return std::vector<manipulation::ProblemsConfig>{p};
   }();
   int batch_size = 20;                ///< candidates per batch at test (thesis 20)
   std::vector<int> batches = {1, 5};  ///< budgets compared (thesis 1 and 5)
-  std::vector<PlanMethodConfig> baselines = {{"GF", PlanMethodKind::kFabric, 1, 1.2}};
+  std::vector<manipulation::PlanMethodConfig> baselines = {
+      {"GF", manipulation::PlanMethodKind::kFabric, 1, 1.2}};
   double resolution = 0.05;
   double max_joint_speed = 1.0;
   int plot_problems = 2;
@@ -147,11 +148,11 @@ struct ExperimentConfig {
   std::int64_t seed = 0;
   DataConfig data;
   std::string robot = "franka_panda";  ///< folder under the data root, or "builtin"
-  std::vector<ManipulationProblemsConfig> train_problems = [] {
-    ManipulationProblemsConfig p;
+  std::vector<manipulation::ProblemsConfig> train_problems = [] {
+    manipulation::ProblemsConfig p;
     p.first = 1;
     p.last = 50;
-    return std::vector<ManipulationProblemsConfig>{p};
+    return std::vector<manipulation::ProblemsConfig>{p};
   }();
   manipulation::FabricParams fabric;
   manipulation::GfcsParams
@@ -189,8 +190,8 @@ struct ExperimentConfig {
 
 /// The harness config of one held-out problem set (methods: uniform and learned GFCS at each
 /// budget, then the baselines), the learned sampler read from `energy_model`.
-ManipulationExperimentConfig EvalPlanConfig(const ExperimentConfig& c,
-                                            const ManipulationProblemsConfig& problems,
-                                            const std::string& energy_model);
+manipulation::ExperimentConfig EvalPlanConfig(const ExperimentConfig& c,
+                                              const manipulation::ProblemsConfig& problems,
+                                              const std::string& energy_model);
 
 }  // namespace foresight::gfcs

@@ -33,9 +33,9 @@ namespace {
 const RunDirectoryRules kGfcsRunRules{{"checkpoints", "autoencoder", "model.h5"}, true};
 
 /// The harness config that loads the robot and one problem set.
-ManipulationExperimentConfig HarnessConfig(const ExperimentConfig& c,
-                                           const ManipulationProblemsConfig& set) {
-  ManipulationExperimentConfig mc;
+manipulation::ExperimentConfig HarnessConfig(const ExperimentConfig& c,
+                                             const manipulation::ProblemsConfig& set) {
+  manipulation::ExperimentConfig mc;
   mc.seed = c.seed;
   mc.robot = c.robot;
   mc.problems = set;
@@ -45,17 +45,18 @@ ManipulationExperimentConfig HarnessConfig(const ExperimentConfig& c,
   return mc;
 }
 
-std::string SetName(const ManipulationProblemsConfig& set) {
-  return set.source == ProblemSource::kSynthetic ? "synthetic" : set.family;
+std::string SetName(const manipulation::ProblemsConfig& set) {
+  return set.source == manipulation::ProblemSource::kSynthetic ? "synthetic" : set.family;
 }
 
 /// The training problems whose start and goal are valid for the robot model (others skipped).
 std::vector<TrainingProblem> LoadTrainingProblems(const ExperimentConfig& c,
                                                   const RobotModel& robot) {
   std::vector<TrainingProblem> out;
-  for (const ManipulationProblemsConfig& set : c.train_problems) {
+  for (const manipulation::ProblemsConfig& set : c.train_problems) {
     int skipped = 0;
-    for (ManipulationProblem& p : LoadExperimentProblems(HarnessConfig(c, set), robot)) {
+    for (ManipulationProblem& p :
+         manipulation::LoadExperimentProblems(HarnessConfig(c, set), robot)) {
       const ValidityChecker checker(robot, p.world);
       KinematicsData data = robot.MakeData();
       if (checker.Check(p.start, &data) != Validity::kValid ||
@@ -187,7 +188,7 @@ void WriteArtifact(const ExperimentConfig& c, const RobotModel& robot, const Enc
 
 RobotModel LoadRobot(const ExperimentConfig& c) {
   FS_THROW_UNLESS(!c.train_problems.empty(), "gfcs: train_problems is empty");
-  return LoadExperimentRobot(HarnessConfig(c, c.train_problems.front()));
+  return manipulation::LoadExperimentRobot(HarnessConfig(c, c.train_problems.front()));
 }
 
 // --- Evaluation -------------------------------------------------------------------------------
@@ -241,19 +242,21 @@ std::string BudgetLabel(int batches) {
 
 }  // namespace
 
-ManipulationExperimentConfig EvalPlanConfig(const ExperimentConfig& c,
-                                            const ManipulationProblemsConfig& problems,
-                                            const std::string& energy_model) {
-  ManipulationExperimentConfig mc = HarnessConfig(c, problems);
+manipulation::ExperimentConfig EvalPlanConfig(const ExperimentConfig& c,
+                                              const manipulation::ProblemsConfig& problems,
+                                              const std::string& energy_model) {
+  manipulation::ExperimentConfig mc = HarnessConfig(c, problems);
   mc.gfcs.batch_size = c.eval.batch_size;
   mc.methods.clear();
   for (int b : c.eval.batches) {
-    mc.methods.push_back({"GFCS uniform (" + BudgetLabel(b) + ")", PlanMethodKind::kGfcs, b, 1.2,
-                          GfcsSamplerKind::kUniform});
-    mc.methods.push_back({"GFCS learned (" + BudgetLabel(b) + ")", PlanMethodKind::kGfcs, b, 1.2,
-                          GfcsSamplerKind::kLearned});
+    mc.methods.push_back({"GFCS uniform (" + BudgetLabel(b) + ")",
+                          manipulation::PlanMethodKind::kGfcs, b, 1.2,
+                          manipulation::GfcsSamplerKind::kUniform});
+    mc.methods.push_back({"GFCS learned (" + BudgetLabel(b) + ")",
+                          manipulation::PlanMethodKind::kGfcs, b, 1.2,
+                          manipulation::GfcsSamplerKind::kLearned});
   }
-  for (const PlanMethodConfig& m : c.eval.baselines) mc.methods.push_back(m);
+  for (const manipulation::PlanMethodConfig& m : c.eval.baselines) mc.methods.push_back(m);
   mc.resolution = c.eval.resolution;
   mc.max_joint_speed = c.eval.max_joint_speed;
   mc.plot_problems = c.eval.plot_problems;
@@ -278,8 +281,8 @@ bool TrainRun(const ExperimentConfig& c, const std::string& run_dir, bool resume
   const RobotModel robot = LoadRobot(c);
   // The held-out sets are read now, so a missing file fails before an hour of training, not after.
   if (check_eval_sets)
-    for (const ManipulationProblemsConfig& set : c.eval.problems)
-      (void)LoadExperimentProblems(HarnessConfig(c, set), robot);
+    for (const manipulation::ProblemsConfig& set : c.eval.problems)
+      (void)manipulation::LoadExperimentProblems(HarnessConfig(c, set), robot);
   std::vector<TrainingProblem> problems = LoadTrainingProblems(c, robot);
   FS_THROW_UNLESS(!problems.empty(), run_dir, ": no training problem has a valid start and goal");
   if (c.loop.shuffle) {
@@ -322,11 +325,12 @@ std::string EvaluateRun(const ExperimentConfig& c, const std::string& run_dir) {
   std::ostringstream os;
   os << "{\n  \"artifact\": " << JsonString(artifact) << ",\n  \"sets\": [\n";
   for (std::size_t i = 0; i < c.eval.problems.size(); ++i) {
-    const ManipulationProblemsConfig& set = c.eval.problems[i];
+    const manipulation::ProblemsConfig& set = c.eval.problems[i];
     const std::string dir = run_dir + "/eval/" + std::to_string(i) + "_" + SetName(set);
     fs::create_directories(dir);
     log::Info("evaluating on ", SetName(set), " problems ", set.first, "-", set.last, " -> ", dir);
-    const PlanReport report = RunPlanExperiment(EvalPlanConfig(c, set, artifact), dir);
+    const manipulation::PlanReport report =
+        manipulation::RunPlanExperiment(EvalPlanConfig(c, set, artifact), dir);
     os << "    {\"set\": " << JsonString(SetName(set)) << ", \"first\": " << set.first
        << ", \"last\": " << set.last << ", \"problems\": " << report.problems
        << ", \"invalid_problems\": " << report.invalid_problems.size()
@@ -339,8 +343,9 @@ std::string EvaluateRun(const ExperimentConfig& c, const std::string& run_dir) {
     for (std::size_t b = 0; b < c.eval.batches.size(); ++b) {
       const std::string uni = "GFCS uniform (" + BudgetLabel(c.eval.batches[b]) + ")";
       const std::string lea = "GFCS learned (" + BudgetLabel(c.eval.batches[b]) + ")";
-      std::map<int, std::pair<const PlanAttempt*, const PlanAttempt*>> by_problem;
-      for (const PlanAttempt& a : report.attempts) {
+      std::map<int, std::pair<const manipulation::PlanAttempt*, const manipulation::PlanAttempt*>>
+          by_problem;
+      for (const manipulation::PlanAttempt& a : report.attempts) {
         if (a.method == uni) by_problem[a.problem].first = &a;
         if (a.method == lea) by_problem[a.problem].second = &a;
       }
@@ -348,7 +353,9 @@ std::string EvaluateRun(const ExperimentConfig& c, const std::string& run_dir) {
       // cost_s over all pairs mixes the penalty of unsolved problems in, cost_both_solved_s not.
       std::vector<double> cost, cost_solved, time, success;
       int only_learned = 0, only_uniform = 0;
-      const auto errored = [](const PlanAttempt& a) { return a.status.rfind("error", 0) == 0; };
+      const auto errored = [](const manipulation::PlanAttempt& a) {
+        return a.status.rfind("error", 0) == 0;
+      };
       for (const auto& [problem, pair] : by_problem) {
         if (!pair.first || !pair.second) continue;
         const bool su = pair.first->metrics.success, sl = pair.second->metrics.success;

@@ -20,7 +20,7 @@
 #include "training/kinds.h"
 #include "training/manipulation/plan.h"
 
-namespace foresight {
+namespace foresight::manipulation {
 namespace {
 using bench::Clock;
 using bench::Median;
@@ -37,7 +37,7 @@ struct ManipulationBenchOptions {
 };
 
 void RunManipulationBench(const BenchRequest& req, const ManipulationBenchOptions& a) {
-  const auto c = LoadBenchConfig<ManipulationExperimentConfig>(req);
+  const auto c = LoadBenchConfig<ExperimentConfig>(req);
   const RobotModel robot = LoadExperimentRobot(c);
   const std::vector<ManipulationProblem> problems = LoadExperimentProblems(c, robot);
   FS_THROW_UNLESS(!problems.empty(), "bench: the config has no problems");
@@ -129,8 +129,8 @@ void RunManipulationBench(const BenchRequest& req, const ManipulationBenchOption
 }
 }  // namespace
 
-void SetManipulationBench(ExperimentKind* kind) {
+void SetBenchStep(ExperimentKind* kind) {
   SetBench<ManipulationBenchOptions>(kind, RunManipulationBench);
 }
 
-}  // namespace foresight
+}  // namespace foresight::manipulation

@@ -4,7 +4,7 @@
 
 #include "core/error.h"
 
-namespace foresight {
+namespace foresight::manipulation {
 
 std::vector<PlanMethodConfig> DefaultPlanMethods() {
   return {{"GF", PlanMethodKind::kFabric, 1, 1.2},
@@ -16,7 +16,7 @@ std::vector<PlanMethodConfig> DefaultPlanMethods() {
           {"GFCS (5 batches)", PlanMethodKind::kGfcs, 5, 1.2}};
 }
 
-void ManipulationExperimentConfig::Validate(const std::string& path) const {
+void ExperimentConfig::Validate(const std::string& path) const {
   FS_THROW_UNLESS(model == "manipulation", path, ": model: '", model, "', expected 'manipulation'");
   FS_THROW_UNLESS(!methods.empty(), path, ": methods: empty list");
   std::set<std::string> names;
@@ -39,4 +39,4 @@ void ManipulationExperimentConfig::Validate(const std::string& path) const {
                   ") is below fabric.dt (", fabric.dt, ")");
 }
 
-}  // namespace foresight
+}  // namespace foresight::manipulation

@@ -13,12 +13,12 @@
 #include "inference/manipulation/gfcs.h"
 #include "inference/manipulation/synthetic_problems.h"
 
-namespace foresight {
+namespace foresight::manipulation {
 
 /// Where the problems come from.
 enum class ProblemSource { kMotionBenchMaker, kSynthetic };
 
-struct ManipulationProblemsConfig {
+struct ProblemsConfig {
   ProblemSource source = ProblemSource::kMotionBenchMaker;
   /// Data root (empty: $FORESIGHT_DATA, else ../shared/data; datasets/data_root.h).
   std::string root;
@@ -104,13 +104,13 @@ struct ReactivityConfig {
 /// and 5 batches), plus RRT-Connect (VAMP's published reference on these problems).
 std::vector<PlanMethodConfig> DefaultPlanMethods();
 
-struct ManipulationExperimentConfig {
+struct ExperimentConfig {
   std::string model = "manipulation";
   std::int64_t seed = 0;
   /// Robot folder with panda.urdf, spheres_vamp.csv, panda.srdf, relative to the data root;
   /// "builtin": the built-in Panda (no data needed).
   std::string robot = "franka_panda";
-  ManipulationProblemsConfig problems;
+  ProblemsConfig problems;
   std::vector<PlanMethodConfig> methods = DefaultPlanMethods();
   manipulation::FabricParams fabric;
   manipulation::GfcsParams gfcs;
@@ -148,4 +148,4 @@ struct ManipulationExperimentConfig {
   void Validate(const std::string& path) const;
 };
 
-}  // namespace foresight
+}  // namespace foresight::manipulation

@@ -5,17 +5,17 @@
 #include "training/kinds.h"
 #include "training/manipulation/config.h"
 
-namespace foresight {
+namespace foresight::manipulation {
 
-ExperimentKind ManipulationKind() {
+ExperimentKind Kind() {
   ExperimentKind k;
   k.tag = "manipulation";
   k.summary = "Manipulation: GFCS, geometric fabrics and OMPL planners (thesis ch 9)";
   k.configs = "configs/manipulation/*.yaml; run by `foresight plan`";
-  k.reference = [] { return config::ReferenceTable<ManipulationExperimentConfig>(); };
+  k.reference = [] { return config::ReferenceTable<ExperimentConfig>(); };
   k.no_step_hint = "run it with `foresight plan CONFIG --run-dir DIR`";
-  SetManipulationBench(&k);
+  SetBenchStep(&k);
   return k;
 }
 
-}  // namespace foresight
+}  // namespace foresight::manipulation

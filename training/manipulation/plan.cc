@@ -20,7 +20,7 @@
 #include "inference/manipulation/validity.h"
 #include "training/manipulation/render.h"
 
-namespace foresight {
+namespace foresight::manipulation {
 namespace fs = std::filesystem;
 using namespace manipulation;  // NOLINT: this file is the manipulation harness
 
@@ -49,7 +49,7 @@ TimedPath ToTimedPath(const std::vector<JointVector>& states, double dt) {
 
 /// `sampler`'s world is set by the caller. `best` receives the best candidate (also unsolved).
 Trajectory RunGfcs(const Fabric& fabric, const ManipulationProblem& problem,
-                   const ManipulationExperimentConfig& c, const PlanMethodConfig& method,
+                   const ExperimentConfig& c, const PlanMethodConfig& method,
                    CommandSampler* sampler, std::uint64_t seed, GfcsCandidate* best) {
   GfcsParams params = c.gfcs;
   params.batches = method.batches;
@@ -96,7 +96,7 @@ Trajectory RunFabric(const Fabric& fabric, const ManipulationProblem& problem) {
 }
 
 Trajectory RunPlanner(PlannerKind kind, const ValidityChecker& checker,
-                      const ManipulationProblem& problem, const ManipulationExperimentConfig& c,
+                      const ManipulationProblem& problem, const ExperimentConfig& c,
                       const PlanMethodConfig& method, std::uint64_t seed) {
   KinematicsData data = checker.robot().MakeData();
   auto is_valid = [&](const JointVector& q) { return checker.Check(q, &data) == Validity::kValid; };
@@ -179,7 +179,7 @@ void WriteProblemsCsv(const std::string& path, const PlanReport& report) {
   WriteFileAtomically(path, os.str());
 }
 
-void WriteSummaryJson(const std::string& path, const ManipulationExperimentConfig& c,
+void WriteSummaryJson(const std::string& path, const ExperimentConfig& c,
                       const PlanReport& report) {
   std::ostringstream os;
   os << "{\n  \"family\": \""
@@ -207,14 +207,14 @@ void WriteSummaryJson(const std::string& path, const ManipulationExperimentConfi
 
 }  // namespace
 
-RobotModel LoadExperimentRobot(const ManipulationExperimentConfig& c) {
+RobotModel LoadExperimentRobot(const ExperimentConfig& c) {
   if (c.robot == "builtin") return BuiltinPanda();
   return RobotModel::LoadPanda(ResolveDataFile(c.problems.root, c.robot));
 }
 
-std::vector<ManipulationProblem> LoadExperimentProblems(const ManipulationExperimentConfig& c,
+std::vector<ManipulationProblem> LoadExperimentProblems(const ExperimentConfig& c,
                                                         const RobotModel& robot) {
-  const ManipulationProblemsConfig& p = c.problems;
+  const ProblemsConfig& p = c.problems;
   if (p.source == ProblemSource::kMotionBenchMaker)
     return LoadMbmFamily(ResolveDataFile(p.root, "motionbenchmaker_panda/problems"), p.family,
                          p.first, p.last);
@@ -233,7 +233,7 @@ std::vector<ManipulationProblem> LoadExperimentProblems(const ManipulationExperi
   return out;
 }
 
-PlanReport RunPlanExperiment(const ManipulationExperimentConfig& c, const std::string& run_dir) {
+PlanReport RunPlanExperiment(const ExperimentConfig& c, const std::string& run_dir) {
   const RobotModel robot = LoadExperimentRobot(c);
   const std::vector<ManipulationProblem> problems = LoadExperimentProblems(c, robot);
   PlanReport report;
@@ -378,4 +378,4 @@ PlanReport RunPlanExperiment(const ManipulationExperimentConfig& c, const std::s
   return report;
 }
 
-}  // namespace foresight
+}  // namespace foresight::manipulation

@@ -15,18 +15,18 @@
 #include "training/manipulation/config.h"
 #include "training/run_dir.h"
 
-namespace foresight {
+namespace foresight::manipulation {
 
 /// A plan run directory holds these; `plan` refuses to write into another run's directory.
-inline const RunDirectoryRules kManipulationRunRules{{"summary.json", "problems.csv"}, false};
+inline const RunDirectoryRules kRunRules{{"summary.json", "problems.csv"}, false};
 
 /// The config's robot: `builtin`, or a folder (panda.urdf, spheres_vamp.csv, panda.srdf) under the
 /// data root.
-manipulation::RobotModel LoadExperimentRobot(const ManipulationExperimentConfig& config);
+manipulation::RobotModel LoadExperimentRobot(const ExperimentConfig& config);
 
 /// The config's problems (MotionBenchMaker family range, or synthetic scenes for `robot`).
 std::vector<manipulation::ManipulationProblem> LoadExperimentProblems(
-    const ManipulationExperimentConfig& config, const manipulation::RobotModel& robot);
+    const ExperimentConfig& config, const manipulation::RobotModel& robot);
 
 /// One method on one problem.
 struct PlanAttempt {
@@ -53,7 +53,6 @@ struct PlanReport {
 
 /// Runs the config's methods on its problems and writes the outputs into `run_dir` (which exists).
 /// Never throws from inside a method's run: failures are statuses in the report.
-PlanReport RunPlanExperiment(const ManipulationExperimentConfig& config,
-                             const std::string& run_dir);
+PlanReport RunPlanExperiment(const ExperimentConfig& config, const std::string& run_dir);
 
-}  // namespace foresight
+}  // namespace foresight::manipulation

@@ -6,7 +6,7 @@
 #include "core/error.h"
 #include "training/image_io.h"
 
-namespace foresight {
+namespace foresight::manipulation {
 namespace {
 
 constexpr int kPanel = 420;  // px, square panel
@@ -144,4 +144,4 @@ void RenderEndEffectorPaths(const std::string& path,
   WriteImage(path, image);
 }
 
-}  // namespace foresight
+}  // namespace foresight::manipulation

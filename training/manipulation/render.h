@@ -10,7 +10,7 @@
 
 #include "inference/manipulation/world.h"
 
-namespace foresight {
+namespace foresight::manipulation {
 
 struct PlanProblemPicture {
   int problem = 0;
@@ -23,4 +23,4 @@ struct PlanProblemPicture {
 void RenderEndEffectorPaths(const std::string& path,
                             const std::vector<PlanProblemPicture>& pictures);
 
-}  // namespace foresight
+}  // namespace foresight::manipulation

@@ -4,40 +4,40 @@
 
 #include "core/error.h"
 
-namespace foresight {
+namespace foresight::nav {
 
 namespace {
-constexpr NavigationMethod kAllMethods[] = {NavigationMethod::kSpan, NavigationMethod::kReactive,
-                                            NavigationMethod::kClRrtStar, NavigationMethod::kOrca};
+constexpr Method kAllMethods[] = {Method::kSpan, Method::kReactive, Method::kClRrtStar,
+                                  Method::kOrca};
 }  // namespace
 
-const char* MethodName(NavigationMethod method) {
+const char* MethodName(Method method) {
   switch (method) {
-    case NavigationMethod::kSpan:
+    case Method::kSpan:
       return "span";
-    case NavigationMethod::kReactive:
+    case Method::kReactive:
       return "reactive";
-    case NavigationMethod::kClRrtStar:
+    case Method::kClRrtStar:
       return "cl_rrt_star";
-    case NavigationMethod::kOrca:
+    case Method::kOrca:
       return "orca";
   }
   return "";
 }
 
-NavigationMethod ParseNavigationMethod(const std::string& name, const std::string& where) {
-  for (const NavigationMethod m : kAllMethods)
+Method ParseMethod(const std::string& name, const std::string& where) {
+  for (const Method m : kAllMethods)
     if (name == MethodName(m)) return m;
   Fail(where, ": unknown method '", name, "' (expected span, reactive, cl_rrt_star or orca)");
 }
 
-std::vector<NavigationMethod> NavigationExperimentConfig::Methods() const {
-  std::vector<NavigationMethod> out;
-  for (const std::string& m : methods) out.push_back(ParseNavigationMethod(m, "methods"));
+std::vector<Method> ExperimentConfig::Methods() const {
+  std::vector<Method> out;
+  for (const std::string& m : methods) out.push_back(ParseMethod(m, "methods"));
   return out;
 }
 
-nav::OrcaControllerOptions MakeOrcaControllerOptions(const NavigationExperimentConfig& c) {
+nav::OrcaControllerOptions MakeOrcaControllerOptions(const ExperimentConfig& c) {
   nav::OrcaControllerOptions o;
   o.time_horizon = c.orca.time_horizon;
   o.responsibility = c.orca.responsibility;
@@ -51,17 +51,17 @@ nav::OrcaControllerOptions MakeOrcaControllerOptions(const NavigationExperimentC
   return o;
 }
 
-bool NavigationExperimentConfig::Uses(NavigationMethod method) const {
+bool ExperimentConfig::Uses(Method method) const {
   return std::find(methods.begin(), methods.end(), MethodName(method)) != methods.end();
 }
 
-void NavigationExperimentConfig::Validate(const std::string& path) const {
-  const NavigationExperimentConfig& c = *this;
+void ExperimentConfig::Validate(const std::string& path) const {
+  const ExperimentConfig& c = *this;
   FS_THROW_UNLESS(c.model == "navigation", path, ": model: '", c.model, "', expected 'navigation'");
   FS_THROW_UNLESS(!c.methods.empty(), path, ": methods: empty list");
   for (std::size_t i = 0; i < c.methods.size(); ++i) {
     const std::string& m = c.methods[i];
-    (void)ParseNavigationMethod(m, path + ": methods");
+    (void)ParseMethod(m, path + ": methods");
     FS_THROW_UNLESS(std::find(c.methods.begin(), c.methods.begin() + static_cast<long>(i), m) ==
                         c.methods.begin() + static_cast<long>(i),
                     path, ": methods: '", m, "' listed twice");
@@ -76,7 +76,7 @@ void NavigationExperimentConfig::Validate(const std::string& path) const {
   FS_THROW_UNLESS(orca_problems.empty(), path, ": orca: ", orca_problems);
   FS_THROW_UNLESS(c.predictor.tracks == "scenario" || c.predictor.tracks == "replay", path,
                   ": predictor.tracks: '", c.predictor.tracks, "', expected scenario or replay");
-  (void)ParseNavigationMethod(c.video.method, path + ": video.method");
+  (void)ParseMethod(c.video.method, path + ": video.method");
   c.scenario.Validate(path + ": scenario");
   // Sizes the config implies, checked before anything is allocated: the rasters of the scenario's
   // extent (obstacle sampling and swept-occupancy field) and the recorded training crowd.
@@ -101,4 +101,4 @@ void NavigationExperimentConfig::Validate(const std::string& path) const {
   }
 }
 
-}  // namespace foresight
+}  // namespace foresight::nav

@@ -13,10 +13,10 @@
 #include "inference/navigation/orca.h"
 #include "inference/navigation/span_controller.h"
 
-namespace foresight {
+namespace foresight::nav {
 
 /// The SPAN predictor used by the controller.
-struct NavigationPredictorConfig {
+struct PredictorConfig {
   /// SPAN artifact (model.h5). When it does not exist, `foresight navigate` trains one there first
   /// (LibTorch builds): tracks from `tracks`, then the SPAN config `train_config` on them.
   std::string artifact = "runs/navigation_predictor/model.h5";
@@ -52,12 +52,12 @@ struct NavigationPredictorConfig {
   }
 };
 
-enum class NavigationMapKind { kFastBhm, kGrid };
+enum class MapKind { kFastBhm, kGrid };
 
 /// The static occupancy map: an artifact, or built from the scenario's obstacles.
-struct NavigationMapConfig {
+struct MapConfig {
   std::string artifact;  ///< occupancy-map artifact; empty: build DIR/map.h5 from the scenario
-  NavigationMapKind kind = NavigationMapKind::kFastBhm;
+  MapKind kind = MapKind::kFastBhm;
   double raster_resolution = 0.1;  ///< m, scenario obstacles sampled at this step (labelled points)
   double spacing = 0.25;  ///< m, Fast-BHM inducing-point spacing (gamma scales as spacing^-2)
   double field_resolution = 0.05;  ///< m, raster of the swept occupancy used by the controllers
@@ -66,10 +66,10 @@ struct NavigationMapConfig {
   void Serialize(A* a) {
     a->Visit("artifact", &artifact, config::Range::Any(),
              "occupancy-map artifact; empty: build from the scenario");
-    a->VisitEnum("kind", &kind,
-                 config::EnumNames<NavigationMapKind>{{NavigationMapKind::kFastBhm, "fast_bhm"},
-                                                      {NavigationMapKind::kGrid, "grid"}},
-                 "map built from the scenario");
+    a->VisitEnum(
+        "kind", &kind,
+        config::EnumNames<MapKind>{{MapKind::kFastBhm, "fast_bhm"}, {MapKind::kGrid, "grid"}},
+        "map built from the scenario");
     a->Visit("raster_resolution", &raster_resolution, config::Range::Closed(0.01, 1.0),
              "sampling step of the scenario obstacles (m)");
     a->Visit("spacing", &spacing, config::Range::Closed(0.05, 2.0),
@@ -151,13 +151,13 @@ struct OrcaConfig {
 };
 
 /// The controllers a navigation experiment compares. Configs name them (`methods: [span, ...]`);
-/// ParseNavigationMethod is the one place a name becomes a method.
-enum class NavigationMethod { kSpan, kReactive, kClRrtStar, kOrca };
-const char* MethodName(NavigationMethod method);
+/// ParseMethod is the one place a name becomes a method.
+enum class Method { kSpan, kReactive, kClRrtStar, kOrca };
+const char* MethodName(Method method);
 /// The method called `name`; an unknown name is an Error naming `where` and the known names.
-NavigationMethod ParseNavigationMethod(const std::string& name, const std::string& where);
+Method ParseMethod(const std::string& name, const std::string& where);
 
-struct NavigationVideoConfig {
+struct VideoConfig {
   bool enabled = true;
   std::string method = "span";  ///< whose episode is filmed
   int episode = 0;
@@ -174,12 +174,12 @@ struct NavigationVideoConfig {
   }
 };
 
-struct NavigationExperimentConfig {
+struct ExperimentConfig {
   std::string model = "navigation";
   std::int64_t seed = 0;
   CrowdScenarioConfig scenario;
-  NavigationPredictorConfig predictor;
-  NavigationMapConfig map;
+  PredictorConfig predictor;
+  MapConfig map;
   std::vector<std::string> methods{"span", "reactive", "cl_rrt_star"};
   int episodes = 20;
   double max_time = 60;                 ///< s per episode
@@ -191,7 +191,7 @@ struct NavigationExperimentConfig {
   ReactiveControllerConfig reactive;
   ClRrtStarConfig cl_rrt_star;
   OrcaConfig orca;
-  NavigationVideoConfig video;
+  VideoConfig video;
 
   template <class A>
   void Serialize(A* a) {
@@ -222,12 +222,12 @@ struct NavigationExperimentConfig {
   /// Scenario and method checks; errors name `path` and the key.
   void Validate(const std::string& path) const;
   /// `methods` as methods (Validate has checked the names).
-  std::vector<NavigationMethod> Methods() const;
-  bool Uses(NavigationMethod method) const;
+  std::vector<Method> Methods() const;
+  bool Uses(Method method) const;
 };
 
 /// The ORCA controller's options of an experiment: the `orca` block with dt, the scenario's radii,
 /// span.epsilon (static threshold) and the control limits.
-nav::OrcaControllerOptions MakeOrcaControllerOptions(const NavigationExperimentConfig& config);
+nav::OrcaControllerOptions MakeOrcaControllerOptions(const ExperimentConfig& config);
 
-}  // namespace foresight
+}  // namespace foresight::nav

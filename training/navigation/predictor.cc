@@ -12,12 +12,11 @@
 #include "training/span/eval.h"
 #include "training/span/pipeline.h"
 
-namespace foresight {
+namespace foresight::nav {
 namespace fs = std::filesystem;
 
-std::string EnsureNavigationPredictor(const NavigationExperimentConfig& c,
-                                      const std::string& embedded_default) {
-  const NavigationPredictorConfig& p = c.predictor;
+std::string EnsurePredictor(const ExperimentConfig& c, const std::string& embedded_default) {
+  const PredictorConfig& p = c.predictor;
   if (fs::exists(p.artifact)) return p.artifact;
   const fs::path artifact(p.artifact);
   FS_THROW_UNLESS(artifact.filename() == "model.h5", "predictor.artifact: ", p.artifact,
@@ -82,4 +81,4 @@ std::string EnsureNavigationPredictor(const NavigationExperimentConfig& c,
   return out;
 }
 
-}  // namespace foresight
+}  // namespace foresight::nav

@@ -8,13 +8,12 @@
 
 #include "training/navigation/config.h"
 
-namespace foresight {
+namespace foresight::nav {
 
 /// Ensures config.predictor.artifact exists (trains it in its directory, which must be the run
 /// directory of a SPAN run: the artifact is named model.h5). A killed training resumes from its
 /// last checkpoint. @return the artifact path.
 /// @param embedded_default SPAN config text used when predictor.train_config is "default".
-std::string EnsureNavigationPredictor(const NavigationExperimentConfig& config,
-                                      const std::string& embedded_default);
+std::string EnsurePredictor(const ExperimentConfig& config, const std::string& embedded_default);
 
-}  // namespace foresight
+}  // namespace foresight::nav

@@ -8,7 +8,7 @@
 #include "core/error.h"
 #include "training/image_io.h"
 
-namespace foresight {
+namespace foresight::nav {
 
 namespace {
 const cv::Scalar kRobot(40, 40, 220), kGoal(60, 170, 60), kPedestrian(110, 110, 110),
@@ -22,7 +22,7 @@ cv::Scalar MethodColour(const std::string& m) {
 }  // namespace
 
 VideoRecorder::VideoRecorder(const std::string& path, const OccupancyRaster& raster,
-                             const NavigationVideoConfig& config, double dt, std::uint64_t seed)
+                             const VideoConfig& config, double dt, std::uint64_t seed)
     : canvas_(raster, config.pixels_per_metre), config_(config), rng_(seed) {
   const cv::Mat bg = canvas_.Background();
   writer_.open(path, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 1.0 / dt, bg.size(), true);
@@ -68,8 +68,7 @@ void VideoRecorder::Frame(double time, const nav::UnicycleState& robot, const Ei
 }
 
 void DrawPaths(const std::string& path, const OccupancyRaster& raster,
-               const NavigationExperimentConfig& config,
-               const std::vector<EpisodeResult>& results) {
+               const ExperimentConfig& config, const std::vector<EpisodeResult>& results) {
   const MapCanvas canvas(
       raster, std::min(40.0, 1200.0 / std::max(raster.extent[1] - raster.extent[0], 1.0)));
   cv::Mat img = canvas.Background();
@@ -93,4 +92,4 @@ void DrawPaths(const std::string& path, const OccupancyRaster& raster,
   WriteImage(path, img);
 }
 
-}  // namespace foresight
+}  // namespace foresight::nav

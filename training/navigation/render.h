@@ -11,13 +11,13 @@
 #include "training/map_canvas.h"
 #include "training/navigation/run.h"
 
-namespace foresight {
+namespace foresight::nav {
 
 class VideoRecorder final : public EpisodeRecorder {
  public:
   /// Opens `path` (an Error naming it when OpenCV cannot write the video).
-  VideoRecorder(const std::string& path, const OccupancyRaster& raster,
-                const NavigationVideoConfig& config, double dt, std::uint64_t seed);
+  VideoRecorder(const std::string& path, const OccupancyRaster& raster, const VideoConfig& config,
+                double dt, std::uint64_t seed);
   void Frame(double time, const nav::UnicycleState& robot, const Eigen::Vector2d& goal,
              const std::vector<CrowdAgent>& agents,
              const std::vector<TrajectoryDistribution>* predictions, int num_predictions,
@@ -26,7 +26,7 @@ class VideoRecorder final : public EpisodeRecorder {
 
  private:
   MapCanvas canvas_;
-  NavigationVideoConfig config_;
+  VideoConfig config_;
   cv::VideoWriter writer_;
   std::mt19937_64 rng_;
   Eigen::VectorXd times_;
@@ -36,6 +36,6 @@ class VideoRecorder final : public EpisodeRecorder {
 
 /// Every episode's path per method (one colour each) over the map, with starts and goals.
 void DrawPaths(const std::string& path, const OccupancyRaster& raster,
-               const NavigationExperimentConfig& config, const std::vector<EpisodeResult>& results);
+               const ExperimentConfig& config, const std::vector<EpisodeResult>& results);
 
-}  // namespace foresight
+}  // namespace foresight::nav

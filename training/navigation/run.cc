@@ -25,21 +25,21 @@
 #include "models/occupancy/raster_map.h"
 #include "training/navigation/render.h"
 
-namespace foresight {
+namespace foresight::nav {
 namespace fs = std::filesystem;
 
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-bool UsesPredictor(const NavigationExperimentConfig& c) { return c.Uses(NavigationMethod::kSpan); }
+bool UsesPredictor(const ExperimentConfig& c) { return c.Uses(Method::kSpan); }
 
 /// Fast-BHM (or grid) map of the scenario's obstacles, saved as an artifact at `path`.
-void BuildScenarioMap(const NavigationExperimentConfig& c, const OccupancyRaster& raster,
+void BuildScenarioMap(const ExperimentConfig& c, const OccupancyRaster& raster,
                       const std::string& path) {
   occupancy::RasterMapOptions o;
-  o.kind = c.map.kind == NavigationMapKind::kGrid ? occupancy::RasterMapKind::kGrid
-                                                  : occupancy::RasterMapKind::kFastBhm;
+  o.kind = c.map.kind == MapKind::kGrid ? occupancy::RasterMapKind::kGrid
+                                        : occupancy::RasterMapKind::kFastBhm;
   o.sample_step = c.map.raster_resolution;
   o.spacing = c.map.spacing;
   o.margin = 1.0;
@@ -71,7 +71,7 @@ bool CellOf(const OccupancyRaster& r, double x, double y, int* row, int* col) {
 }
 
 /// Breadth-first search over raster cells with clearance > radius.
-bool Reachable(const NavigationResources& res, const Eigen::Vector2d& a, const Eigen::Vector2d& b,
+bool Reachable(const Resources& res, const Eigen::Vector2d& a, const Eigen::Vector2d& b,
                double radius) {
   int r0, c0, r1, c1;
   if (!CellOf(res.raster, a.x(), a.y(), &r0, &c0) || !CellOf(res.raster, b.x(), b.y(), &r1, &c1))
@@ -107,9 +107,8 @@ double Percentile(std::vector<double> v, double q) {
   return v[lo] + (pos - static_cast<double>(lo)) * (v[hi] - v[lo]);
 }
 
-std::unique_ptr<nav::NavigationController> MakeController(const NavigationExperimentConfig& c,
-                                                          const NavigationResources& res,
-                                                          NavigationMethod method,
+std::unique_ptr<nav::NavigationController> MakeController(const ExperimentConfig& c,
+                                                          const Resources& res, Method method,
                                                           std::uint64_t seed) {
   nav::ControlLimits limits{-c.v_max, c.v_max, c.omega_max};
   nav::SpanControllerOptions o = c.span.options;
@@ -118,12 +117,12 @@ std::unique_ptr<nav::NavigationController> MakeController(const NavigationExperi
   o.pedestrian_radius = c.scenario.pedestrian_radius;
   o.limits = limits;
   switch (method) {
-    case NavigationMethod::kSpan:
+    case Method::kSpan:
       return std::make_unique<nav::SpanController>(res.predictor.get(), res.field.get(), o);
-    case NavigationMethod::kReactive:
+    case Method::kReactive:
       return std::make_unique<nav::ReactiveController>(res.field.get(), o,
                                                        c.reactive.heading_weight);
-    case NavigationMethod::kClRrtStar: {
+    case Method::kClRrtStar: {
       nav::ClRrtStarOptions r = c.cl_rrt_star.options;
       r.robot_radius = o.robot_radius;
       r.pedestrian_radius = o.pedestrian_radius;
@@ -132,7 +131,7 @@ std::unique_ptr<nav::NavigationController> MakeController(const NavigationExperi
       return std::make_unique<nav::ClRrtStarController>(res.field.get(), res.raster.extent, r,
                                                         seed);
     }
-    case NavigationMethod::kOrca:
+    case Method::kOrca:
       return std::make_unique<nav::OrcaController>(res.field.get(), MakeOrcaControllerOptions(c));
   }
   Fail("navigation: method ", static_cast<int>(method), " has no controller");
@@ -169,16 +168,15 @@ RateInterval WilsonInterval(int k, int n, double z) {
   return {std::max(0.0, centre - half), std::min(1.0, centre + half)};
 }
 
-double NavigationResources::StaticDistance(double x, double y) const {
+double Resources::StaticDistance(double x, double y) const {
   int r, c;
   if (!CellOf(raster, x, y, &r, &c)) return 0.0;
   return static_distance(r, c);
 }
 
-NavigationResources PrepareNavigation(const NavigationExperimentConfig& c,
-                                      const std::string& out_dir) {
+Resources PrepareNavigation(const ExperimentConfig& c, const std::string& out_dir) {
   c.Validate("navigation config");  // configs built in code get the same checks as loaded ones
-  NavigationResources res;
+  Resources res;
   res.raster = ScenarioOccupancy(c.scenario, 0.05);
   res.static_distance = DistanceToObstacles(res.raster);
   std::string map_path = c.map.artifact;
@@ -202,8 +200,8 @@ NavigationResources PrepareNavigation(const NavigationExperimentConfig& c,
   return res;
 }
 
-EpisodeResult RunEpisode(const NavigationExperimentConfig& c, const NavigationResources& res,
-                         NavigationMethod method, int episode, EpisodeRecorder* recorder) {
+EpisodeResult RunEpisode(const ExperimentConfig& c, const Resources& res, Method method,
+                         int episode, EpisodeRecorder* recorder) {
   EpisodeResult out;
   out.method = MethodName(method);
   out.episode = episode;
@@ -395,7 +393,7 @@ MethodSummary Summarise(const std::string& method, const std::vector<EpisodeResu
   return m;
 }
 
-std::string SummaryJson(const NavigationExperimentConfig& c, int episodes,
+std::string SummaryJson(const ExperimentConfig& c, int episodes,
                         const std::vector<MethodSummary>& s) {
   std::ostringstream j;
   std::string name;
@@ -432,11 +430,11 @@ std::string SummaryJson(const NavigationExperimentConfig& c, int episodes,
   return j.str();
 }
 
-std::vector<MethodSummary> RunNavigation(const NavigationExperimentConfig& c,
-                                         const std::string& out_dir, int episodes) {
+std::vector<MethodSummary> RunNavigation(const ExperimentConfig& c, const std::string& out_dir,
+                                         int episodes) {
   fs::create_directories(out_dir);
   const int n = episodes > 0 ? episodes : c.episodes;
-  const NavigationResources res = PrepareNavigation(c, out_dir);
+  const Resources res = PrepareNavigation(c, out_dir);
   // Every episode's start and goal must be free and connected on the static map.
   for (int e = 0; e < n; ++e) {
     const EpisodeEndpoints ends =
@@ -472,7 +470,7 @@ std::vector<MethodSummary> RunNavigation(const NavigationExperimentConfig& c,
   std::ostringstream csv;
   csv << "method,episode,seed,reached,ttg,doc,doc_static,min_clearance,path_length,cycles,solve_"
          "failures,cycle_ms_median,cycle_ms_p99,robot_caused_doc\n";
-  for (const NavigationMethod method : c.Methods()) {
+  for (const Method method : c.Methods()) {
     for (int e = 0; e < n; ++e) {
       std::unique_ptr<VideoRecorder> video;
       if (c.video.enabled && MethodName(method) == c.video.method && e == c.video.episode)
@@ -497,4 +495,4 @@ std::vector<MethodSummary> RunNavigation(const NavigationExperimentConfig& c,
   return summaries;
 }
 
-}  // namespace foresight
+}  // namespace foresight::nav

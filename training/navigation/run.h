@@ -19,11 +19,11 @@
 #include "training/navigation/config.h"
 #include "training/run_dir.h"
 
-namespace foresight {
+namespace foresight::nav {
 
 /// What every episode shares: the static map (through its artifact), the swept field, the
 /// ground-truth obstacle raster (for collision metrics) and the predictor.
-struct NavigationResources {
+struct Resources {
   std::unique_ptr<occupancy::Map> map;
   std::unique_ptr<nav::StaticCollisionField> field;
   OccupancyRaster raster;
@@ -36,8 +36,7 @@ struct NavigationResources {
 /// Builds DIR/map.h5 from the scenario (or loads map.artifact), and loads predictor.artifact when a
 /// method needs it. Wrong artifact kinds, a start or goal in collision or an unreachable goal (no
 /// free path on the static raster) are Errors naming the config key.
-NavigationResources PrepareNavigation(const NavigationExperimentConfig& config,
-                                      const std::string& out_dir);
+Resources PrepareNavigation(const ExperimentConfig& config, const std::string& out_dir);
 
 struct EpisodeResult {
   std::string method;
@@ -91,9 +90,8 @@ class EpisodeRecorder {
 
 /// Runs one episode of `method` (span | reactive | cl_rrt_star | orca). Never throws from the
 /// control loop.
-EpisodeResult RunEpisode(const NavigationExperimentConfig& config,
-                         const NavigationResources& resources, NavigationMethod method, int episode,
-                         EpisodeRecorder* recorder = nullptr);
+EpisodeResult RunEpisode(const ExperimentConfig& config, const Resources& resources, Method method,
+                         int episode, EpisodeRecorder* recorder = nullptr);
 
 struct MethodSummary {
   std::string method;
@@ -119,15 +117,15 @@ struct MethodSummary {
 MethodSummary Summarise(const std::string& method, const std::vector<EpisodeResult>& results);
 
 /// What shows a navigation run in a directory (episodes run in one pass: no resume).
-inline const RunDirectoryRules kNavigationRunRules{{"summary.json", "episodes.csv"}, false};
+inline const RunDirectoryRules kRunRules{{"summary.json", "episodes.csv"}, false};
 
 /// Runs every method for `episodes` episodes (config.episodes when <= 0) into `out_dir`.
 /// @return the summaries, in config.methods order.
-std::vector<MethodSummary> RunNavigation(const NavigationExperimentConfig& config,
-                                         const std::string& out_dir, int episodes = 0);
+std::vector<MethodSummary> RunNavigation(const ExperimentConfig& config, const std::string& out_dir,
+                                         int episodes = 0);
 
 /// summary.json text: {"scenario": ..., "episodes": N, "<method>": {...}, ...}.
-std::string SummaryJson(const NavigationExperimentConfig& config, int episodes,
+std::string SummaryJson(const ExperimentConfig& config, int episodes,
                         const std::vector<MethodSummary>& s);
 
-}  // namespace foresight
+}  // namespace foresight::nav
