@@ -16,8 +16,17 @@ void SelectedInverter::Compute(const SparseCholesky& llt) {
   FS_THROW_UNLESS(l.isCompressed(), "selected inverse: the factor L is not compressed");
   const int n = static_cast<int>(l.cols());
   const auto nnz = static_cast<std::size_t>(l.nonZeros());
-  outer_.assign(l.outerIndexPtr(), l.outerIndexPtr() + n + 1);
-  inner_.assign(l.innerIndexPtr(), l.innerIndexPtr() + nnz);
+  const bool same_pattern = static_cast<int>(outer_.size()) == n + 1 && inner_.size() == nnz &&
+                            std::equal(outer_.begin(), outer_.end(), l.outerIndexPtr()) &&
+                            std::equal(inner_.begin(), inner_.end(), l.innerIndexPtr());
+  if (!same_pattern) {
+    outer_.assign(l.outerIndexPtr(), l.outerIndexPtr() + n + 1);
+    inner_.assign(l.innerIndexPtr(), l.innerIndexPtr() + nnz);
+    for (int j = 0; j < n; ++j)
+      FS_THROW_UNLESS(outer_[j + 1] > outer_[j] && inner_[outer_[j]] == j,
+                      "selected inverse: column ", j, " of L does not start with its diagonal");
+    FindSupernodes();
+  }
   const double* lx = l.valuePtr();
   perm_.resize(n);
   pinv_.resize(n);
@@ -26,39 +35,64 @@ void SelectedInverter::Compute(const SparseCholesky& llt) {
   for (int i = 0; i < n; ++i) pinv_[perm_[i]] = i;
   z_.assign(nnz, 0.0);
   pos_.assign(n, -1);
-  acc_.resize(n);
   log_det_ = 0;
-  for (int j = n - 1; j >= 0; --j) {
-    const int begin = outer_[j], end = outer_[j + 1];
-    FS_THROW_UNLESS(end > begin && inner_[begin] == j, "selected inverse: column ", j,
-                    " of L does not start with its diagonal");
-    const double ljj = lx[begin];
-    log_det_ += 2.0 * std::log(ljj);
-    const int m = end - begin - 1;  // off-diagonal rows r_a = inner_[begin + 1 + a]
-    for (int a = 0; a < m; ++a) {
-      pos_[inner_[begin + 1 + a]] = a;
-      acc_[a] = 0.0;
+  for (int j = 0; j < n; ++j) log_det_ += 2.0 * std::log(lx[outer_[j]]);
+  // Supernodes from the last to the first: J = columns [c0, c1] share the rows S below them.
+  for (std::size_t sn = supernode_start_.size() - 1; sn-- > 0;) {
+    const int c0 = supernode_start_[sn], c1 = supernode_start_[sn + 1] - 1, s = c1 - c0 + 1;
+    const int s_begin = outer_[c1] + 1, r = outer_[c1 + 1] - s_begin;  // S = inner_[s_begin..]
+    // Dense blocks of L: L_JJ (s x s lower) and L_SJ (r x s).
+    ljj_.setZero(s, s);
+    lsj_.resize(r, s);
+    for (int k = 0; k < s; ++k) {
+      const int col = outer_[c0 + k];
+      for (int i = k; i < s; ++i) ljj_(i, k) = lx[col + (i - k)];
+      for (int t = 0; t < r; ++t) lsj_(t, k) = lx[col + (s - k) + t];
     }
-    // acc[b] = sum_a Z(r_b, r_a) L(r_a, j): scan column k = r_a of Z (rows >= k).
-    for (int a = 0; a < m; ++a) {
-      const int k = inner_[begin + 1 + a];
-      const double lkj = lx[begin + 1 + a];
+    // Z_SS (already final: every row of S is after J), gathered from the columns of S.
+    zss_.setZero(r, r);
+    for (int t = 0; t < r; ++t) pos_[inner_[s_begin + t]] = t;
+    for (int a = 0; a < r; ++a) {
+      const int k = inner_[s_begin + a];
       for (int q = outer_[k]; q < outer_[k + 1]; ++q) {
         const int b = pos_[inner_[q]];
-        if (b < 0) continue;
-        acc_[b] += z_[q] * lkj;                            // Z(r_b, k) L(k, j), b >= a
-        if (b != a) acc_[a] += z_[q] * lx[begin + 1 + b];  // Z(k, r_b) L(r_b, j), b > a
+        if (b >= 0) zss_(b, a) = zss_(a, b) = z_[q];
       }
     }
-    double diag = 1.0 / ljj;
-    for (int a = 0; a < m; ++a) {
-      const double zij = -acc_[a] / ljj;
-      z_[begin + 1 + a] = zij;
-      diag -= zij * lx[begin + 1 + a];
-      pos_[inner_[begin + 1 + a]] = -1;
+    for (int t = 0; t < r; ++t) pos_[inner_[s_begin + t]] = -1;
+    // U = L_SJ L_JJ^-1; Z_SJ = -Z_SS U; Z_JJ = L_JJ^-T L_JJ^-1 - U' Z_SJ (block Takahashi).
+    const auto tri = ljj_.triangularView<Eigen::Lower>();
+    zjj_.setIdentity(s, s);
+    tri.solveInPlace(zjj_);                   // L_JJ^-1
+    zjj_ = (zjj_.transpose() * zjj_).eval();  // L_JJ^-T L_JJ^-1
+    if (r > 0) {                              // (Eigen's solvers touch the data of an empty matrix)
+      u_ = lsj_;
+      tri.solveInPlace<Eigen::OnTheRight>(u_);
+      zsj_.noalias() = -zss_ * u_;
+      zjj_.noalias() -= u_.transpose() * zsj_;
     }
-    z_[begin] = diag / ljj;
+    for (int k = 0; k < s; ++k) {
+      const int col = outer_[c0 + k];
+      for (int i = k; i < s; ++i) z_[col + (i - k)] = zjj_(i, k);
+      for (int t = 0; t < r; ++t) z_[col + (s - k) + t] = zsj_(t, k);
+    }
   }
+}
+
+void SelectedInverter::FindSupernodes() {
+  // Columns c and c + 1 share a supernode when struct(L_:c) = {c} + struct(L_:c+1): then every
+  // column of the run has the rows of the run below it (a dense triangle) and the same rows S.
+  const int n = static_cast<int>(outer_.size()) - 1;
+  supernode_start_.clear();
+  for (int c = 0; c < n; ++c) {
+    const bool joins_previous = c > 0 &&
+                                outer_[c] - outer_[c - 1] == outer_[c + 1] - outer_[c] + 1 &&
+                                inner_[outer_[c - 1] + 1] == c &&
+                                std::equal(inner_.begin() + outer_[c - 1] + 1,
+                                           inner_.begin() + outer_[c], inner_.begin() + outer_[c]);
+    if (!joins_previous) supernode_start_.push_back(c);
+  }
+  supernode_start_.push_back(n);
 }
 
 std::ptrdiff_t SelectedInverter::Slot(int i, int j) const {

@@ -7,9 +7,13 @@
 ///   Z_ij = -(1 / L_jj) sum_{k > j, k in struct(L_:j)} Z_ik L_kj
 ///   Z_jj = (1 / L_jj) (1 / L_jj - sum_{k > j, k in struct(L_:j)} Z_kj L_kj),
 /// and every Z_ik needed lies in the pattern of L (struct(L_:j) is a clique of the filled graph).
-/// Cost ~ sum_j |struct(L_:j)| * |struct(L_:k)|, memory nnz(L). Sigma_ij = Z_{p(i) p(j)}, where
-/// p is the fill-reducing permutation (P x)[p(i)] = x[i].
+/// Columns with nested structure (supernodes J, rows S below them shared) are done as dense blocks:
+///   U = L_SJ L_JJ^-1,  Z_SJ = -Z_SS U,  Z_JJ = L_JJ^-T L_JJ^-1 - U' Z_SJ
+/// (the same identity for a block of columns), so Z_SS is gathered once per supernode and the rest
+/// is dense triangular solves and products. Cost ~ sum_J (|S_J|^2 |J| + gather), memory nnz(L).
+/// Sigma_ij = Z_{p(i) p(j)}, where p is the fill-reducing permutation (P x)[p(i)] = x[i].
 
+#include <Eigen/Core>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 #include <cstddef>
@@ -57,11 +61,14 @@ class SelectedInverter {
   SelectedInverse ToSparse() const;
 
  private:
-  std::vector<int> outer_, inner_;  // pattern of L (diagonal first, rows ascending)
-  std::vector<int> perm_, pinv_;    // perm_[orig] = permuted index; pinv_ its inverse
-  std::vector<double> z_;           // Z on the pattern of L
-  std::vector<int> pos_;            // scatter: row -> position in the current column, or -1
-  std::vector<double> acc_;
+  void FindSupernodes();  // supernode_start_ from the pattern of L
+
+  std::vector<int> outer_, inner_;    // pattern of L (diagonal first, rows ascending)
+  std::vector<int> supernode_start_;  // first column of each supernode, then n
+  std::vector<int> perm_, pinv_;      // perm_[orig] = permuted index; pinv_ its inverse
+  std::vector<double> z_;             // Z on the pattern of L
+  std::vector<int> pos_;              // scatter: row -> position in the current column, or -1
+  Eigen::MatrixXd ljj_, lsj_, zss_, u_, zsj_, zjj_;  // dense blocks of one supernode
   double log_det_ = 0;
 };
 

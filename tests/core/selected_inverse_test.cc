@@ -58,6 +58,21 @@ Eigen::MatrixXd GridLaplacian(int nx, int ny, double shift) {
   return a;
 }
 
+/// SPD matrix coupling every pair of nodes of an nx x ny grid within `reach` cells (Chebyshev),
+/// with random weights, diagonally dominant by `shift`.
+Eigen::MatrixXd WideGrid(int nx, int ny, int reach, double shift) {
+  std::mt19937_64 rng(static_cast<std::uint64_t>(nx * 100 + ny * 10 + reach));
+  std::uniform_real_distribution<double> u(0.1, 1.0);
+  const int n = nx * ny;
+  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(n, n);
+  for (int i = 0; i < n; ++i)
+    for (int j = i + 1; j < n; ++j)
+      if (std::abs(i % nx - j % nx) <= reach && std::abs(i / nx - j / nx) <= reach)
+        a(i, j) = a(j, i) = -u(rng);
+  for (int i = 0; i < n; ++i) a(i, i) = a.row(i).cwiseAbs().sum() + shift;
+  return a;
+}
+
 /// Every entry of the selected inverse equals the dense inverse, the pattern covers the diagonal
 /// and the pattern of A, and QuadraticForm matches phi' Sigma phi.
 void CheckAgainstDense(const Eigen::MatrixXd& a) {
@@ -111,6 +126,36 @@ TEST(SelectedInverse, RandomSparseSpdMatchesDenseInverse) {
 
 TEST(SelectedInverse, GridLaplacianMatchesDenseInverse) {
   CheckAgainstDense(GridLaplacian(9, 7, 0.05));
+}
+
+// Supernodes of every size: a dense matrix (one supernode), a wide-stencil grid (the coupled
+// BHM's precision: every pair within 2 cells), a banded matrix, and a reused inverter on a second
+// factor of the same pattern (the EM loop) and of another pattern.
+TEST(SelectedInverse, SupernodalBlocksMatchDenseInverse) {
+  CheckAgainstDense(RandomSparseSpd(25, 1.0, 7));
+  CheckAgainstDense(WideGrid(12, 9, 2, 0.1));
+  CheckAgainstDense(WideGrid(30, 1, 3, 0.01));  // a band: one chain of supernodes
+}
+
+TEST(SelectedInverse, AReusedInverterFollowsNewValuesAndNewPatterns) {
+  SelectedInverter inverter;
+  for (const Eigen::MatrixXd& a : {WideGrid(8, 6, 2, 0.1), WideGrid(8, 6, 2, 3.0),
+                                   RandomSparseSpd(30, 0.1, 3), WideGrid(8, 6, 2, 0.1)}) {
+    const SparseCholesky llt(LowerOf(a));
+    ASSERT_EQ(llt.info(), Eigen::Success);
+    inverter.Compute(llt);
+    const Eigen::MatrixXd inv = a.inverse();
+    const double scale = inv.cwiseAbs().maxCoeff();
+    for (int j = 0; j < a.cols(); ++j) {
+      for (int i = j; i < a.rows(); ++i) {
+        if (a(i, j) == 0 && i != j) continue;
+        const std::ptrdiff_t slot = inverter.Slot(i, j);
+        ASSERT_GE(slot, 0) << "(" << i << ", " << j << ")";
+        EXPECT_NEAR(inverter.values()[slot], inv(i, j), 1e-12 * scale)
+            << "(" << i << ", " << j << ")";
+      }
+    }
+  }
 }
 
 TEST(SelectedInverse, OneByOne) {
