@@ -49,14 +49,19 @@ double MatrixNormalMixture::LogPdf(const Eigen::MatrixXd& w) const {
   return LogSumExp(terms);
 }
 
+double SquaredMahalanobis2(const Eigen::Vector2d& x, const Eigen::Vector2d& mu,
+                           const Eigen::Matrix2d& cov) {
+  const double det = cov(0, 0) * cov(1, 1) - cov(0, 1) * cov(1, 0);
+  const Eigen::Vector2d d = x - mu;
+  return (d[0] * (cov(1, 1) * d[0] - cov(0, 1) * d[1]) +
+          d[1] * (-cov(1, 0) * d[0] + cov(0, 0) * d[1])) /
+         det;
+}
+
 double LogGaussian2(const Eigen::Vector2d& x, const Eigen::Vector2d& mu,
                     const Eigen::Matrix2d& cov) {
   const double det = cov(0, 0) * cov(1, 1) - cov(0, 1) * cov(1, 0);
-  const Eigen::Vector2d d = x - mu;
-  const double q = (d[0] * (cov(1, 1) * d[0] - cov(0, 1) * d[1]) +
-                    d[1] * (-cov(1, 0) * d[0] + cov(0, 0) * d[1])) /
-                   det;
-  return -0.5 * q - std::log(2.0 * M_PI) - 0.5 * std::log(det);
+  return -0.5 * SquaredMahalanobis2(x, mu, cov) - std::log(2.0 * M_PI) - 0.5 * std::log(det);
 }
 
 }  // namespace foresight

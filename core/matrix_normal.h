@@ -34,6 +34,12 @@ struct MatrixNormalMixture {
   double LogPdf(const Eigen::MatrixXd& w) const;
 };
 
+/// (x - mu)' Sigma^-1 (x - mu) for a 2-d Gaussian; x lies inside the k-sigma ellipse when it is
+/// <= k^2, which a calibrated forecast gives with probability 1 - exp(-k^2 / 2) (39.3 % for k = 1,
+/// 86.5 % for k = 2).
+double SquaredMahalanobis2(const Eigen::Vector2d& x, const Eigen::Vector2d& mu,
+                           const Eigen::Matrix2d& cov);
+
 /// log N(x; mu, Sigma) for a 2-d Gaussian.
 double LogGaussian2(const Eigen::Vector2d& x, const Eigen::Vector2d& mu,
                     const Eigen::Matrix2d& cov);

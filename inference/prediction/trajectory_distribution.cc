@@ -50,6 +50,20 @@ Eigen::Vector2d TrajectoryDistribution::MeanPosition(double t) const {
   return out;
 }
 
+void TrajectoryDistribution::MixturePosition(double t, Eigen::Vector2d* mean,
+                                             Eigen::Matrix2d* cov) const {
+  mean->setZero();
+  cov->setZero();
+  Eigen::Vector2d mu_r;
+  Eigen::Matrix2d cov_r;
+  for (int r = 0; r < components(); ++r) {
+    Position(t, r, &mu_r, &cov_r);
+    *mean += alpha_[r] * mu_r;
+    cov->noalias() += alpha_[r] * (cov_r + mu_r * mu_r.transpose());
+  }
+  cov->noalias() -= *mean * mean->transpose();
+}
+
 double TrajectoryDistribution::LogDensity(double t, const Eigen::Vector2d& x) const {
   double mx = -INFINITY;
   double terms[64];

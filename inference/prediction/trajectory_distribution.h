@@ -39,6 +39,9 @@ class TrajectoryDistribution {
   void Position(double t, int r, Eigen::Vector2d* mean, Eigen::Matrix2d* cov) const;
   /// Mixture mean position at time t (world, m).
   Eigen::Vector2d MeanPosition(double t) const;
+  /// Mean [2] and covariance [2 x 2] of the mixture's position at time t (world, m): the moments
+  /// of the mixture, sum_r alpha_r (Sigma_r + mu_r mu_r') - mu mu' (exact for one component).
+  void MixturePosition(double t, Eigen::Vector2d* mean, Eigen::Matrix2d* cov) const;
   /// log density of the observed position x at time t under the mixture.
   double LogDensity(double t, const Eigen::Vector2d& x) const;
   /// Samples one trajectory at `times` [T] into `path` [T x 2] (preallocated; no allocation).

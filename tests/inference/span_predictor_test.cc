@@ -127,6 +127,11 @@ TEST_P(SpanEngine, PositionAndSamplesAgreeWithTheMatrixNormal) {
     second += dist.alpha(r) * (cov + mu * mu.transpose());
   }
   const Eigen::Matrix2d cov_mix = second - mean * mean.transpose();
+  Eigen::Vector2d moment_mean;
+  Eigen::Matrix2d moment_cov;
+  dist.MixturePosition(t, &moment_mean, &moment_cov);
+  EXPECT_LT((moment_mean - mean).norm(), 1e-12 * (1 + mean.norm()));
+  EXPECT_LT((moment_cov - cov_mix).norm(), 1e-12 * (1 + cov_mix.norm()));
   std::mt19937_64 rng(5);
   Eigen::VectorXd times(1);
   times << t;

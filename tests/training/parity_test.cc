@@ -124,6 +124,18 @@ TEST(Pipeline, TrainExportEvalWritesEveryKey) {
        {"\"ade\"", "\"fde\"", "\"nll\"", "\"best_of_20_ade\"", "\"best_of_20_fde\"", "\"cv_ade\"",
         "\"cv_fde\"", "\"cv_nll\"", "\"cv_best_of_20_ade\"", "\"cv_best_of_20_fde\""})
     EXPECT_NE(ss.str().find(key), std::string::npos) << key;
+  EXPECT_NE(ss.str().find("\"calibration\": {\"horizon_s\": ["), std::string::npos) << ss.str();
+  // Calibration: a share per future step, in [0, 1], the 2-sigma ellipse holding at least as many.
+  for (const span::Metrics* m : {&r.model, &r.cv}) {
+    ASSERT_EQ(m->within_1sigma.size(), static_cast<std::size_t>(t->config.windows.predicted));
+    ASSERT_EQ(m->within_2sigma.size(), m->within_1sigma.size());
+    for (std::size_t k = 0; k < m->within_1sigma.size(); ++k) {
+      EXPECT_GE(m->within_1sigma[k], 0.0);
+      EXPECT_LE(m->within_1sigma[k], m->within_2sigma[k]);
+      EXPECT_LE(m->within_2sigma[k], 1.0);
+    }
+  }
+  EXPECT_NEAR(r.horizon_s.back(), t->config.windows.predicted * r.horizon_s.front(), 1e-12);
   EXPECT_TRUE(std::filesystem::exists(t->dir.File("plots/samples.png")));
   EXPECT_TRUE(std::isfinite(r.model.ade) && std::isfinite(r.model.nll) && std::isfinite(r.cv.nll));
   EXPECT_LE(r.model.best_of_n_ade, r.model.ade + 1e-9);

@@ -75,6 +75,13 @@ std::string Num(double v) {
   return std::isfinite(v) ? os.str() : "null";
 }
 
+/// A JSON array of numbers (null for non-finite entries).
+std::string NumList(const std::vector<double>& v) {
+  std::string out = "[";
+  for (std::size_t i = 0; i < v.size(); ++i) out += (i ? ", " : "") + Num(v[i]);
+  return out + "]";
+}
+
 /// `node` as one line of YAML flow text.
 std::string Flow(const YAML::Node& node) {
   YAML::Emitter e;
@@ -131,6 +138,13 @@ std::string EvalReport::ToJson(int num_samples) const {
      << "  \"cv_nll\": " << Num(cv.nll) << ",\n"
      << "  \"cv_best_of_20_ade\": " << Num(cv.best_of_n_ade) << ",\n"
      << "  \"cv_best_of_20_fde\": " << Num(cv.best_of_n_fde) << ",\n"
+     << "  \"calibration\": {\"horizon_s\": " << NumList(horizon_s)
+     << ", \"nominal_1sigma\": " << Num(1 - std::exp(-0.5))
+     << ", \"nominal_2sigma\": " << Num(1 - std::exp(-2.0))
+     << ",\n    \"within_1sigma\": " << NumList(model.within_1sigma)
+     << ",\n    \"within_2sigma\": " << NumList(model.within_2sigma)
+     << ",\n    \"cv_within_1sigma\": " << NumList(cv.within_1sigma)
+     << ",\n    \"cv_within_2sigma\": " << NumList(cv.within_2sigma) << "},\n"
      << "  \"val\": ";
   if (val_windows > 0) {
     os << "{\"windows\": " << val_windows << ", \"ade\": " << Num(val_model.ade)
@@ -167,6 +181,20 @@ EvalReport EvaluateOn(const std::string& artifact, const WindowSet& train, const
 
   EvalReport rep;
   rep.windows = count;
+  rep.horizon_s.assign(times.data(), times.data() + f);
+  for (Metrics* m : {&rep.model, &rep.cv}) {
+    m->within_1sigma.assign(static_cast<std::size_t>(f), 0.0);
+    m->within_2sigma.assign(static_cast<std::size_t>(f), 0.0);
+  }
+  // Counts a true position inside the 1- and 2-sigma ellipses of N(mean, cov) at step k.
+  const auto count_inside = [](Metrics* m, int k, const Eigen::Vector2d& x,
+                               const Eigen::Vector2d& mean, const Eigen::Matrix2d& cov) {
+    const double d2 = SquaredMahalanobis2(x, mean, cov);
+    m->within_1sigma[static_cast<std::size_t>(k)] += d2 <= 1.0;
+    m->within_2sigma[static_cast<std::size_t>(k)] += d2 <= 4.0;
+  };
+  Eigen::Vector2d mix_mean;
+  Eigen::Matrix2d mix_cov;
   Eigen::Matrix<double, Eigen::Dynamic, 2> path(f, 2), cv_path(f, 2);
   Eigen::Matrix<double, Eigen::Dynamic, 2> past(test.observed, 2);
   for (int n = 0; n < count; ++n) {
@@ -181,6 +209,9 @@ EvalReport EvaluateOn(const std::string& artifact, const WindowSet& train, const
       const Eigen::Matrix2d cov =
           frame.rotation * cv.cov_ego[static_cast<std::size_t>(k)] * frame.rotation.transpose();
       cv_nll -= LogGaussian2(test.Future(n, k), cv.Mean(test, n, k), cov);
+      dist.MixturePosition(times[k], &mix_mean, &mix_cov);
+      count_inside(&rep.model, k, test.Future(n, k), mix_mean, mix_cov);
+      count_inside(&rep.cv, k, test.Future(n, k), cv.Mean(test, n, k), cov);
     }
     rep.model.ade += Ade(path, test, n);
     rep.model.fde += Fde(path, test, n);
@@ -209,6 +240,8 @@ EvalReport EvaluateOn(const std::string& artifact, const WindowSet& train, const
   for (Metrics* m : {&rep.model, &rep.cv}) {
     const double d = count;
     m->ade /= d, m->fde /= d, m->nll /= d, m->best_of_n_ade /= d, m->best_of_n_fde /= d;
+    for (double& share : m->within_1sigma) share /= d;
+    for (double& share : m->within_2sigma) share /= d;
   }
   return rep;
 }
