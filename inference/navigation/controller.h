@@ -4,6 +4,7 @@
 /// a failed solve returns a stop command with a status other than kSolved and a message saying why.
 
 #include <Eigen/Core>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -35,8 +36,10 @@ struct ControlOutcome {
   ControlStatus status = ControlStatus::kSolved;  ///< not kSolved: the command stops the robot
   std::string message;  ///< why a cycle was not solved (empty when solved)
   int evaluations = 0;  ///< objective evaluations (SPAN, reactive) or planner iterations (CL-RRT*)
-  double tau = 0;       ///< time-to-collision of the chosen control (inf: none within the horizon)
-  double cost = 0;      ///< objective value of the chosen control
+  /// Time-to-collision of the chosen control (inf: none within the horizon; NaN: the controller
+  /// does not report one).
+  double tau = std::numeric_limits<double>::quiet_NaN();
+  double cost = 0;  ///< objective value of the chosen control
   bool solved() const { return status == ControlStatus::kSolved; }
   /// A stop command with `status` and `message`.
   static ControlOutcome Stop(ControlStatus status, std::string message);

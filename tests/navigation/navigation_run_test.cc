@@ -3,6 +3,7 @@
 // artifacts of the wrong kind).
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -77,12 +78,15 @@ TEST(NavigationRun, EveryMethodRunsAnEpisodeAndTheSummaryHasItsKeys) {
   for (const char* f : {"episodes.csv", "paths.png", "episode.avi", "map.h5"})
     EXPECT_TRUE(std::filesystem::exists(dir.File(f))) << f;
   EXPECT_GT(std::filesystem::file_size(dir.File("episode.avi")), 1000u);
-  // episodes.csv: the robot-caused DOC is the last column (readers by position keep working).
+  // episodes.csv: new columns are appended (readers by position keep working).
   std::ifstream csv(dir.File("episodes.csv"));
   std::string header;
   std::getline(csv, header);
-  EXPECT_EQ(header.substr(header.rfind(',') + 1), "robot_caused_doc");
-  EXPECT_EQ(header.rfind("method,episode,seed,reached,ttg,doc,doc_static,min_clearance,", 0), 0u);
+  EXPECT_EQ(header,
+            "method,episode,seed,reached,ttg,doc,doc_static,min_clearance,path_length,cycles,solve_"
+            "failures,cycle_ms_median,cycle_ms_p99,robot_caused_doc,blocked_cycles,stopped_time");
+  for (const char* key : {"blocked_cycle_share", "stopped_time_share"})
+    EXPECT_NE(text.str().find(key), std::string::npos) << key;
 }
 
 TEST(NavigationRun, OrcaIsTheFourthMethod) {
@@ -251,6 +255,15 @@ TEST(NavigationRun, SummaryMetricsFollowTheirDefinitions) {
   EXPECT_EQ(m.success_rate_ci.lo, nav::WilsonInterval(2, 3).lo);
   EXPECT_EQ(m.success_and_collision_free_rate_ci.hi, nav::WilsonInterval(1, 3).hi);
   EXPECT_EQ(m.robot_caused_collision_free_rate_ci.hi, nav::WilsonInterval(2, 3).hi);
+  // No controller reported a time-to-collision: the blocked share is unknown, not 0.
+  EXPECT_TRUE(std::isnan(m.blocked_cycle_share));
+  EXPECT_DOUBLE_EQ(m.stopped_time_share, 0.0);
+  // Blocked cycles over the cycles that reported one; stopped time over the episodes' durations.
+  results[0].tau_cycles = 10, results[0].blocked_cycles = 4, results[0].stopped_time = 5;
+  results[1].tau_cycles = 30, results[1].blocked_cycles = 6, results[1].stopped_time = 9;
+  const nav::MethodSummary b = nav::Summarise("span", results);
+  EXPECT_DOUBLE_EQ(b.blocked_cycle_share, 10.0 / 40);
+  EXPECT_DOUBLE_EQ(b.stopped_time_share, 14.0 / (20 + 90 + 30));
   // None reached: TTG is null in the JSON, never NaN.
   nav::ExperimentConfig c;
   c.scenario.name = "a\"b";

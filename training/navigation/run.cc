@@ -298,7 +298,12 @@ EpisodeResult RunEpisode(const ExperimentConfig& c, const Resources& res, Method
                   " s: ", nav::ToString(u.status), " (", u.message, ")");
       ++out.solve_failures;
     }
+    if (!std::isnan(u.tau)) {
+      ++out.tau_cycles;
+      out.blocked_cycles += std::isfinite(u.tau);
+    }
     const nav::Control cmd = limits.Clamp(u.command);
+    if (std::abs(cmd.v) < kRobotCausedSpeed) out.stopped_time += c.dt;
     const nav::UnicycleState next = nav::EulerStep(s, cmd, c.dt);
     const Eigen::Vector2d robot_velocity = (next.position() - s.position()) / c.dt;
     RobotAgent robot;
@@ -353,6 +358,8 @@ MethodSummary Summarise(const std::string& method, const std::vector<EpisodeResu
   m.method = method;
   std::vector<double> cycles, ttg;
   double doc = 0, robot_doc = 0, clear = 0, worst = kInf, ttg_censored = 0;
+  double stopped = 0, elapsed = 0;
+  int blocked = 0, tau_cycles = 0;
   for (const EpisodeResult& r : results) {
     if (r.method != method) continue;
     ++m.episodes;
@@ -367,6 +374,10 @@ MethodSummary Summarise(const std::string& method, const std::vector<EpisodeResu
     clear += r.min_clearance;
     worst = std::min(worst, r.min_clearance);
     m.solve_failures += r.solve_failures;
+    blocked += r.blocked_cycles;
+    tau_cycles += r.tau_cycles;
+    stopped += r.stopped_time;
+    elapsed += r.ttg;  // the episode's duration (arrival, or max_time)
     cycles.insert(cycles.end(), r.cycle_ms.begin(), r.cycle_ms.end());
   }
   m.success_rate_ci = WilsonInterval(m.successes, m.episodes);
@@ -390,6 +401,8 @@ MethodSummary Summarise(const std::string& method, const std::vector<EpisodeResu
   m.cycle_ms_median = Percentile(cycles, 0.5);
   m.cycle_ms_p99 = Percentile(cycles, 0.99);
   m.cycle_ms_max = cycles.empty() ? std::nan("") : *std::max_element(cycles.begin(), cycles.end());
+  m.blocked_cycle_share = tau_cycles > 0 ? static_cast<double>(blocked) / tau_cycles : std::nan("");
+  m.stopped_time_share = elapsed > 0 ? stopped / elapsed : std::nan("");
   return m;
 }
 
@@ -412,6 +425,8 @@ std::string SummaryJson(const ExperimentConfig& c, int episodes,
       << ", \"cycle_ms_median\": " << Json(m.cycle_ms_median)
       << ", \"cycle_ms_p99\": " << Json(m.cycle_ms_p99)
       << ", \"cycle_ms_max\": " << Json(m.cycle_ms_max)
+      << ", \"blocked_cycle_share\": " << Json(m.blocked_cycle_share)
+      << ", \"stopped_time_share\": " << Json(m.stopped_time_share)
       << ", \"solve_failures\": " << m.solve_failures << ", \"episodes\": " << m.episodes
       << ", \"successes\": " << m.successes << ", \"collision_free\": " << m.collision_free
       << ", \"success_and_collision_free\": " << m.success_and_collision_free
@@ -469,7 +484,7 @@ std::vector<MethodSummary> RunNavigation(const ExperimentConfig& c, const std::s
   // Rewritten (atomically) after every episode: a stopped run keeps the episodes it finished.
   std::ostringstream csv;
   csv << "method,episode,seed,reached,ttg,doc,doc_static,min_clearance,path_length,cycles,solve_"
-         "failures,cycle_ms_median,cycle_ms_p99,robot_caused_doc\n";
+         "failures,cycle_ms_median,cycle_ms_p99,robot_caused_doc,blocked_cycles,stopped_time\n";
   for (const Method method : c.Methods()) {
     for (int e = 0; e < n; ++e) {
       std::unique_ptr<VideoRecorder> video;
@@ -480,7 +495,9 @@ std::vector<MethodSummary> RunNavigation(const ExperimentConfig& c, const std::s
       csv << r.method << ',' << r.episode << ',' << r.seed << ',' << r.reached << ',' << r.ttg
           << ',' << r.doc << ',' << r.doc_static << ',' << r.min_clearance << ',' << r.path_length
           << ',' << r.cycles << ',' << r.solve_failures << ',' << Percentile(r.cycle_ms, 0.5) << ','
-          << Percentile(r.cycle_ms, 0.99) << ',' << r.robot_caused_doc << '\n';
+          << Percentile(r.cycle_ms, 0.99) << ',' << r.robot_caused_doc << ','
+          << (r.tau_cycles > 0 ? std::to_string(r.blocked_cycles) : std::string()) << ','
+          << r.stopped_time << '\n';
       WriteFileAtomically(out_dir + "/episodes.csv", csv.str());
       log::Info(r.method, " episode ", e, ": ", r.reached ? "reached" : "not reached", " ttg ",
                 r.ttg, " s, doc ", r.doc, " s, min clearance ", r.min_clearance,

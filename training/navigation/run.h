@@ -51,6 +51,11 @@ struct EpisodeResult {
   double min_clearance = 0;  ///< m, smallest gap to a pedestrian or obstacle (negative: overlap)
   double path_length = 0;    ///< m
   int cycles = 0, solve_failures = 0;
+  /// Cycles whose chosen control collides within the horizon (a finite time-to-collision: no
+  /// collision-free control was found); counted for controllers that report one (SPAN).
+  int blocked_cycles = 0;
+  int tau_cycles = 0;            ///< cycles whose controller reported a time-to-collision
+  double stopped_time = 0;       ///< s with a commanded speed below kRobotCausedSpeed
   std::vector<double> cycle_ms;  ///< compute time of each control cycle
   Eigen::Matrix2Xd path;         ///< robot positions, one per cycle
 };
@@ -113,6 +118,9 @@ struct MethodSummary {
   double min_clearance_mean = 0;  ///< m, mean over episodes of each episode's smallest gap
   double cycle_ms_median = 0, cycle_ms_p99 = 0, cycle_ms_max = 0;
   int solve_failures = 0;
+  /// Share of all cycles that were blocked (EpisodeResult::blocked_cycles; NaN -> null for
+  /// controllers that report no time-to-collision), and of the episodes' time spent stopped.
+  double blocked_cycle_share = 0, stopped_time_share = 0;
 };
 MethodSummary Summarise(const std::string& method, const std::vector<EpisodeResult>& results);
 
