@@ -286,6 +286,7 @@ ControlOutcome ReactiveController::Compute(const NavigationInput& input) {
       out.status = ControlStatus::kNoFinitePlan;
       out.message = "every candidate control collides";
       out.command = {0, 0};
+      out.tau = options_.dt;  // the best candidate collides within its one step
       return out;
     }
     out.command = best;
