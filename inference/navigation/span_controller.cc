@@ -6,6 +6,9 @@
 #include <limits>
 #include <nlopt.hpp>
 #include <sstream>
+#include <tuple>
+#include <utility>
+#include <vector>
 
 #include "core/error.h"
 #include "core/geometry2d.h"
@@ -51,6 +54,77 @@ double NloptCost(unsigned, const double* x, double*, void* data) {
   auto* p = static_cast<Problem*>(data);
   ++p->evaluations;
   return p->cost({x[0], x[1]});
+}
+
+/// The multi-segment problem: x = (v_1, omega_1, ..., v_S, omega_S).
+struct SegmentProblem {
+  std::function<double(const std::vector<Control>&)> cost;
+  std::vector<Control> u;  // scratch
+  int evaluations = 0;
+};
+
+double NloptSegmentCost(unsigned n, const double* x, double*, void* data) {
+  auto* p = static_cast<SegmentProblem*>(data);
+  ++p->evaluations;
+  p->u.resize(n / 2);
+  for (unsigned i = 0; i < n / 2; ++i) p->u[i] = {x[2 * i], x[2 * i + 1]};
+  return p->cost(p->u);
+}
+
+/// COBYLA over S segments from starts: the previous solution shifted by one segment (its later
+/// segments first, the last repeated), then every one-control start held over the whole horizon.
+std::pair<std::vector<Control>, double> MinimiseSegments(const SpanControllerOptions& o,
+                                                         const std::vector<Control>& single_starts,
+                                                         const std::vector<Control>* previous,
+                                                         double lower_bound,
+                                                         SegmentProblem* problem) {
+  const int s = o.segments;
+  std::vector<std::vector<Control>> starts;
+  if (previous && static_cast<int>(previous->size()) == s) {
+    std::vector<Control> shifted(previous->begin() + 1, previous->end());
+    shifted.push_back(previous->back());
+    starts.push_back(shifted);
+  }
+  for (const Control& c : single_starts) starts.emplace_back(static_cast<std::size_t>(s), c);
+  nlopt::opt opt(nlopt::LN_COBYLA, static_cast<unsigned>(2 * s));
+  std::vector<double> lower, upper;
+  for (int i = 0; i < s; ++i) {
+    lower.insert(lower.end(), {o.limits.v_min, -o.limits.omega_max});
+    upper.insert(upper.end(), {o.limits.v_max, o.limits.omega_max});
+  }
+  opt.set_lower_bounds(lower);
+  opt.set_upper_bounds(upper);
+  opt.set_min_objective(NloptSegmentCost, problem);
+  opt.set_maxeval(o.max_evaluations * s);
+  opt.set_xtol_abs(o.xtol);
+  opt.set_initial_step(o.initial_step);
+  std::vector<Control> best(static_cast<std::size_t>(s), Control{0.0, 0.0});
+  double best_cost = kInf;
+  const int n = std::min<int>(o.initialisations, static_cast<int>(starts.size()));
+  std::vector<double> x(static_cast<std::size_t>(2 * s));
+  for (int i = 0; i < n; ++i) {
+    for (int k = 0; k < s; ++k) {
+      const Control c =
+          o.limits.Clamp(starts[static_cast<std::size_t>(i)][static_cast<std::size_t>(k)]);
+      x[static_cast<std::size_t>(2 * k)] = c.v;
+      x[static_cast<std::size_t>(2 * k + 1)] = c.omega;
+    }
+    double f = kInf;
+    try {
+      opt.optimize(x, f);
+    } catch (const std::exception&) {
+      // nlopt reports round-off limits and similar by exception; x holds the last iterate.
+      f = NloptSegmentCost(static_cast<unsigned>(x.size()), x.data(), nullptr, problem);
+    }
+    if (std::isfinite(f) && f < best_cost) {
+      best_cost = f;
+      for (int k = 0; k < s; ++k)
+        best[static_cast<std::size_t>(k)] = o.limits.Clamp(
+            {x[static_cast<std::size_t>(2 * k)], x[static_cast<std::size_t>(2 * k + 1)]});
+    }
+    if (best_cost <= lower_bound + 1e-3) break;  // cannot do better than the unobstructed optimum
+  }
+  return {best, best_cost};
 }
 
 /// (Re)builds the goal-distance field when the goal changed (geodesic goal term with a static map).
@@ -106,6 +180,7 @@ std::string SpanControllerOptions::Problems() const {
   if (!(limits.v_min <= 0 && limits.v_max > 0 && limits.omega_max > 0))
     e << "control limits need v_min <= 0 < v_max and omega_max > 0; ";
   if (initialisations < 1) e << "initialisations = " << initialisations << " must be >= 1; ";
+  if (segments < 1 || segments > 8) e << "segments = " << segments << " must be in [1, 8]; ";
   if (max_evaluations < 3) e << "max_evaluations = " << max_evaluations << " must be >= 3; ";
   return e.str();
 }
@@ -171,11 +246,23 @@ void SpanController::Forecast(const NavigationInput& input) {
 
 double SpanController::Cost(const UnicycleState& robot, const Eigen::Vector2d& goal,
                             const Control& u, double* tau) const {
+  return SegmentCost(robot, goal, &u, 1, tau);
+}
+
+double SpanController::Cost(const UnicycleState& robot, const Eigen::Vector2d& goal,
+                            const std::vector<Control>& u, double* tau) const {
+  FS_THROW_UNLESS(!u.empty(), "SPAN controller: Cost() of an empty control sequence");
+  return SegmentCost(robot, goal, u.data(), static_cast<int>(u.size()), tau);
+}
+
+double SpanController::SegmentCost(const UnicycleState& robot, const Eigen::Vector2d& goal,
+                                   const Control* u, int parts, double* tau) const {
   const double r = options_.robot_radius + options_.pedestrian_radius;
   UnicycleState s = robot;
   double t_collide = kInf;
   for (int k = 1; k <= steps_; ++k) {
-    s = EulerStep(s, u, options_.dt);
+    // Step k (ending at k dt) uses the segment its start (k - 1) dt falls in.
+    s = EulerStep(s, u[std::min(parts - 1, (k - 1) * parts / steps_)], options_.dt);
     if (t_collide < kInf) continue;
     const Eigen::Vector2d p = s.position();
     if ((field_ && field_->Collides(p.x(), p.y(), options_.epsilon, &map_ws_)) ||
@@ -203,24 +290,39 @@ ControlOutcome SpanController::Compute(const NavigationInput& input) {
     // margin_weight).
     const double rate = goal_field_.empty() ? 1.0 : 1.0 + goal_field_.margin_weight();
     const double lower = std::max(0.0, here - rate * options_.limits.v_max * options_.horizon);
-    const auto [best, cost] = MinimiseFromStarts(
-        options_, Starts(options_, input.robot, input.goal, has_previous_ ? &previous_ : nullptr),
-        options_.initialisations, lower, &problem);
-    out.evaluations = problem.evaluations;
+    std::vector<Control> best;
+    double cost = kInf;
+    if (options_.segments == 1) {
+      const Control* previous = previous_.size() == 1 ? &previous_.front() : nullptr;
+      const auto [u, c] =
+          MinimiseFromStarts(options_, Starts(options_, input.robot, input.goal, previous),
+                             options_.initialisations, lower, &problem);
+      best.assign(1, u);
+      cost = c;
+      out.evaluations = problem.evaluations;
+    } else {
+      SegmentProblem segments;
+      segments.cost = [&](const std::vector<Control>& u) {
+        return Cost(input.robot, input.goal, u, nullptr);
+      };
+      std::tie(best, cost) =
+          MinimiseSegments(options_, Starts(options_, input.robot, input.goal, nullptr),
+                           previous_.empty() ? nullptr : &previous_, lower, &segments);
+      out.evaluations = segments.evaluations;
+    }
     if (!std::isfinite(cost)) {
       out.status = ControlStatus::kNoFinitePlan;
       out.message = "no start of the optimiser reached a finite cost";
       out.command = {0, 0};
-      has_previous_ = false;
+      previous_.clear();
       return out;
     }
-    out.command = best;
+    out.command = best.front();
     out.cost = Cost(input.robot, input.goal, best, &out.tau);
-    previous_ = best;
-    has_previous_ = true;
+    previous_ = std::move(best);
   } catch (const std::exception& e) {
     out = ControlOutcome::Stop(ControlStatus::kError, e.what());  // e.g. malformed observations
-    has_previous_ = false;
+    previous_.clear();
   }
   return out;
 }

@@ -33,6 +33,9 @@ struct SpanControllerOptions {
   int max_evaluations = 40;   ///< per start
   double xtol = 1e-3;         ///< COBYLA tolerance on u
   double initial_step = 0.4;  ///< COBYLA initial trust radius on u
+  /// Constant controls per horizon: 1 is the thesis's one constant control (v, omega) over T;
+  /// 2 lets it change once, at T / 2 (u is then 4-dimensional; the robot executes the first).
+  int segments = 1;
   /// With a static map: measure the goal term as the geodesic distance around obstacles
   /// (GoalDistanceField) instead of ||x(T) - g||; identical where the way to the goal is free.
   bool geodesic_goal = true;
@@ -52,9 +55,13 @@ class SpanController final : public NavigationController {
   ControlOutcome Compute(const NavigationInput& input) override;
 
   /// J(u) from `robot` towards `goal` against the current forecast; `tau` receives the TTC (inf:
-  /// none).
+  /// none). One control held over the horizon.
   double Cost(const UnicycleState& robot, const Eigen::Vector2d& goal, const Control& u,
               double* tau) const;
+  /// Same for piecewise-constant controls: u[i] held over the i-th of u.size() equal parts of the
+  /// horizon (options().segments of them in Compute).
+  double Cost(const UnicycleState& robot, const Eigen::Vector2d& goal,
+              const std::vector<Control>& u, double* tau) const;
   /// Fills the forecast from observations (done by Compute; exposed for tests and drawing).
   void Forecast(const NavigationInput& input);
   const CrowdForecast& forecast() const { return forecast_; }
@@ -66,6 +73,9 @@ class SpanController final : public NavigationController {
   int steps() const { return steps_; }
 
  private:
+  double SegmentCost(const UnicycleState& robot, const Eigen::Vector2d& goal, const Control* u,
+                     int parts, double* tau) const;
+
   const span::Predictor* predictor_;
   const StaticCollisionField* field_;
   SpanControllerOptions options_;
@@ -77,9 +87,8 @@ class SpanController final : public NavigationController {
   mutable occupancy::MapWorkspace map_ws_;
   Eigen::MatrixXd clean_rows_;
   Eigen::Matrix2Xd current_;
-  Control previous_;
-  bool has_previous_ = false;
-  GoalDistanceField goal_field_;  ///< rebuilt when the goal changes
+  std::vector<Control> previous_;  ///< last cycle's solution (segments), empty: none
+  GoalDistanceField goal_field_;   ///< rebuilt when the goal changes
 };
 
 /// The reactive baseline (thesis ch 5, "Experimental Evaluation"): optimises the next step only,

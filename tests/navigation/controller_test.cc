@@ -4,7 +4,9 @@
 
 #include <cmath>
 #include <limits>
+#include <vector>
 
+#include "core/error.h"
 #include "inference/mapping/grid_map.h"
 #include "inference/navigation/cl_rrt_star.h"
 #include "inference/navigation/goal_distance.h"
@@ -127,6 +129,35 @@ TEST(SpanController, CostIsDistancePlusKappaOverTheFirstCollisionTime) {
   EXPECT_NEAR(cost, 6.0 + 100.0 / 1.3, 1e-9);
   EXPECT_NEAR(c.Cost(in.robot, in.goal, {0.0, 0.0}, &tau), 10.0, 1e-12);
   EXPECT_EQ(tau, kInf);
+}
+
+// Piecewise-constant controls (segments): the same control in every segment is the one-control
+// cost; a stop for the first half then full speed ends 2 m from the start (closed form), and the
+// controller with two segments drives straight at a goal in free space.
+TEST(SpanController, SegmentedControlsFollowTheirClosedForm) {
+  SpanController c(nullptr, nullptr, Options());
+  const UnicycleState robot{0, 0, 0};
+  const Eigen::Vector2d goal(10, 0);
+  double tau_one = 0, tau_two = 0;
+  EXPECT_EQ(c.Cost(robot, goal, Control{0.7, 0.2}, &tau_one),
+            c.Cost(robot, goal, std::vector<Control>{{0.7, 0.2}, {0.7, 0.2}}, &tau_two));
+  EXPECT_EQ(tau_one, tau_two);
+  // Steps 1-20 (t < 2 s) stopped, steps 21-40 at 1 m/s: x(T) = 2 m, 8 m from the goal.
+  EXPECT_NEAR(c.Cost(robot, goal, std::vector<Control>{{0.0, 0.0}, {1.0, 0.0}}, nullptr), 8.0,
+              1e-9);
+  SpanControllerOptions o = Options();
+  o.segments = 2;
+  SpanController two(nullptr, nullptr, o);
+  NavigationInput in;
+  in.robot = robot;
+  in.goal = goal;
+  const ControlOutcome out = two.Compute(in);
+  EXPECT_TRUE(out.solved());
+  EXPECT_NEAR(out.command.v, 1.0, 1e-3);
+  EXPECT_NEAR(out.cost, 6.0, 1e-2);
+  o.segments = 0;
+  EXPECT_NE(o.Problems().find("segments = 0"), std::string::npos);
+  EXPECT_THROW(c.Cost(robot, goal, std::vector<Control>{}, nullptr), Error);
 }
 
 TEST(SpanController, CobylaFindsAsGoodAControlAsAGridSearch) {

@@ -97,6 +97,8 @@ struct SpanControllerConfig {
              "COBYLA initial trust radius");
     a->Visit("geodesic_goal", &o.geodesic_goal, config::Range::Any(),
              "goal term as the distance around static obstacles (false: ||x(T) - g|| as printed)");
+    a->Visit("segments", &o.segments, config::Range::Closed(1, 8),
+             "constant controls per horizon (1: the thesis's; 2: may change once, at T / 2)");
   }
 };
 
