@@ -20,11 +20,14 @@ void SelectedInverter::Compute(const SparseCholesky& llt) {
                             std::equal(outer_.begin(), outer_.end(), l.outerIndexPtr()) &&
                             std::equal(inner_.begin(), inner_.end(), l.innerIndexPtr());
   if (!same_pattern) {
-    outer_.assign(l.outerIndexPtr(), l.outerIndexPtr() + n + 1);
-    inner_.assign(l.innerIndexPtr(), l.innerIndexPtr() + nnz);
+    // Checked before it is kept: a refused pattern must not pass as "the same" next time.
+    const int* outer = l.outerIndexPtr();
+    const int* inner = l.innerIndexPtr();
     for (int j = 0; j < n; ++j)
-      FS_THROW_UNLESS(outer_[j + 1] > outer_[j] && inner_[outer_[j]] == j,
-                      "selected inverse: column ", j, " of L does not start with its diagonal");
+      FS_THROW_UNLESS(outer[j + 1] > outer[j] && inner[outer[j]] == j, "selected inverse: column ",
+                      j, " of L does not start with its diagonal");
+    outer_.assign(outer, outer + n + 1);
+    inner_.assign(inner, inner + nnz);
     FindSupernodes();
   }
   const double* lx = l.valuePtr();

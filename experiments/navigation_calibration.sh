@@ -21,6 +21,10 @@ for s in sim1 sim2 thor; do
   "$BIN" eval "$d" > "$d.eval.out" 2>&1 || { tail -5 "$d.eval.out"; exit 1; }
   RUNS+=("$d")
 done
+if [[ ${#RUNS[@]} -eq 0 ]]; then
+  echo "no navigation predictor to evaluate: run experiments/navigation.sh first" >&2
+  exit 1
+fi
 python3 - "${RUNS[@]}" <<'PY'
 import json, sys
 rows = ["| predictor | windows | horizon (s) | inside 1 sigma: SPAN / CV | inside 2 sigma: SPAN / CV |",

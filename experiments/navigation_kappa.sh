@@ -27,12 +27,18 @@ navigate() {  # navigate NAME SCENARIO [key=value ...]
 settings=()
 for k in $KAPPAS; do settings+=("kappa$k:span.kappa=$k"); done
 settings+=("segments2:span.segments=2")
+wait_all() {  # waits for every given process; stops the script when one failed
+  local pid
+  for pid in "$@"; do wait "$pid" || { echo "a run failed (see $OUT/*.out)" >&2; exit 1; }; done
+}
 for s in "${settings[@]}"; do
   name=${s%%:*}
+  pids=()
   for scenario in sim1 sim2; do
     navigate "val_${scenario}_$name" "$scenario" "methods=[span]" seed=1000 "${s#*:}" &
+    pids+=($!)
   done
-  wait
+  wait_all "${pids[@]}"
 done
 chosen=$(python3 - "$OUT" "${settings[@]}" <<'PY'
 import json, sys
@@ -54,8 +60,9 @@ PY
 echo "chosen on validation seeds: $chosen"
 for scenario in sim1 sim2 dataset; do
   navigate "test_${scenario}_thesis" "$scenario" "methods=[span, reactive, orca]" &
+  a=$!
   navigate "test_${scenario}_chosen" "$scenario" "methods=[span]" "$chosen" &
-  wait
+  wait_all "$a" "$!"
 done
 python3 - "$OUT" "$chosen" "${settings[@]}" <<'PY'
 import json, sys

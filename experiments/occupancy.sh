@@ -12,6 +12,7 @@ set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BIN="${FORESIGHT_BIN:-$ROOT/build/bin/foresight}"
 REPEATS="${REPEATS:-3}"
+[[ "$REPEATS" =~ ^[1-9][0-9]*$ ]] || { echo "REPEATS=$REPEATS: a positive number of runs" >&2; exit 1; }
 cd "$ROOT"
 mkdir -p results runs
 

@@ -300,8 +300,7 @@ ControlOutcome OrcaController::Compute(const NavigationInput& input) {
     previous_ = u;
     out.command = u;
     out.cost = (last_.velocity - preferred).norm();
-    out.tau = std::numeric_limits<double>::infinity();
-    out.evaluations = n;
+    out.evaluations = n;  // tau stays NaN: ORCA has no time-to-collision of a planned control
   } catch (const std::exception& e) {
     out = ControlOutcome::Stop(ControlStatus::kError, e.what());
     previous_ = out.command;

@@ -71,8 +71,8 @@ double NloptSegmentCost(unsigned n, const double* x, double*, void* data) {
   return p->cost(p->u);
 }
 
-/// COBYLA over S segments from starts: the previous solution shifted by one segment (its later
-/// segments first, the last repeated), then every one-control start held over the whole horizon.
+/// COBYLA over S segments from starts: the previous solution (the plan in progress: one cycle of
+/// dt has passed, far less than a segment), then every one-control start held over the horizon.
 std::pair<std::vector<Control>, double> MinimiseSegments(const SpanControllerOptions& o,
                                                          const std::vector<Control>& single_starts,
                                                          const std::vector<Control>* previous,
@@ -80,11 +80,7 @@ std::pair<std::vector<Control>, double> MinimiseSegments(const SpanControllerOpt
                                                          SegmentProblem* problem) {
   const int s = o.segments;
   std::vector<std::vector<Control>> starts;
-  if (previous && static_cast<int>(previous->size()) == s) {
-    std::vector<Control> shifted(previous->begin() + 1, previous->end());
-    shifted.push_back(previous->back());
-    starts.push_back(shifted);
-  }
+  if (previous && static_cast<int>(previous->size()) == s) starts.push_back(*previous);
   for (const Control& c : single_starts) starts.emplace_back(static_cast<std::size_t>(s), c);
   nlopt::opt opt(nlopt::LN_COBYLA, static_cast<unsigned>(2 * s));
   std::vector<double> lower, upper;
@@ -181,6 +177,9 @@ std::string SpanControllerOptions::Problems() const {
     e << "control limits need v_min <= 0 < v_max and omega_max > 0; ";
   if (initialisations < 1) e << "initialisations = " << initialisations << " must be >= 1; ";
   if (segments < 1 || segments > 8) e << "segments = " << segments << " must be in [1, 8]; ";
+  if (dt > 0 && segments > std::lround(horizon / dt))
+    e << "segments = " << segments << " exceeds the horizon's " << std::lround(horizon / dt)
+      << " steps; ";
   if (max_evaluations < 3) e << "max_evaluations = " << max_evaluations << " must be >= 3; ";
   return e.str();
 }
@@ -388,12 +387,11 @@ ControlOutcome ReactiveController::Compute(const NavigationInput& input) {
       out.status = ControlStatus::kNoFinitePlan;
       out.message = "every candidate control collides";
       out.command = {0, 0};
-      out.tau = options_.dt;  // the best candidate collides within its one step
       return out;
     }
     out.command = best;
     out.cost = cost;
-    out.tau = kInf;
+    // tau stays NaN: the reactive controller plans one step, no time-to-collision to report
   } catch (const std::exception& e) {
     out = ControlOutcome::Stop(ControlStatus::kError, e.what());
   }

@@ -257,10 +257,11 @@ TEST(NavigationRun, SummaryMetricsFollowTheirDefinitions) {
   EXPECT_EQ(m.robot_caused_collision_free_rate_ci.hi, nav::WilsonInterval(2, 3).hi);
   // No controller reported a time-to-collision: the blocked share is unknown, not 0.
   EXPECT_TRUE(std::isnan(m.blocked_cycle_share));
-  EXPECT_DOUBLE_EQ(m.stopped_time_share, 0.0);
+  EXPECT_TRUE(std::isnan(m.stopped_time_share));  // no simulated time recorded
   // Blocked cycles over the cycles that reported one; stopped time over the episodes' durations.
   results[0].tau_cycles = 10, results[0].blocked_cycles = 4, results[0].stopped_time = 5;
   results[1].tau_cycles = 30, results[1].blocked_cycles = 6, results[1].stopped_time = 9;
+  results[0].duration = 20, results[1].duration = 90, results[2].duration = 30;
   const nav::MethodSummary b = nav::Summarise("span", results);
   EXPECT_DOUBLE_EQ(b.blocked_cycle_share, 10.0 / 40);
   EXPECT_DOUBLE_EQ(b.stopped_time_share, 14.0 / (20 + 90 + 30));

@@ -304,6 +304,7 @@ EpisodeResult RunEpisode(const ExperimentConfig& c, const Resources& res, Method
     }
     const nav::Control cmd = limits.Clamp(u.command);
     if (std::abs(cmd.v) < kRobotCausedSpeed) out.stopped_time += c.dt;
+    out.duration += c.dt;
     const nav::UnicycleState next = nav::EulerStep(s, cmd, c.dt);
     const Eigen::Vector2d robot_velocity = (next.position() - s.position()) / c.dt;
     RobotAgent robot;
@@ -377,7 +378,7 @@ MethodSummary Summarise(const std::string& method, const std::vector<EpisodeResu
     blocked += r.blocked_cycles;
     tau_cycles += r.tau_cycles;
     stopped += r.stopped_time;
-    elapsed += r.ttg;  // the episode's duration (arrival, or max_time)
+    elapsed += r.duration;
     cycles.insert(cycles.end(), r.cycle_ms.begin(), r.cycle_ms.end());
   }
   m.success_rate_ci = WilsonInterval(m.successes, m.episodes);

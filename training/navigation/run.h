@@ -56,6 +56,7 @@ struct EpisodeResult {
   int blocked_cycles = 0;
   int tau_cycles = 0;            ///< cycles whose controller reported a time-to-collision
   double stopped_time = 0;       ///< s with a commanded speed below kRobotCausedSpeed
+  double duration = 0;           ///< s simulated (cycles x dt)
   std::vector<double> cycle_ms;  ///< compute time of each control cycle
   Eigen::Matrix2Xd path;         ///< robot positions, one per cycle
 };
