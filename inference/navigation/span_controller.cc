@@ -6,7 +6,6 @@
 #include <limits>
 #include <nlopt.hpp>
 #include <sstream>
-#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -19,12 +18,11 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-/// Starts of the per-cycle COBYLA runs: the previous solution, a goal-directed turn, a fan, then
+/// One-control starts of the per-cycle COBYLA runs: a goal-directed turn, a fan, then
 /// quasi-random points of the control box (a fixed Halton sequence) up to `initialisations`.
 std::vector<Control> Starts(const SpanControllerOptions& o, const UnicycleState& robot,
-                            const Eigen::Vector2d& goal, const Control* previous) {
+                            const Eigen::Vector2d& goal) {
   std::vector<Control> s;
-  if (previous) s.push_back(*previous);
   const double bearing = std::atan2(goal.y() - robot.y, goal.x() - robot.x);
   const double turn =
       std::clamp(WrapToPi(bearing - robot.heading) / std::max(o.horizon * 0.5, o.dt),
@@ -45,18 +43,7 @@ std::vector<Control> Starts(const SpanControllerOptions& o, const UnicycleState&
   return s;
 }
 
-struct Problem {
-  std::function<double(const Control&)> cost;
-  int evaluations = 0;
-};
-
-double NloptCost(unsigned, const double* x, double*, void* data) {
-  auto* p = static_cast<Problem*>(data);
-  ++p->evaluations;
-  return p->cost({x[0], x[1]});
-}
-
-/// The multi-segment problem: x = (v_1, omega_1, ..., v_S, omega_S).
+/// The optimisation problem over S constant controls: x = (v_1, omega_1, ..., v_S, omega_S).
 struct SegmentProblem {
   std::function<double(const std::vector<Control>&)> cost;
   std::vector<Control> u;  // scratch
@@ -71,14 +58,13 @@ double NloptSegmentCost(unsigned n, const double* x, double*, void* data) {
   return p->cost(p->u);
 }
 
-/// COBYLA over S segments from starts: the previous solution (the plan in progress: one cycle of
-/// dt has passed, far less than a segment), then every one-control start held over the horizon.
-std::pair<std::vector<Control>, double> MinimiseSegments(const SpanControllerOptions& o,
-                                                         const std::vector<Control>& single_starts,
-                                                         const std::vector<Control>* previous,
-                                                         double lower_bound,
-                                                         SegmentProblem* problem) {
-  const int s = o.segments;
+/// COBYLA over `s` constant controls from at most o.initialisations starts: the previous solution
+/// (the plan in progress: one cycle of dt has passed, far less than a segment), then every
+/// one-control start held over the horizon. Returns the best controls and their cost (inf when
+/// no start reached a finite one). Never throws.
+std::pair<std::vector<Control>, double> MinimiseFromStarts(
+    const SpanControllerOptions& o, int s, const std::vector<Control>& single_starts,
+    const std::vector<Control>* previous, double lower_bound, SegmentProblem* problem) {
   std::vector<std::vector<Control>> starts;
   if (previous && static_cast<int>(previous->size()) == s) starts.push_back(*previous);
   for (const Control& c : single_starts) starts.emplace_back(static_cast<std::size_t>(s), c);
@@ -128,39 +114,6 @@ void UpdateGoalField(const SpanControllerOptions& o, const StaticCollisionField*
                      const Eigen::Vector2d& goal, GoalDistanceField* goal_field) {
   if (o.geodesic_goal && field && (goal_field->empty() || goal_field->goal() != goal))
     *goal_field = GoalDistanceField(*field, goal, o.epsilon);
-}
-
-/// Runs COBYLA from each start; returns the best control and its cost. Never throws.
-std::pair<Control, double> MinimiseFromStarts(const SpanControllerOptions& o,
-                                              const std::vector<Control>& starts, int max_starts,
-                                              double lower_bound, Problem* problem) {
-  Control best{0.0, 0.0};
-  double best_cost = kInf;
-  nlopt::opt opt(nlopt::LN_COBYLA, 2);
-  opt.set_lower_bounds({o.limits.v_min, -o.limits.omega_max});
-  opt.set_upper_bounds({o.limits.v_max, o.limits.omega_max});
-  opt.set_min_objective(NloptCost, problem);
-  opt.set_maxeval(o.max_evaluations);
-  opt.set_xtol_abs(o.xtol);
-  opt.set_initial_step(o.initial_step);
-  const int n = std::min<int>(max_starts, static_cast<int>(starts.size()));
-  for (int i = 0; i < n; ++i) {
-    const Control s = o.limits.Clamp(starts[static_cast<std::size_t>(i)]);
-    std::vector<double> x{s.v, s.omega};
-    double f = kInf;
-    try {
-      opt.optimize(x, f);
-    } catch (const std::exception&) {
-      // nlopt reports round-off limits and similar by exception; x holds the last iterate.
-      f = problem->cost({x[0], x[1]});
-    }
-    if (std::isfinite(f) && f < best_cost) {
-      best_cost = f;
-      best = o.limits.Clamp({x[0], x[1]});
-    }
-    if (best_cost <= lower_bound + 1e-3) break;  // cannot do better than the unobstructed optimum
-  }
-  return {best, best_cost};
 }
 
 }  // namespace
@@ -280,8 +233,10 @@ ControlOutcome SpanController::Compute(const NavigationInput& input) {
   try {
     Forecast(input);
     Prepare(input.goal);
-    Problem problem;
-    problem.cost = [&](const Control& u) { return Cost(input.robot, input.goal, u, nullptr); };
+    SegmentProblem problem;
+    problem.cost = [&](const std::vector<Control>& u) {
+      return Cost(input.robot, input.goal, u, nullptr);
+    };
     const double here = goal_field_.empty() || goal_field_.goal() != input.goal
                             ? (input.robot.position() - input.goal).norm()
                             : goal_field_.Distance(input.robot.position());
@@ -289,26 +244,10 @@ ControlOutcome SpanController::Compute(const NavigationInput& input) {
     // margin_weight).
     const double rate = goal_field_.empty() ? 1.0 : 1.0 + goal_field_.margin_weight();
     const double lower = std::max(0.0, here - rate * options_.limits.v_max * options_.horizon);
-    std::vector<Control> best;
-    double cost = kInf;
-    if (options_.segments == 1) {
-      const Control* previous = previous_.size() == 1 ? &previous_.front() : nullptr;
-      const auto [u, c] =
-          MinimiseFromStarts(options_, Starts(options_, input.robot, input.goal, previous),
-                             options_.initialisations, lower, &problem);
-      best.assign(1, u);
-      cost = c;
-      out.evaluations = problem.evaluations;
-    } else {
-      SegmentProblem segments;
-      segments.cost = [&](const std::vector<Control>& u) {
-        return Cost(input.robot, input.goal, u, nullptr);
-      };
-      std::tie(best, cost) =
-          MinimiseSegments(options_, Starts(options_, input.robot, input.goal, nullptr),
-                           previous_.empty() ? nullptr : &previous_, lower, &segments);
-      out.evaluations = segments.evaluations;
-    }
+    auto [best, cost] =
+        MinimiseFromStarts(options_, options_.segments, Starts(options_, input.robot, input.goal),
+                           previous_.empty() ? nullptr : &previous_, lower, &problem);
+    out.evaluations = problem.evaluations;
     if (!std::isfinite(cost)) {
       out.status = ControlStatus::kNoFinitePlan;
       out.message = "no start of the optimiser reached a finite cost";
@@ -375,11 +314,13 @@ ControlOutcome ReactiveController::Compute(const NavigationInput& input) {
     const int n = input.past_rows ? CleanObservations(*input.past_rows, &clean, &current_) : 0;
     forecast_.FromCurrentPositions(current_.leftCols(n), 1);
     Prepare(input.goal);
-    Problem problem;
-    problem.cost = [&](const Control& u) { return Cost(input.robot, input.goal, u, nullptr); };
-    const auto [best, cost] =
-        MinimiseFromStarts(options_, Starts(options_, input.robot, input.goal, nullptr),
-                           options_.initialisations, 0.0, &problem);
+    SegmentProblem problem;
+    problem.cost = [&](const std::vector<Control>& u) {
+      return Cost(input.robot, input.goal, u.front(), nullptr);
+    };
+    const auto [controls, cost] = MinimiseFromStarts(
+        options_, 1, Starts(options_, input.robot, input.goal), nullptr, 0.0, &problem);
+    const Control best = controls.front();
     out.evaluations = problem.evaluations;
     bool hit = true;
     if (std::isfinite(cost)) Cost(input.robot, input.goal, best, &hit);
