@@ -108,4 +108,17 @@ double CrowdForecast::MaxBound(int k, const Eigen::Vector2d& x, double radius) c
   return best;
 }
 
+double CrowdForecast::UnionBound(int k, const Eigen::Vector2d& x, double radius) const {
+  double sum = 0.0;
+  for (int n = 0; n < n_; ++n)
+    for (int r = 0; r < r_; ++r) {
+      const std::size_t j = Index(n, k, r);
+      const double outer = radius + 6.0 * reach_[j];
+      if ((x - mean_[j]).squaredNorm() >= outer * outer) continue;
+      sum += alpha_[static_cast<std::size_t>(n * r_ + r)] *
+             CollisionProbabilityBound(x, mean_[j], cov_[j], radius);
+    }
+  return sum;
+}
+
 }  // namespace foresight::nav

@@ -133,6 +133,10 @@ std::string SpanControllerOptions::Problems() const {
   if (dt > 0 && segments > std::lround(horizon / dt))
     e << "segments = " << segments << " exceeds the horizon's " << std::lround(horizon / dt)
       << " steps; ";
+  if (!(escape_tau >= 0) || !std::isfinite(escape_tau))
+    e << "escape_tau = " << escape_tau << " must be >= 0; ";
+  if (!(escape_horizon >= dt && escape_horizon <= horizon))
+    e << "escape_horizon = " << escape_horizon << " must be in [dt, horizon]; ";
   if (max_evaluations < 3) e << "max_evaluations = " << max_evaluations << " must be >= 3; ";
   return e.str();
 }
@@ -169,6 +173,8 @@ SpanController::SpanController(const span::Predictor* predictor, const StaticCol
   FS_THROW_UNLESS(problems.empty(), "SPAN controller options: ", problems);
   threshold_ = ChanceThreshold(options_.epsilon);
   steps_ = static_cast<int>(std::lround(options_.horizon / options_.dt));
+  escape_steps_ =
+      std::clamp(static_cast<int>(std::lround(options_.escape_horizon / options_.dt)), 1, steps_);
   if (field_ && field_->empty()) field_ = nullptr;
   if (field_) map_ws_ = field_->MakeWorkspace();
   if (predictor_) {
@@ -228,6 +234,28 @@ double SpanController::SegmentCost(const UnicycleState& robot, const Eigen::Vect
   return std::isfinite(t_collide) ? distance + options_.kappa / t_collide : distance;
 }
 
+double SpanController::EscapeCost(const UnicycleState& robot, const Eigen::Vector2d& goal,
+                                  const Control& u) const {
+  // Why: tau is the first step whose chance bound exceeds epsilon, so it is piecewise constant in
+  // u; when every control collides at the first step, kappa / tau is the same for all of them and
+  // says nothing about which way is safer. E[#pedestrians in contact at step k] = sum_n P_n(x_k)
+  // <= sum_n bound_n(x_k) (eq. upperbounds per pedestrian, linearity of expectation), which does
+  // fall as the robot moves away; its mean over the escape window is minimised instead.
+  const double r = options_.robot_radius + options_.pedestrian_radius;
+  UnicycleState s = robot;
+  double contacts = 0.0;
+  for (int k = 1; k <= escape_steps_; ++k) {
+    s = EulerStep(s, u, options_.dt);
+    const Eigen::Vector2d p = s.position();
+    if (field_ && field_->Collides(p.x(), p.y(), options_.epsilon, &map_ws_)) contacts += 1.0;
+    contacts += forecast_.UnionBound(std::min(k, forecast_.steps()), p, r);
+  }
+  const double distance = !goal_field_.empty() && goal_field_.goal() == goal
+                              ? goal_field_.Distance(s.position())
+                              : (s.position() - goal).norm();
+  return contacts / escape_steps_ + 1e-3 * distance;
+}
+
 ControlOutcome SpanController::Compute(const NavigationInput& input) {
   ControlOutcome out;
   try {
@@ -257,6 +285,21 @@ ControlOutcome SpanController::Compute(const NavigationInput& input) {
     }
     out.command = best.front();
     out.cost = Cost(input.robot, input.goal, best, &out.tau);
+    if (options_.escape_tau > 0 && out.tau <= options_.escape_tau + 1e-9) {
+      SegmentProblem escape;
+      escape.cost = [&](const std::vector<Control>& u) {
+        return EscapeCost(input.robot, input.goal, u.front());
+      };
+      const auto [controls, escape_cost] = MinimiseFromStarts(
+          options_, 1, Starts(options_, input.robot, input.goal), nullptr, -kInf, &escape);
+      out.evaluations += escape.evaluations;
+      if (std::isfinite(escape_cost)) {
+        ++escapes_;
+        best.assign(static_cast<std::size_t>(options_.segments), controls.front());
+        out.command = controls.front();
+        out.cost = Cost(input.robot, input.goal, best, &out.tau);
+      }
+    }
     previous_ = std::move(best);
   } catch (const std::exception& e) {
     out = ControlOutcome::Stop(ControlStatus::kError, e.what());  // e.g. malformed observations

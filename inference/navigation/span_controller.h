@@ -36,6 +36,13 @@ struct SpanControllerOptions {
   /// Constant controls per horizon: 1 is the thesis's one constant control (v, omega) over T;
   /// 2 lets it change once, at T / 2 (u is then 4-dimensional; the robot executes the first).
   int segments = 1;
+  /// Fallback when nothing better than an imminent collision is found: when the chosen plan's
+  /// time-to-collision is at most `escape_tau` (s), the command instead minimises the expected
+  /// number of contacts over the next `escape_horizon` s (EscapeCost). 0 turns it off (the
+  /// thesis: the kappa / tau term is then the same for every control and the goal term alone
+  /// decides, driving through the pedestrian).
+  double escape_tau = 0.0;
+  double escape_horizon = 1.0;  ///< s, at least dt and at most the horizon
   /// With a static map: measure the goal term as the geodesic distance around obstacles
   /// (GoalDistanceField) instead of ||x(T) - g||; identical where the way to the goal is free.
   bool geodesic_goal = true;
@@ -62,6 +69,13 @@ class SpanController final : public NavigationController {
   /// horizon (options().segments of them in Compute).
   double Cost(const UnicycleState& robot, const Eigen::Vector2d& goal,
               const std::vector<Control>& u, double* tau) const;
+  /// The escape objective for one control held from `robot`: over the steps k = 1..K of
+  /// escape_horizon, the mean of the union bound sum_n P(contact with pedestrian n at step k)
+  /// (CrowdForecast::UnionBound, an upper bound on the expected number of pedestrians in
+  /// contact) plus 1 for a step in the static map's collision region, plus 1e-3 times the goal
+  /// distance at step K (ties go towards the goal).
+  double EscapeCost(const UnicycleState& robot, const Eigen::Vector2d& goal,
+                    const Control& u) const;
   /// Fills the forecast from observations (done by Compute; exposed for tests and drawing).
   void Forecast(const NavigationInput& input);
   const CrowdForecast& forecast() const { return forecast_; }
@@ -71,6 +85,8 @@ class SpanController final : public NavigationController {
   int PredictedPedestrians() const override { return forecast_.pedestrians(); }
   const SpanControllerOptions& options() const { return options_; }
   int steps() const { return steps_; }
+  /// Cycles whose command came from the escape fallback, since construction.
+  int escapes() const { return escapes_; }
 
  private:
   double SegmentCost(const UnicycleState& robot, const Eigen::Vector2d& goal, const Control* u,
@@ -81,6 +97,8 @@ class SpanController final : public NavigationController {
   SpanControllerOptions options_;
   ChanceThreshold threshold_;
   int steps_;
+  int escape_steps_;
+  int escapes_ = 0;
   CrowdForecast forecast_;
   std::vector<TrajectoryDistribution> predictions_;
   span::Predictor::Workspace predictor_ws_;

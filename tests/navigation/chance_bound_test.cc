@@ -86,6 +86,9 @@ TEST(CrowdForecast, StandingPedestriansCollideWithinTheSumOfRadii) {
   EXPECT_FALSE(f.Collides(3, Eigen::Vector2d(0.81, 0), 0.8, t));
   EXPECT_TRUE(f.Collides(2, Eigen::Vector2d(5.5, 0.5), 0.8, t));
   EXPECT_EQ(f.MaxBound(1, Eigen::Vector2d(2.5, 0), 0.8), 0.0);
+  // Within both discs (2.5 apart, radius 3): two pedestrians in contact.
+  EXPECT_EQ(f.UnionBound(1, Eigen::Vector2d(2.5, 0), 3.0), 2.0);
+  EXPECT_EQ(f.UnionBound(1, Eigen::Vector2d(2.5, 0), 0.8), 0.0);
 }
 
 TEST(CrowdForecast, TablesThePredictorAndAgreesWithTheBoundByBruteForce) {
@@ -122,6 +125,13 @@ TEST(CrowdForecast, TablesThePredictorAndAgreesWithTheBoundByBruteForce) {
       if (std::abs(bound - 0.25) < 1e-6) continue;
       EXPECT_EQ(f.Collides(k, x, 0.8, t), bound > 0.25)
           << "k " << k << " x " << x.transpose() << " bound " << bound;
+      // The union bound is the sum of the per-pedestrian bounds (terms below 1e-9 skipped).
+      double sum = 0.0;
+      for (int n = 0; n < 2; ++n)
+        for (int r = 0; r < components; ++r)
+          sum += f.Alpha(n, r) * CollisionProbabilityBound(x, f.Mean(n, k, r), f.Cov(n, k, r), 0.8);
+      EXPECT_NEAR(f.UnionBound(k, x, 0.8), sum, 1e-8);
+      EXPECT_GE(f.UnionBound(k, x, 0.8), bound - 1e-8);
       ++checked;
     }
     EXPECT_GT(checked, 2900);

@@ -255,6 +255,41 @@ TEST(Baselines, NonFiniteObservationsAreDroppedNotObstacles) {
   for (Eigen::Index i = 0; i < rrt.path().cols(); ++i) EXPECT_TRUE(rrt.path().col(i).allFinite());
 }
 
+// A standing pedestrian 0.5 m ahead, inside the 0.8 m sum of radii: every control collides at
+// the first step, so kappa / tau is the same for all of them. The thesis's cost then drives on
+// towards the goal, through the pedestrian; the escape fallback backs away.
+TEST(SpanController, EscapeBacksAwayWhenEveryControlCollidesAtOnce) {
+  const Eigen::MatrixXd rows = Standing({{0.5, 0.0}}, 5);
+  NavigationInput in;
+  in.robot = {0, 0, 0};
+  in.goal = {10, 0};
+  in.past_rows = &rows;
+  SpanController thesis(nullptr, nullptr, Options());
+  ControlOutcome out = thesis.Compute(in);
+  EXPECT_NEAR(out.tau, 0.1, 1e-12);
+  EXPECT_GT(out.command.v, 0.0);
+  EXPECT_EQ(thesis.escapes(), 0);
+
+  SpanControllerOptions o = Options();
+  o.escape_tau = 0.1;
+  o.escape_horizon = 1.0;
+  SpanController escape(nullptr, nullptr, o);
+  escape.Forecast(in);
+  // Closed form: standing still keeps the contact for all 10 steps; reversing at 1 m/s leaves
+  // the disc after two steps (gaps 0.6 and 0.7 m, then 0.8 m is no longer inside).
+  EXPECT_NEAR(escape.EscapeCost(in.robot, in.goal, {0.0, 0.0}), 1.0 + 1e-3 * 10.0, 1e-12);
+  EXPECT_NEAR(escape.EscapeCost(in.robot, in.goal, {-1.0, 0.0}), 0.2 + 1e-3 * 11.0, 1e-12);
+  out = escape.Compute(in);
+  EXPECT_TRUE(out.solved());
+  EXPECT_LT(out.command.v, -0.5);
+  EXPECT_EQ(escape.escapes(), 1);
+  // Far from everyone the fallback stays out of the way.
+  in.past_rows = nullptr;
+  out = escape.Compute(in);
+  EXPECT_NEAR(out.command.v, 1.0, 1e-3);
+  EXPECT_EQ(escape.escapes(), 1);
+}
+
 TEST(SpanController, BadOptionsAreClearErrors) {
   SpanControllerOptions o;
   o.epsilon = 1.2;
@@ -262,6 +297,13 @@ TEST(SpanController, BadOptionsAreClearErrors) {
   o = SpanControllerOptions();
   o.horizon = 0.0;
   testing::ExpectErrorContains([&] { SpanController(nullptr, nullptr, o); }, {"horizon"});
+  o = SpanControllerOptions();
+  o.escape_tau = -1.0;
+  testing::ExpectErrorContains([&] { SpanController(nullptr, nullptr, o); }, {"escape_tau", "-1"});
+  o = SpanControllerOptions();
+  o.escape_horizon = 5.0;
+  testing::ExpectErrorContains([&] { SpanController(nullptr, nullptr, o); },
+                               {"escape_horizon", "5"});
 }
 
 TEST(ReactiveController, StopsWhenBoxedInAndMovesWhenFree) {

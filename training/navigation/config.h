@@ -97,6 +97,11 @@ struct SpanControllerConfig {
              "COBYLA initial trust radius");
     a->Visit("geodesic_goal", &o.geodesic_goal, config::Range::Any(),
              "goal term as the distance around static obstacles (false: ||x(T) - g|| as printed)");
+    a->Visit("escape_tau", &o.escape_tau, config::Range::NonNegative(),
+             "fallback when the best plan collides within this many s: minimise the expected "
+             "contacts over escape_horizon instead (0: off, the thesis)");
+    a->Visit("escape_horizon", &o.escape_horizon, config::Range::Positive(),
+             "window of the escape fallback (s)");
     a->Visit("segments", &o.segments, config::Range::Closed(1, 8),
              "constant controls per horizon (1: the thesis's; 2: may change once, at T / 2)");
   }
