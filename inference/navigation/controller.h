@@ -39,7 +39,8 @@ struct ControlOutcome {
   /// Time-to-collision of the chosen control (inf: none within the horizon; NaN: the controller
   /// does not report one).
   double tau = std::numeric_limits<double>::quiet_NaN();
-  double cost = 0;  ///< objective value of the chosen control
+  double cost = 0;        ///< objective value of the chosen control
+  bool fallback = false;  ///< the command came from a fallback (SPAN's escape), not the objective
   bool solved() const { return status == ControlStatus::kSolved; }
   /// A stop command with `status` and `message`.
   static ControlOutcome Stop(ControlStatus status, std::string message);

@@ -114,7 +114,9 @@ double CrowdForecast::UnionBound(int k, const Eigen::Vector2d& x, double radius)
     for (int r = 0; r < r_; ++r) {
       const std::size_t j = Index(n, k, r);
       const double outer = radius + 6.0 * reach_[j];
-      if ((x - mean_[j]).squaredNorm() >= outer * outer) continue;
+      // Far components add < 1e-9; a non-finite one (a broken prediction) is ignored, as in
+      // Collides().
+      if (!((x - mean_[j]).squaredNorm() < outer * outer)) continue;
       sum += alpha_[static_cast<std::size_t>(n * r_ + r)] *
              CollisionProbabilityBound(x, mean_[j], cov_[j], radius);
     }

@@ -37,7 +37,7 @@ class CrowdForecast {
   double MaxBound(int k, const Eigen::Vector2d& x, double radius) const;
   /// Union bound on colliding with any pedestrian at step k: sum_n sum_r alpha_r bound_{n,r}
   /// (P(any) <= sum_n P_n; may exceed 1). Components farther than radius + 6 sigma (a term below
-  /// 1e-9) are skipped.
+  /// 1e-9) and non-finite ones are skipped.
   double UnionBound(int k, const Eigen::Vector2d& x, double radius) const;
 
   const Eigen::Vector2d& Mean(int n, int k, int r) const { return mean_[Index(n, k, r)]; }

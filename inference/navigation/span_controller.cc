@@ -135,7 +135,7 @@ std::string SpanControllerOptions::Problems() const {
       << " steps; ";
   if (!(escape_tau >= 0) || !std::isfinite(escape_tau))
     e << "escape_tau = " << escape_tau << " must be >= 0; ";
-  if (!(escape_horizon >= dt && escape_horizon <= horizon))
+  if (escape_tau > 0 && !(escape_horizon >= dt && escape_horizon <= horizon))
     e << "escape_horizon = " << escape_horizon << " must be in [dt, horizon]; ";
   if (max_evaluations < 3) e << "max_evaluations = " << max_evaluations << " must be >= 3; ";
   return e.str();
@@ -290,11 +290,16 @@ ControlOutcome SpanController::Compute(const NavigationInput& input) {
       escape.cost = [&](const std::vector<Control>& u) {
         return EscapeCost(input.robot, input.goal, u.front());
       };
+      // E >= 1e-3 x the goal distance after the window, which cannot drop by more than
+      // rate v_max escape_horizon: a start reaching that is optimal.
+      const double escape_lower =
+          1e-3 * std::max(0.0, here - rate * options_.limits.v_max * options_.escape_horizon);
       const auto [controls, escape_cost] = MinimiseFromStarts(
-          options_, 1, Starts(options_, input.robot, input.goal), nullptr, -kInf, &escape);
+          options_, 1, Starts(options_, input.robot, input.goal), nullptr, escape_lower, &escape);
       out.evaluations += escape.evaluations;
       if (std::isfinite(escape_cost)) {
         ++escapes_;
+        out.fallback = true;
         best.assign(static_cast<std::size_t>(options_.segments), controls.front());
         out.command = controls.front();
         out.cost = Cost(input.robot, input.goal, best, &out.tau);

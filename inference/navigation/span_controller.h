@@ -37,10 +37,11 @@ struct SpanControllerOptions {
   /// 2 lets it change once, at T / 2 (u is then 4-dimensional; the robot executes the first).
   int segments = 1;
   /// Fallback when nothing better than an imminent collision is found: when the chosen plan's
-  /// time-to-collision is at most `escape_tau` (s), the command instead minimises the expected
-  /// number of contacts over the next `escape_horizon` s (EscapeCost). 0 turns it off (the
-  /// thesis: the kappa / tau term is then the same for every control and the goal term alone
-  /// decides, driving through the pedestrian).
+  /// time-to-collision (pedestrians or the static map) is at most `escape_tau` (s), the command
+  /// instead minimises EscapeCost over the next `escape_horizon` s. 0 turns it off (the thesis:
+  /// the kappa / tau term is then the same for every control and the goal term alone decides,
+  /// driving on through the pedestrian). escape_horizon is checked (in [dt, horizon]) only when
+  /// the fallback is on.
   double escape_tau = 0.0;
   double escape_horizon = 1.0;  ///< s, at least dt and at most the horizon
   /// With a static map: measure the goal term as the geodesic distance around obstacles
@@ -70,10 +71,10 @@ class SpanController final : public NavigationController {
   double Cost(const UnicycleState& robot, const Eigen::Vector2d& goal,
               const std::vector<Control>& u, double* tau) const;
   /// The escape objective for one control held from `robot`: over the steps k = 1..K of
-  /// escape_horizon, the mean of the union bound sum_n P(contact with pedestrian n at step k)
-  /// (CrowdForecast::UnionBound, an upper bound on the expected number of pedestrians in
-  /// contact) plus 1 for a step in the static map's collision region, plus 1e-3 times the goal
-  /// distance at step K (ties go towards the goal).
+  /// escape_horizon, the mean of the union bound sum_n bound_n(x_k) (CrowdForecast::UnionBound,
+  /// an upper bound on the expected number of pedestrians in contact) plus 1 for a step in the
+  /// static map's collision region (swept occupancy above epsilon: a penalty, not a bound), plus
+  /// 1e-3 times the goal distance at step K (ties go towards the goal).
   double EscapeCost(const UnicycleState& robot, const Eigen::Vector2d& goal,
                     const Control& u) const;
   /// Fills the forecast from observations (done by Compute; exposed for tests and drawing).

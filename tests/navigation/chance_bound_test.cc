@@ -86,7 +86,7 @@ TEST(CrowdForecast, StandingPedestriansCollideWithinTheSumOfRadii) {
   EXPECT_FALSE(f.Collides(3, Eigen::Vector2d(0.81, 0), 0.8, t));
   EXPECT_TRUE(f.Collides(2, Eigen::Vector2d(5.5, 0.5), 0.8, t));
   EXPECT_EQ(f.MaxBound(1, Eigen::Vector2d(2.5, 0), 0.8), 0.0);
-  // Within both discs (2.5 apart, radius 3): two pedestrians in contact.
+  // 2.5 m from each pedestrian (they are 5 m apart), radius 3: inside both discs, two contacts.
   EXPECT_EQ(f.UnionBound(1, Eigen::Vector2d(2.5, 0), 3.0), 2.0);
   EXPECT_EQ(f.UnionBound(1, Eigen::Vector2d(2.5, 0), 0.8), 0.0);
 }

@@ -255,11 +255,11 @@ TEST(Baselines, NonFiniteObservationsAreDroppedNotObstacles) {
   for (Eigen::Index i = 0; i < rrt.path().cols(); ++i) EXPECT_TRUE(rrt.path().col(i).allFinite());
 }
 
-// A standing pedestrian 0.5 m ahead, inside the 0.8 m sum of radii: every control collides at
+// A standing pedestrian 0.45 m ahead, inside the 0.8 m sum of radii: every control collides at
 // the first step, so kappa / tau is the same for all of them. The thesis's cost then drives on
 // towards the goal, through the pedestrian; the escape fallback backs away.
 TEST(SpanController, EscapeBacksAwayWhenEveryControlCollidesAtOnce) {
-  const Eigen::MatrixXd rows = Standing({{0.5, 0.0}}, 5);
+  const Eigen::MatrixXd rows = Standing({{0.45, 0.0}}, 5);
   NavigationInput in;
   in.robot = {0, 0, 0};
   in.goal = {10, 0};
@@ -276,18 +276,20 @@ TEST(SpanController, EscapeBacksAwayWhenEveryControlCollidesAtOnce) {
   SpanController escape(nullptr, nullptr, o);
   escape.Forecast(in);
   // Closed form: standing still keeps the contact for all 10 steps; reversing at 1 m/s leaves
-  // the disc after two steps (gaps 0.6 and 0.7 m, then 0.8 m is no longer inside).
+  // the disc after three steps (centre distances 0.55, 0.65, 0.75 m, then 0.85 m).
   EXPECT_NEAR(escape.EscapeCost(in.robot, in.goal, {0.0, 0.0}), 1.0 + 1e-3 * 10.0, 1e-12);
-  EXPECT_NEAR(escape.EscapeCost(in.robot, in.goal, {-1.0, 0.0}), 0.2 + 1e-3 * 11.0, 1e-12);
+  EXPECT_NEAR(escape.EscapeCost(in.robot, in.goal, {-1.0, 0.0}), 0.3 + 1e-3 * 11.0, 1e-12);
   out = escape.Compute(in);
   EXPECT_TRUE(out.solved());
   EXPECT_LT(out.command.v, -0.5);
   EXPECT_EQ(escape.escapes(), 1);
+  EXPECT_TRUE(out.fallback);
   // Far from everyone the fallback stays out of the way.
   in.past_rows = nullptr;
   out = escape.Compute(in);
   EXPECT_NEAR(out.command.v, 1.0, 1e-3);
   EXPECT_EQ(escape.escapes(), 1);
+  EXPECT_FALSE(out.fallback);
 }
 
 TEST(SpanController, BadOptionsAreClearErrors) {
@@ -302,6 +304,8 @@ TEST(SpanController, BadOptionsAreClearErrors) {
   testing::ExpectErrorContains([&] { SpanController(nullptr, nullptr, o); }, {"escape_tau", "-1"});
   o = SpanControllerOptions();
   o.escape_horizon = 5.0;
+  EXPECT_EQ(o.Problems(), "");  // the fallback is off: its window is not used
+  o.escape_tau = 0.1;
   testing::ExpectErrorContains([&] { SpanController(nullptr, nullptr, o); },
                                {"escape_horizon", "5"});
 }

@@ -84,7 +84,8 @@ TEST(NavigationRun, EveryMethodRunsAnEpisodeAndTheSummaryHasItsKeys) {
   std::getline(csv, header);
   EXPECT_EQ(header,
             "method,episode,seed,reached,ttg,doc,doc_static,min_clearance,path_length,cycles,solve_"
-            "failures,cycle_ms_median,cycle_ms_p99,robot_caused_doc,blocked_cycles,stopped_time");
+            "failures,cycle_ms_median,cycle_ms_p99,robot_caused_doc,blocked_cycles,stopped_time,"
+            "fallback_cycles");
   for (const char* key : {"blocked_cycle_share", "stopped_time_share"})
     EXPECT_NE(text.str().find(key), std::string::npos) << key;
 }
@@ -262,7 +263,10 @@ TEST(NavigationRun, SummaryMetricsFollowTheirDefinitions) {
   results[0].tau_cycles = 10, results[0].blocked_cycles = 4, results[0].stopped_time = 5;
   results[1].tau_cycles = 30, results[1].blocked_cycles = 6, results[1].stopped_time = 9;
   results[0].duration = 20, results[1].duration = 90, results[2].duration = 30;
+  results[0].cycles = 200, results[1].cycles = 900, results[2].cycles = 300;
+  results[0].fallback_cycles = 7, results[2].fallback_cycles = 3;
   const nav::MethodSummary b = nav::Summarise("span", results);
+  EXPECT_DOUBLE_EQ(b.fallback_cycle_share, 10.0 / 1400);
   EXPECT_DOUBLE_EQ(b.blocked_cycle_share, 10.0 / 40);
   EXPECT_DOUBLE_EQ(b.stopped_time_share, 14.0 / (20 + 90 + 30));
   // None reached: TTG is null in the JSON, never NaN.

@@ -101,7 +101,7 @@ struct SpanControllerConfig {
              "fallback when the best plan collides within this many s: minimise the expected "
              "contacts over escape_horizon instead (0: off, the thesis)");
     a->Visit("escape_horizon", &o.escape_horizon, config::Range::Positive(),
-             "window of the escape fallback (s)");
+             "window of the escape fallback (s), in [dt, horizon] when escape_tau > 0");
     a->Visit("segments", &o.segments, config::Range::Closed(1, 8),
              "constant controls per horizon (1: the thesis's; 2: may change once, at T / 2)");
   }

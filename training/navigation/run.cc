@@ -302,6 +302,7 @@ EpisodeResult RunEpisode(const ExperimentConfig& c, const Resources& res, Method
       ++out.tau_cycles;
       out.blocked_cycles += std::isfinite(u.tau);
     }
+    out.fallback_cycles += u.fallback;
     const nav::Control cmd = limits.Clamp(u.command);
     if (std::abs(cmd.v) < kRobotCausedSpeed) out.stopped_time += c.dt;
     out.duration += c.dt;
@@ -360,7 +361,7 @@ MethodSummary Summarise(const std::string& method, const std::vector<EpisodeResu
   std::vector<double> cycles, ttg;
   double doc = 0, robot_doc = 0, clear = 0, worst = kInf, ttg_censored = 0;
   double stopped = 0, elapsed = 0;
-  int blocked = 0, tau_cycles = 0;
+  int blocked = 0, tau_cycles = 0, fallback = 0, all_cycles = 0;
   for (const EpisodeResult& r : results) {
     if (r.method != method) continue;
     ++m.episodes;
@@ -377,6 +378,8 @@ MethodSummary Summarise(const std::string& method, const std::vector<EpisodeResu
     m.solve_failures += r.solve_failures;
     blocked += r.blocked_cycles;
     tau_cycles += r.tau_cycles;
+    fallback += r.fallback_cycles;
+    all_cycles += r.cycles;
     stopped += r.stopped_time;
     elapsed += r.duration;
     cycles.insert(cycles.end(), r.cycle_ms.begin(), r.cycle_ms.end());
@@ -404,6 +407,8 @@ MethodSummary Summarise(const std::string& method, const std::vector<EpisodeResu
   m.cycle_ms_max = cycles.empty() ? std::nan("") : *std::max_element(cycles.begin(), cycles.end());
   m.blocked_cycle_share = tau_cycles > 0 ? static_cast<double>(blocked) / tau_cycles : std::nan("");
   m.stopped_time_share = elapsed > 0 ? stopped / elapsed : std::nan("");
+  m.fallback_cycle_share =
+      all_cycles > 0 ? static_cast<double>(fallback) / all_cycles : std::nan("");
   return m;
 }
 
@@ -428,6 +433,7 @@ std::string SummaryJson(const ExperimentConfig& c, int episodes,
       << ", \"cycle_ms_max\": " << Json(m.cycle_ms_max)
       << ", \"blocked_cycle_share\": " << Json(m.blocked_cycle_share)
       << ", \"stopped_time_share\": " << Json(m.stopped_time_share)
+      << ", \"fallback_cycle_share\": " << Json(m.fallback_cycle_share)
       << ", \"solve_failures\": " << m.solve_failures << ", \"episodes\": " << m.episodes
       << ", \"successes\": " << m.successes << ", \"collision_free\": " << m.collision_free
       << ", \"success_and_collision_free\": " << m.success_and_collision_free
@@ -485,7 +491,8 @@ std::vector<MethodSummary> RunNavigation(const ExperimentConfig& c, const std::s
   // Rewritten (atomically) after every episode: a stopped run keeps the episodes it finished.
   std::ostringstream csv;
   csv << "method,episode,seed,reached,ttg,doc,doc_static,min_clearance,path_length,cycles,solve_"
-         "failures,cycle_ms_median,cycle_ms_p99,robot_caused_doc,blocked_cycles,stopped_time\n";
+         "failures,cycle_ms_median,cycle_ms_p99,robot_caused_doc,blocked_cycles,stopped_time,"
+         "fallback_cycles\n";
   for (const Method method : c.Methods()) {
     for (int e = 0; e < n; ++e) {
       std::unique_ptr<VideoRecorder> video;
@@ -498,7 +505,7 @@ std::vector<MethodSummary> RunNavigation(const ExperimentConfig& c, const std::s
           << ',' << r.cycles << ',' << r.solve_failures << ',' << Percentile(r.cycle_ms, 0.5) << ','
           << Percentile(r.cycle_ms, 0.99) << ',' << r.robot_caused_doc << ','
           << (r.tau_cycles > 0 ? std::to_string(r.blocked_cycles) : std::string()) << ','
-          << r.stopped_time << '\n';
+          << r.stopped_time << ',' << r.fallback_cycles << '\n';
       WriteFileAtomically(out_dir + "/episodes.csv", csv.str());
       log::Info(r.method, " episode ", e, ": ", r.reached ? "reached" : "not reached", " ttg ",
                 r.ttg, " s, doc ", r.doc, " s, min clearance ", r.min_clearance,

@@ -55,6 +55,7 @@ struct EpisodeResult {
   /// collision-free control was found); counted for controllers that report one (SPAN).
   int blocked_cycles = 0;
   int tau_cycles = 0;            ///< cycles whose controller reported a time-to-collision
+  int fallback_cycles = 0;       ///< cycles whose command came from a fallback (SPAN's escape)
   double stopped_time = 0;       ///< s with a commanded speed below kRobotCausedSpeed
   double duration = 0;           ///< s simulated (cycles x dt)
   std::vector<double> cycle_ms;  ///< compute time of each control cycle
@@ -122,6 +123,8 @@ struct MethodSummary {
   /// Share of all cycles that were blocked (EpisodeResult::blocked_cycles; NaN -> null for
   /// controllers that report no time-to-collision), and of the episodes' time spent stopped.
   double blocked_cycle_share = 0, stopped_time_share = 0;
+  /// Share of all cycles whose command came from a fallback (ControlOutcome::fallback).
+  double fallback_cycle_share = 0;
 };
 MethodSummary Summarise(const std::string& method, const std::vector<EpisodeResult>& results);
 
