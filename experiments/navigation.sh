@@ -4,7 +4,7 @@
 # episodes each (seeds 0 to EPISODES - 1); writes runs/navigate_<scenario>/ and results/navigation.md.
 # Predictors are trained on first use. sim1 and sim2 run side by side, one process per core (each is
 # single-threaded; CL-RRT*'s per-cycle budget is wall time, so run it on an otherwise idle machine).
-# About 30 minutes on 2 cores.
+# About 12 minutes on 2 cores.
 #   experiments/navigation.sh [key.path=value ...]      (overrides apply to every scenario)
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
