@@ -73,6 +73,12 @@ void CrowdScenarioConfig::Validate(const std::string& where) const {
       const std::string key = "groups[" + std::to_string(g) + "]";
       FS_THROW_UNLESS(groups[g].count >= 1, where, ": '", key, ".count' must be >= 1, got ",
                       groups[g].count);
+      // The simulator caps |v| at max_speed: a faster preferred speed would be cut silently.
+      FS_THROW_UNLESS(
+          groups[g].preferred_speed + groups[g].speed_jitter <= power_law.max_speed + 1e-9, where,
+          ": '", key, ".preferred_speed' = ", groups[g].preferred_speed, " + speed_jitter ",
+          groups[g].speed_jitter,
+          " exceeds the simulator's limit power_law.max_speed = ", power_law.max_speed, " m/s");
       CheckBox(groups[g].spawn, extent, where, key + ".spawn");
       CheckBox(groups[g].goal, extent, where, key + ".goal");
     }

@@ -78,9 +78,10 @@ struct PedestrianGroupConfig {
   std::vector<double> spawn{-1, 1, -1,
                             1};            ///< x_min, x_max, y_min, y_max (m); degenerate = a point
   std::vector<double> goal{-1, 1, -1, 1};  ///< x_min, x_max, y_min, y_max (m)
-  double preferred_speed = 1.0;            ///< m/s (capped by PowerLawParams::max_speed)
-  double speed_jitter = 0.1;               ///< m/s, uniform +- jitter of each pedestrian's speed
-  double radius = 0.0;                     ///< m, 0 = CrowdScenarioConfig::pedestrian_radius
+  /// m/s; with the jitter at most PowerLawParams::max_speed (Validate refuses faster groups)
+  double preferred_speed = 0.9;
+  double speed_jitter = 0.1;  ///< m/s, uniform +- jitter of each pedestrian's speed
+  double radius = 0.0;        ///< m, 0 = CrowdScenarioConfig::pedestrian_radius
   /// On reaching the goal, walk back to a new point of the spawn box (and so on), so the density
   /// persists; otherwise stop at the goal (the pedestrian stays, as an obstacle).
   bool round_trip = true;

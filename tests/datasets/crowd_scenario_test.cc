@@ -137,6 +137,9 @@ TEST(CrowdScenario, ValidateRejectsInconsistentScenes) {
       },
       {"'groups[0].goal'", "not inside"});
   expect([](CrowdScenarioConfig* s) { s->groups[0].count = 0; }, {"'groups[0].count'"});
+  // Faster than the simulator's cap (1 m/s): 0.95 + 0.1 jitter.
+  expect([](CrowdScenarioConfig* s) { s->groups[1].preferred_speed = 0.95; },
+         {"'groups[1].preferred_speed' = 0.95", "speed_jitter 0.1", "power_law.max_speed = 1"});
   expect(
       [](CrowdScenarioConfig* s) {
         s->source = CrowdSource::kReplay;

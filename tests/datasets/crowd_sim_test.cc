@@ -157,18 +157,23 @@ TEST(PowerLaw, WallForceIsMinusTheGradientOfTheWallEnergy) {
   EXPECT_NEAR(WallTimeToCollision({-2, 0}, {1, 0}, 0.4, w), 1.5, 1e-12);  // 2 - 0.4 - 0.1 at 1 m/s
 }
 
-TEST(PowerLawCrowd, LoneAgentWalksStraightAtItsPreferredSpeedCappedAtMaxSpeed) {
-  for (const double speed : {0.8, 1.6}) {
+// A preferred speed above the simulator's cap (1 m/s) would be cut silently: refused instead.
+TEST(PowerLawCrowd, LoneAgentWalksStraightAtItsPreferredSpeedAndFasterOnesAreRefused) {
+  for (const double speed : {0.8, 1.0}) {
     PowerLawCrowd crowd(Singles({{-10, 1}}, {{10, 1}}, speed, PowerLawParams::Aggressive()), 1);
     crowd.Step(3.0, NoRobot());  // relaxed after ~10 relaxation times
     const CrowdAgent& a = crowd.agents()[0];
-    const double expected = std::min(speed, 1.0);
-    EXPECT_NEAR(a.velocity.norm(), expected, 1e-4) << speed;  // e^-10 left of the relaxation
+    EXPECT_NEAR(a.velocity.norm(), speed, 1e-4) << speed;  // e^-10 left of the relaxation
     EXPECT_NEAR(a.position.y(), 1.0, 1e-9);
     EXPECT_NEAR(a.velocity.y(), 0.0, 1e-9);
     crowd.Step(5.0, NoRobot());
-    EXPECT_NEAR(crowd.agents()[0].position.x(), -10 + 8 * expected - expected * 0.3, 0.05) << speed;
+    EXPECT_NEAR(crowd.agents()[0].position.x(), -10 + 8 * speed - speed * 0.3, 0.05) << speed;
   }
+  testing::ExpectErrorContains(
+      [] {
+        PowerLawCrowd(Singles({{-10, 1}}, {{10, 1}}, 1.6, PowerLawParams::Aggressive()), 1);
+      },
+      {"'groups[0].preferred_speed' = 1.6", "max_speed = 1"});
 }
 
 TEST(PowerLawCrowd, TwoAgentsHeadOnAvoidEachOtherAndArrive) {
