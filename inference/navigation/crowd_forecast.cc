@@ -1,5 +1,6 @@
 #include "inference/navigation/crowd_forecast.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/error.h"
@@ -68,25 +69,26 @@ void CrowdForecast::FromCurrentPositions(const Eigen::Ref<const Eigen::Matrix2Xd
 bool CrowdForecast::Collides(int k, const Eigen::Vector2d& x, double radius,
                              const ChanceThreshold& threshold) const {
   const double c = threshold.c();
+  const int kc = commit_steps_ > 0 ? std::min(k, commit_steps_) : k;  // step of the covariance
   for (int n = 0; n < n_; ++n) {
     if (r_ == 1) {
-      const std::size_t j = Index(n, k, 0);
+      const std::size_t j = Index(n, k, 0), jc = Index(n, kc, 0);
       const Eigen::Vector2d d = x - mean_[j];
       // Quick reject: a' Sigma a <= lambda_max, so no collision when ||d|| >= radius + c sqrt(2
       // lambda_max).
-      const double outer = radius + std::max(0.0, c) * M_SQRT2 * reach_[j];
+      const double outer = radius + std::max(0.0, c) * M_SQRT2 * reach_[jc];
       if (d.squaredNorm() >= outer * outer) continue;
-      if (threshold.Exceeds(d, cov_[j], radius)) return true;
+      if (threshold.Exceeds(d, cov_[jc], radius)) return true;
     } else {
       double bound = 0.0;
       for (int r = 0; r < r_; ++r) {
-        const std::size_t j = Index(n, k, r);
+        const std::size_t j = Index(n, k, r), jc = Index(n, kc, r);
         const Eigen::Vector2d d = x - mean_[j];
         // Components farther than radius + 6 sigma contribute < 1e-9: skipped.
-        const double outer = radius + 6.0 * reach_[j];
+        const double outer = radius + 6.0 * reach_[jc];
         if (d.squaredNorm() >= outer * outer) continue;
         bound += alpha_[static_cast<std::size_t>(n * r_ + r)] *
-                 CollisionProbabilityBound(x, mean_[j], cov_[j], radius);
+                 CollisionProbabilityBound(x, mean_[j], cov_[jc], radius);
       }
       if (bound > threshold.epsilon()) return true;
     }

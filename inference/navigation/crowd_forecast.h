@@ -24,13 +24,19 @@ class CrowdForecast {
   /// view).
   void FromCurrentPositions(const Eigen::Ref<const Eigen::Matrix2Xd>& positions, int steps);
 
+  /// Steps k_c after which Collides() holds the covariance at k_c (0: never, the thesis).
+  void set_commit_steps(int k_c) { commit_steps_ = k_c > 0 ? k_c : 0; }
+  int commit_steps() const { return commit_steps_; }
+
   int pedestrians() const { return n_; }
   int steps() const { return steps_; }
   int components() const { return r_; }
 
   /// True when the probability bound of colliding with any pedestrian at step k (1-based) exceeds
   /// the threshold (eq. dynamicCheck). One component: the erf-free form of ChanceThreshold;
-  /// mixtures: sum_r alpha_r bound_r > epsilon (a bound on the mixture probability).
+  /// mixtures: sum_r alpha_r bound_r > epsilon (a bound on the mixture probability). With a
+  /// commitment of k_c steps (set_commit_steps), a step k > k_c is tested with the mean at k and
+  /// the covariance at k_c (SpanControllerOptions::commit_time has the derivation).
   bool Collides(int k, const Eigen::Vector2d& x, double radius,
                 const ChanceThreshold& threshold) const;
   /// Largest bound over the pedestrians at step k (for tests and plots).
@@ -48,7 +54,7 @@ class CrowdForecast {
   std::size_t Index(int n, int k, int r) const {
     return (static_cast<std::size_t>(n) * steps_ + static_cast<std::size_t>(k - 1)) * r_ + r;
   }
-  int n_ = 0, steps_ = 0, r_ = 1;
+  int n_ = 0, steps_ = 0, r_ = 1, commit_steps_ = 0;
   std::vector<double> alpha_;          ///< [N * R]
   std::vector<Eigen::Vector2d> mean_;  ///< [N * K * R]
   std::vector<Eigen::Matrix2d> cov_;   ///< [N * K * R]

@@ -135,6 +135,9 @@ std::string SpanControllerOptions::Problems() const {
       << " steps; ";
   if (!(escape_tau >= 0) || !std::isfinite(escape_tau))
     e << "escape_tau = " << escape_tau << " must be >= 0; ";
+  if (!(commit_time >= 0) || !std::isfinite(commit_time) ||
+      (commit_time > 0 && !(commit_time >= dt && commit_time <= horizon)))
+    e << "commit_time = " << commit_time << " must be 0 (off) or in [dt, horizon]; ";
   if (escape_tau > 0 && !(escape_horizon >= dt && escape_horizon <= horizon))
     e << "escape_horizon = " << escape_horizon << " must be in [dt, horizon]; ";
   if (max_evaluations < 3) e << "max_evaluations = " << max_evaluations << " must be >= 3; ";
@@ -181,6 +184,9 @@ SpanController::SpanController(const span::Predictor* predictor, const StaticCol
     predictor_ws_ = predictor_->MakeWorkspace();
     forecast_.Reserve(64, steps_, predictor_->layout().components);
   }
+  forecast_.set_commit_steps(options_.commit_time > 0
+                                 ? static_cast<int>(std::lround(options_.commit_time / options_.dt))
+                                 : 0);
 }
 
 void SpanController::Prepare(const Eigen::Vector2d& goal) {

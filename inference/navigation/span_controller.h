@@ -44,6 +44,20 @@ struct SpanControllerOptions {
   /// the fallback is on.
   double escape_tau = 0.0;
   double escape_horizon = 1.0;  ///< s, at least dt and at most the horizon
+  /// Commitment time t_c (s; 0 = off, the thesis): the collision test at t_k > t_c uses the
+  /// predicted mean at t_k with the covariance at t_c. Why: the robot re-plans every dt, so a
+  /// predicted contact at t_k only commits it if it must still be avoided when its last chance
+  /// to react comes, about t_c before. If forecasts are updated without bias (each newer forecast
+  /// of o(t_k) is the current one plus zero-mean news; exact for a random walk), the forecast
+  /// made at t_k - t_c has its mean spread around today's with a' (Sigma_k - Sigma_c) a and keeps
+  /// residual variance a' Sigma_c a. That later plan flags the step when a'd' < r + c sqrt(2 a'
+  /// Sigma_c a), which happens with probability above 1/2 exactly when today's mean offset d
+  /// satisfies the same inequality: the thesis's test with Sigma_c in place of Sigma_k. Per step
+  /// this is epsilon_k = erfc(c sqrt(a' Sigma_c a / a' Sigma_k a)) / 2 >= epsilon. Mixture
+  /// forecasts hold each component's covariance the same way (a heuristic extension). t_c about
+  /// dt + (r_robot + r_ped) / |v_min| (time to back out of contact). EscapeCost keeps the full
+  /// covariance.
+  double commit_time = 0.0;
   /// With a static map: measure the goal term as the geodesic distance around obstacles
   /// (GoalDistanceField) instead of ||x(T) - g||; identical where the way to the goal is free.
   bool geodesic_goal = true;

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <random>
 
 #include "inference/navigation/crowd_forecast.h"
@@ -135,6 +137,43 @@ TEST(CrowdForecast, TablesThePredictorAndAgreesWithTheBoundByBruteForce) {
       ++checked;
     }
     EXPECT_GT(checked, 2900);
+
+    // Commitment after k_c = 5 steps: steps up to 5 are unchanged; later ones test the mean at k
+    // with the covariance at k_c, by brute force over the bounds. For one component the same
+    // test is the thesis's at the per-step threshold
+    // epsilon_k = erfc(c sqrt(a' Sigma_c a / a' Sigma_k a)) / 2 (span_controller.h).
+    CrowdForecast capped = f;
+    capped.set_commit_steps(5);
+    int compared = 0, differs = 0;
+    for (int i = 0; i < 3000; ++i) {
+      const Eigen::Vector2d x(u(rng), u(rng));
+      const int k = 1 + i % 20, kc = std::min(k, 5);
+      double worst = 0.0;
+      bool per_step = false;
+      for (int n = 0; n < 2; ++n) {
+        double b = 0.0;
+        for (int r = 0; r < components; ++r)
+          b += f.Alpha(n, r) * CollisionProbabilityBound(x, f.Mean(n, k, r), f.Cov(n, kc, r), 0.8);
+        worst = std::max(worst, b);
+        if (components == 1) {
+          const Eigen::Vector2d a = (x - f.Mean(n, k, 0)).normalized();
+          const double eps_k =
+              0.5 *
+              std::erfc(t.c() * std::sqrt(a.dot(f.Cov(n, kc, 0) * a) / a.dot(f.Cov(n, k, 0) * a)));
+          per_step = per_step ||
+                     CollisionProbabilityBound(x, f.Mean(n, k, 0), f.Cov(n, k, 0), 0.8) > eps_k;
+        }
+      }
+      if (std::abs(worst - 0.25) < 1e-6) continue;
+      const bool hit = capped.Collides(k, x, 0.8, t);
+      EXPECT_EQ(hit, worst > 0.25) << "k " << k << " x " << x.transpose();
+      if (components == 1) EXPECT_EQ(hit, per_step) << "k " << k << " x " << x.transpose();
+      if (k <= 5) EXPECT_EQ(hit, f.Collides(k, x, 0.8, t));
+      differs += hit != f.Collides(k, x, 0.8, t);
+      ++compared;
+    }
+    EXPECT_GT(compared, 2900);
+    EXPECT_GT(differs, 0);  // the cap matters somewhere in this scene
   }
 }
 

@@ -300,6 +300,10 @@ TEST(SpanController, BadOptionsAreClearErrors) {
   o.horizon = 0.0;
   testing::ExpectErrorContains([&] { SpanController(nullptr, nullptr, o); }, {"horizon"});
   o = SpanControllerOptions();
+  o.commit_time = 0.05;  // shorter than a step
+  testing::ExpectErrorContains([&] { SpanController(nullptr, nullptr, o); },
+                               {"commit_time = 0.05", "[dt, horizon]"});
+  o = SpanControllerOptions();
   o.escape_tau = -1.0;
   testing::ExpectErrorContains([&] { SpanController(nullptr, nullptr, o); }, {"escape_tau", "-1"});
   o = SpanControllerOptions();

@@ -102,6 +102,9 @@ struct SpanControllerConfig {
              "contacts over escape_horizon instead (0: off, the thesis)");
     a->Visit("escape_horizon", &o.escape_horizon, config::Range::Positive(),
              "window of the escape fallback (s), in [dt, horizon] when escape_tau > 0");
+    a->Visit("commit_time", &o.commit_time, config::Range::NonNegative(),
+             "commitment time t_c (s): collision tests beyond it hold the covariance at t_c "
+             "(0: off, the thesis; else in [dt, horizon]; docs/navigation.md)");
     a->Visit("segments", &o.segments, config::Range::Closed(1, 8),
              "constant controls per horizon (1: the thesis's; 2: may change once, at T / 2)");
   }
