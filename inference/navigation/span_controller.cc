@@ -234,10 +234,13 @@ double SpanController::SegmentCost(const UnicycleState& robot, const Eigen::Vect
       t_collide = k * options_.dt;
   }
   if (tau) *tau = t_collide;
-  const double distance = !goal_field_.empty() && goal_field_.goal() == goal
-                              ? goal_field_.Distance(s.position())
-                              : (s.position() - goal).norm();
+  const double distance = GoalDistance(s.position(), goal);
   return std::isfinite(t_collide) ? distance + options_.kappa / t_collide : distance;
+}
+
+double SpanController::GoalDistance(const Eigen::Vector2d& p, const Eigen::Vector2d& goal) const {
+  return !goal_field_.empty() && goal_field_.goal() == goal ? goal_field_.Distance(p)
+                                                            : (p - goal).norm();
 }
 
 double SpanController::EscapeCost(const UnicycleState& robot, const Eigen::Vector2d& goal,
@@ -256,9 +259,7 @@ double SpanController::EscapeCost(const UnicycleState& robot, const Eigen::Vecto
     if (field_ && field_->Collides(p.x(), p.y(), options_.epsilon, &map_ws_)) contacts += 1.0;
     contacts += forecast_.UnionBound(std::min(k, forecast_.steps()), p, r);
   }
-  const double distance = !goal_field_.empty() && goal_field_.goal() == goal
-                              ? goal_field_.Distance(s.position())
-                              : (s.position() - goal).norm();
+  const double distance = GoalDistance(s.position(), goal);
   return contacts / escape_steps_ + 1e-3 * distance;
 }
 
@@ -271,9 +272,7 @@ ControlOutcome SpanController::Compute(const NavigationInput& input) {
     problem.cost = [&](const std::vector<Control>& u) {
       return Cost(input.robot, input.goal, u, nullptr);
     };
-    const double here = goal_field_.empty() || goal_field_.goal() != input.goal
-                            ? (input.robot.position() - input.goal).norm()
-                            : goal_field_.Distance(input.robot.position());
+    const double here = GoalDistance(input.robot.position(), input.goal);
     // The weighted geodesic distance can drop faster than v_max near walls (up to 1 +
     // margin_weight).
     const double rate = goal_field_.empty() ? 1.0 : 1.0 + goal_field_.margin_weight();

@@ -104,6 +104,8 @@ class SpanController final : public NavigationController {
   int escapes() const { return escapes_; }
 
  private:
+  /// The goal term's distance: geodesic when the field is built for `goal`, else Euclidean.
+  double GoalDistance(const Eigen::Vector2d& p, const Eigen::Vector2d& goal) const;
   double SegmentCost(const UnicycleState& robot, const Eigen::Vector2d& goal, const Control* u,
                      int parts, double* tau) const;
 
