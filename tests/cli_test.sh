@@ -152,6 +152,8 @@ if [ "${FORESIGHT_WITH_TORCH:-1}" = "1" ] || [ "${FORESIGHT_WITH_TORCH}" = "ON" 
   expect_error "unknown key 'train.learning_rat'" train "$TMP/typo.yaml" --run-dir "$TMP/r0"
   expect_error "'train.epochs'" train default train.epochs=zero --run-dir "$TMP/r0"
   expect_error "'train.epochs'" train default train.epochs=0 --run-dir "$TMP/r0"
+  expect_error "'augment.speed_scales': value 1" train default "augment.speed_scales=[0.8,1]" --run-dir "$TMP/r0"
+  expect_error "augment.speed_scales" train default "augment.speed_scales=[-2]" --run-dir "$TMP/r0"
   expect_error "cannot open config file" train "$TMP/missing.yaml"
   RUN="$TMP/run"
   TINY=(data.synthetic.num_tracks=120 network.hidden=[16,16] train.epochs=2 train.batch_size=64 train.progress=lines)

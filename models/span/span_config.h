@@ -58,4 +58,25 @@ struct NetConfig {
   }
 };
 
+/// Training-set augmentation by exact symmetries of the ego-frame samples (an extension of the
+/// thesis). Every training window also enters at each speed scale s (positions relative to the
+/// present times s: the same path walked s times as fast) and, with `mirror`, reflected about
+/// the heading (ego y -> -y). Inputs and ridge targets are linear in the positions, so the
+/// augmented samples are exactly those of the scaled or mirrored windows. Validation and test
+/// windows are never augmented.
+struct AugmentConfig {
+  std::vector<double> speed_scales = {};  ///< extra scales besides 1 (empty: none)
+  bool mirror = false;
+
+  template <class A>
+  void Serialize(A* a) {
+    a->Visit("speed_scales", &speed_scales, config::Range::Closed(0.1, 10.0),
+             "each training window is added again at each of these speed scales (s != 1)");
+    a->Visit("mirror", &mirror, config::Range::Any(),
+             "add each training window (and its scaled copies) mirrored about its heading");
+  }
+  /// Training samples per original window.
+  int Copies() const { return (1 + static_cast<int>(speed_scales.size())) * (mirror ? 2 : 1); }
+};
+
 }  // namespace foresight::span

@@ -1,6 +1,7 @@
 #include "models/span/span_data.h"
 
 #include "core/ego_frame.h"
+#include "core/error.h"
 
 namespace foresight::span {
 
@@ -40,6 +41,32 @@ Samples MakeSamples(const WindowSet& w, const TimeBasis& basis, const Trajectory
     }
   }
   return s;
+}
+
+Samples Augment(const Samples& in, const AugmentConfig& a) {
+  for (const double s : a.speed_scales)
+    FS_THROW_UNLESS(s > 0 && std::abs(s - 1.0) > 1e-9, "augment.speed_scales: value ", s,
+                    " (a scale must be positive and not 1; the data enter at scale 1 anyway)");
+  const Eigen::Index n = in.inputs.rows();
+  Samples out;
+  out.inputs.resize(n * a.Copies(), in.inputs.cols());
+  out.targets.resize(n * a.Copies(), in.targets.cols());
+  Eigen::Index row = 0;
+  const auto append = [&](double scale) {
+    out.inputs.middleRows(row, n) = scale * in.inputs;
+    out.targets.middleRows(row, n) = scale * in.targets;
+    row += n;
+  };
+  append(1.0);
+  for (const double s : a.speed_scales) append(s);
+  if (a.mirror) {
+    // Columns alternate x, y in both inputs (past points) and targets (rows of W).
+    out.inputs.middleRows(row, row) = out.inputs.topRows(row);
+    out.targets.middleRows(row, row) = out.targets.topRows(row);
+    for (Eigen::Index c = 1; c < out.inputs.cols(); c += 2) out.inputs.col(c).tail(row) *= -1.0;
+    for (Eigen::Index c = 1; c < out.targets.cols(); c += 2) out.targets.col(c).tail(row) *= -1.0;
+  }
+  return out;
 }
 
 }  // namespace foresight::span

@@ -26,4 +26,9 @@ Samples MakeSamples(const WindowSet& windows, const TimeBasis& basis,
                     const TrajectoryBasisConfig& config, bool rotate,
                     bool residual_to_constant_velocity = false);
 
+/// The samples of `samples` followed by their copies at each of `augment.speed_scales` and, with
+/// `augment.mirror`, all of those mirrored (ego y -> -y); see AugmentConfig. Scales must be
+/// positive and differ from 1 (a copy at 1 would only repeat the data): an Error names the value.
+Samples Augment(const Samples& samples, const AugmentConfig& augment);
+
 }  // namespace foresight::span

@@ -1,5 +1,7 @@
 #include "training/span/config.h"
 
+#include <cmath>
+
 #include "core/layer_widths.h"
 
 namespace foresight::span {
@@ -19,6 +21,9 @@ void ExperimentConfig::Validate(const std::string& source) const {
           c.data.format != TrackFormat::kSynthetic,
       source, ": key 'data.synthetic.min_steps' must be >= windows.observed + windows.predicted");
   CheckLayerWidths(c.network.hidden, source, "network.hidden");
+  for (const double scale : c.augment.speed_scales)
+    FS_THROW_UNLESS(std::abs(scale - 1.0) > 1e-9, source, ": key 'augment.speed_scales': value ",
+                    scale, " (the data enter at scale 1 anyway; list only the extra scales)");
 }
 
 }  // namespace foresight::span

@@ -36,6 +36,7 @@ struct ExperimentConfig {
   WindowConfig windows;
   TrajectoryBasisConfig basis;
   NetConfig network;
+  AugmentConfig augment;
   TrainConfig train;
   EvalConfig eval;
 
@@ -47,6 +48,8 @@ struct ExperimentConfig {
     a->Visit("windows", &windows, config::Range::Any(), "observation / prediction windows");
     a->Visit("basis", &basis, config::Range::Any(), "RBF trajectory representation of futures");
     a->Visit("network", &network, config::Range::Any(), "predictor network and head");
+    a->Visit("augment", &augment, config::Range::Any(),
+             "training-set augmentation by speed scaling and mirroring (extension)");
     a->Visit("train", &train, config::Range::Any(), "trainer");
     a->Visit("eval", &eval, config::Range::Any(), "evaluation");
   }

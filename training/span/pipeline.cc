@@ -82,7 +82,9 @@ TrainingSummary TrainRun(const ExperimentConfig& c, const std::string& run_dir, 
                   "); the validation loss chooses the best checkpoint and drives early stopping");
   ModelSpec spec = ModelSpecOf(c);
   spec.seconds_per_step = train_w.seconds_per_step;
-  return TrainOnWindows(spec, train_w, val_w, c.train, c.seed, run_dir, resume, hooks);
+  if (c.augment.Copies() > 1)
+    log::Info("augmenting the training windows x", c.augment.Copies(), " (augment.*)");
+  return TrainOnWindows(spec, train_w, val_w, c.train, c.seed, run_dir, resume, hooks, c.augment);
 }
 
 ModelSpec ModelSpecOf(const ExperimentConfig& c) {
@@ -183,7 +185,7 @@ TrainingSummary TrainNet(const ModelSpec& spec, const Samples& train_s, const Sa
 TrainingSummary TrainOnWindows(const ModelSpec& spec, const WindowSet& train_w,
                                const WindowSet& val_w, const TrainConfig& train_config,
                                std::int64_t seed, const std::string& run_dir, bool resume,
-                               const TrainHooks& hooks) {
+                               const TrainHooks& hooks, const AugmentConfig& augment) {
   FS_THROW_UNLESS(train_w.size() > 0, run_dir, ": no training windows");
   FS_THROW_UNLESS(val_w.size() > 0, run_dir, ": no validation windows");
   FS_THROW_UNLESS(train_w.observed == spec.observed && train_w.predicted == spec.predicted &&
@@ -191,8 +193,8 @@ TrainingSummary TrainOnWindows(const ModelSpec& spec, const WindowSet& train_w,
                   run_dir, ": windows of ", train_w.observed, " + ", train_w.predicted,
                   " (train) / ", val_w.observed, " + ", val_w.predicted,
                   " (val) points, the model expects ", spec.observed, " + ", spec.predicted);
-  return TrainNet(spec, MakeSamples(spec, train_w), MakeSamples(spec, val_w), train_config, seed,
-                  run_dir, resume, hooks);
+  return TrainNet(spec, Augment(MakeSamples(spec, train_w), augment), MakeSamples(spec, val_w),
+                  train_config, seed, run_dir, resume, hooks);
 }
 
 Mlp ToEngineMlp(torch::nn::Module& net, const std::vector<std::string>& names) {

@@ -76,11 +76,12 @@ TrainingSummary TrainNet(const ModelSpec& spec, const Samples& train, const Samp
                          const TrainConfig& train_config, std::int64_t seed,
                          const std::string& run_dir, bool resume, const TrainHooks& hooks = {});
 
-/// MakeSpanSamples of both window sets, then TrainSpanNet. No windows is an Error.
+/// MakeSamples of both window sets, the training ones augmented by `augment` (Augment in
+/// models/span/span_data.h), then TrainNet. No windows is an Error.
 TrainingSummary TrainOnWindows(const ModelSpec& spec, const WindowSet& train, const WindowSet& val,
                                const TrainConfig& train_config, std::int64_t seed,
                                const std::string& run_dir, bool resume,
-                               const TrainHooks& hooks = {});
+                               const TrainHooks& hooks = {}, const AugmentConfig& augment = {});
 
 /// The engine weights of a SpanNet checkpoint with `input_dim` inputs and the normalisation of
 /// `normalisation_file`; the caller adds an input stage (KTM) if any and saves them.
