@@ -65,6 +65,8 @@ Predictor Predictor::Load(const std::string& path) {
   for (Eigen::Index i = 0; i < p.input_mean_.size(); ++i)
     FS_THROW_UNLESS(std::abs(p.input_mean_[i]) <= 1e6, path, ": /normalisation/input_mean[", i,
                     "] is ", p.input_mean_[i], "; expected a mean from -1e6 to 1e6");
+  if (f.HasAttr("/model", "covariance_scale"))
+    p.covariance_scale_ = art.DoubleAttr("/model", "covariance_scale", 1e-6, 1e6);
   p.mlp_ = Mlp::LoadListed(f, "/model", "dense_layers", "/weights/");
   FS_THROW_UNLESS(p.mlp_.input_size() == in, path, ": network takes ", p.mlp_.input_size(),
                   " inputs, expected ",
@@ -88,6 +90,7 @@ void Predictor::Save(const std::string& path, const PredictorWeights& w,
     f->SetAttr("/model", "components", static_cast<std::int64_t>(w.layout.components));
     f->SetAttr("/model", "u_param", std::string(UParamName(w.layout.u_param)));
     f->SetAttr("/model", "basis_gamma", w.basis_gamma);
+    if (w.covariance_scale != 1.0) f->SetAttr("/model", "covariance_scale", w.covariance_scale);
     f->WriteMatrix("/model/basis_centres", w.basis_centres);
     f->WriteMatrix("/normalisation/input_mean", w.input_mean);
     f->WriteMatrix("/normalisation/input_std", w.input_std);
@@ -201,7 +204,7 @@ void Predictor::Predict(const Eigen::Ref<const Eigen::Matrix<double, Eigen::Dyna
     const int vo = layout_.VOffset(r);
     Eigen::Matrix2d lv;
     lv << clamped_exp(z[vo]), 0.0, z[vo + 1], clamped_exp(z[vo + 2]);
-    const Eigen::Matrix2d v = rot * (lv * lv.transpose()) * rot.transpose();
+    const Eigen::Matrix2d v = covariance_scale_ * (rot * (lv * lv.transpose()) * rot.transpose());
     const double l00 = std::sqrt(v(0, 0));
     const double l10 = v(1, 0) / l00;
     const double l11 = std::sqrt(std::max(v(1, 1) - l10 * l10, 1e-300));

@@ -40,6 +40,9 @@ struct PredictorWeights {
   /// past q and reference r_i; input_mean/std then have K entries.
   Eigen::MatrixXd ktm_references;  ///< [K x 2p] ego frame (m); empty: raw input
   double ktm_lengthscale = 0;      ///< l (m); used when ktm_references is not empty
+  /// c: every predicted covariance is c (phi' U phi) V, i.e. V is scaled by c; fitted on
+  /// validation windows when the config asks for it (training/span/calibration.h), else 1.
+  double covariance_scale = 1.0;
 };
 
 class Predictor {
@@ -66,6 +69,8 @@ class Predictor {
   /// KTM references [K x 2p] (ego frame, m); empty when the net reads the past directly.
   const Eigen::MatrixXd& ktm_references() const { return ktm_references_; }
   double ktm_lengthscale() const { return ktm_lengthscale_; }
+  /// c of PredictorWeights::covariance_scale (1 in artifacts written without one).
+  double covariance_scale() const { return covariance_scale_; }
 
   Workspace MakeWorkspace() const;
   TrajectoryDistribution MakeDistribution() const;
@@ -93,6 +98,7 @@ class Predictor {
   Mlp mlp_;
   Eigen::MatrixXd ktm_references_;
   double ktm_lengthscale_ = 0;
+  double covariance_scale_ = 1.0;
 };
 
 }  // namespace foresight::span

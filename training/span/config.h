@@ -38,6 +38,9 @@ struct ExperimentConfig {
   NetConfig network;
   AugmentConfig augment;
   TrainConfig train;
+  /// Export fits one scale on every predicted covariance to the validation windows
+  /// (training/span/calibration.h); off: the net's covariances as trained (the thesis).
+  bool calibrate_covariance = false;
   EvalConfig eval;
 
   template <class A>
@@ -51,6 +54,9 @@ struct ExperimentConfig {
     a->Visit("augment", &augment, config::Range::Any(),
              "training-set augmentation by speed scaling and mirroring (extension)");
     a->Visit("train", &train, config::Range::Any(), "trainer");
+    a->Visit("calibrate_covariance", &calibrate_covariance, config::Range::Any(),
+             "export scales every predicted covariance by the c that minimises the validation "
+             "NLL (extension)");
     a->Visit("eval", &eval, config::Range::Any(), "evaluation");
   }
   /// Rules across keys; errors name `source` and the key.

@@ -13,6 +13,7 @@
 #include "models/span/span_data.h"
 #include "models/span/span_net.h"
 #include "training/run_dir.h"
+#include "training/span/calibration.h"
 #include "training/tensor_eigen.h"
 
 namespace foresight::span {
@@ -232,13 +233,6 @@ PredictorWeights WeightsFromCheckpoint(const ModelSpec& spec, int input_dim,
   return w;
 }
 
-void WriteArtifact(const ExperimentConfig& c, const std::string& checkpoint,
-                   const std::string& normalisation_file, const std::string& artifact_path) {
-  const PredictorWeights w =
-      WeightsFromCheckpoint(ModelSpecOf(c), 2 * c.windows.observed, checkpoint, normalisation_file);
-  Predictor::Save(artifact_path, w, config::ToYaml(c), c.seed);
-}
-
 std::string ExportRun(const std::string& run_dir) {
   const std::string config_path = run_dir + "/config.yaml";
   FS_THROW_UNLESS(fs::exists(config_path), run_dir, ": not a run directory (no config.yaml)");
@@ -248,9 +242,24 @@ std::string ExportRun(const std::string& run_dir) {
       fs::exists(run.BestCheckpoint()) ? run.BestCheckpoint() : run.Checkpoint();
   FS_THROW_UNLESS(fs::exists(ckpt), run_dir, ": no checkpoint to export (train first)");
   const std::string out = run_dir + "/model.h5";
-  WriteArtifact(c, ckpt, run_dir + "/normalisation.h5", out);
+  PredictorWeights w = WeightsFromCheckpoint(ModelSpecOf(c), 2 * c.windows.observed, ckpt,
+                                             run_dir + "/normalisation.h5");
+  Predictor::Save(out, w, config::ToYaml(c), c.seed);
   // Prove the artifact loads in the engine before reporting success.
-  (void)Predictor::Load(out);
+  const Predictor model = Predictor::Load(out);
+  if (c.calibrate_covariance) {
+    const TrackSplit split = LoadPedestrianSplits(c.data, static_cast<std::uint64_t>(c.seed));
+    const WindowSet val = MakeWindows(split.val, c.windows);
+    FS_THROW_UNLESS(val.size() > 0, run_dir,
+                    ": calibrate_covariance needs validation windows and there are none");
+    const std::vector<PointTerms> terms = CovarianceScaleTerms(model, val);
+    w.covariance_scale = FitCovarianceScale(terms);
+    log::Info("covariance scale fitted on ", val.size(),
+              " validation windows: c = ", w.covariance_scale, " (validation NLL per point ",
+              ScaledNll(terms, 1.0), " -> ", ScaledNll(terms, w.covariance_scale), ")");
+    Predictor::Save(out, w, config::ToYaml(c), c.seed);
+    (void)Predictor::Load(out);
+  }
   log::Info("exported ", ckpt, " -> ", out);
   return out;
 }

@@ -32,12 +32,9 @@ inline const RunDirectoryRules kRunRules{{"checkpoints/", "model.h5", "eval.json
 TrainingSummary TrainRun(const ExperimentConfig& config, const std::string& run_dir, bool resume,
                          const TrainHooks& hooks = {});
 
-/// Writes `run_dir`/model.h5 from the best checkpoint. @return the artifact path.
+/// Writes `run_dir`/model.h5 from the best checkpoint; with calibrate_covariance, then fits its
+/// covariance scale on the validation windows (training/span/calibration.h). @return the path.
 std::string ExportRun(const std::string& run_dir);
-
-/// Writes the artifact of a SpanNet checkpoint at `checkpoint` (used by export and tests).
-void WriteArtifact(const ExperimentConfig& config, const std::string& checkpoint,
-                   const std::string& normalisation_file, const std::string& artifact_path);
 
 // ---------------------------------------------------------------- shared pieces
 
