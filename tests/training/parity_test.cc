@@ -1,6 +1,7 @@
 // Export -> engine: the Eigen engine reproduces LibTorch on the exported network.
 
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include <filesystem>
 #include <fstream>
@@ -117,14 +118,16 @@ TEST(Pipeline, TrainExportEvalWritesEveryKey) {
   const auto t = TrainTiny(1, UParam::kCholesky);
   const span::EvalReport r = span::Evaluate(t->config, t->artifact, t->dir.path());
   EXPECT_GT(r.windows, 0);
-  std::ifstream in(t->dir.File("eval.json"));
-  std::stringstream ss;
-  ss << in.rdbuf();
+  // JSON is YAML: yaml-cpp reads the file back.
+  const YAML::Node j = YAML::LoadFile(t->dir.File("eval.json"));
   for (const char* key :
-       {"\"ade\"", "\"fde\"", "\"nll\"", "\"best_of_20_ade\"", "\"best_of_20_fde\"", "\"cv_ade\"",
-        "\"cv_fde\"", "\"cv_nll\"", "\"cv_best_of_20_ade\"", "\"cv_best_of_20_fde\""})
-    EXPECT_NE(ss.str().find(key), std::string::npos) << key;
-  EXPECT_NE(ss.str().find("\"calibration\": {\"horizon_s\": ["), std::string::npos) << ss.str();
+       {"ade", "fde", "nll", "best_of_20_ade", "best_of_20_fde", "cv_ade", "cv_fde", "cv_nll",
+        "cv_best_of_20_ade", "cv_best_of_20_fde", "covariance_scale"})
+    EXPECT_TRUE(j[key].IsScalar()) << key;
+  EXPECT_EQ(j["calibration"]["horizon_s"].size(),
+            static_cast<std::size_t>(t->config.windows.predicted));
+  EXPECT_EQ(j["val"]["calibration"]["within_2sigma"].size(),
+            static_cast<std::size_t>(t->config.windows.predicted));
   // Calibration: a share per future step, in [0, 1], the 2-sigma ellipse holding at least as many.
   for (const span::Metrics* m : {&r.model, &r.cv}) {
     ASSERT_EQ(m->within_1sigma.size(), static_cast<std::size_t>(t->config.windows.predicted));
@@ -178,20 +181,21 @@ span::EvalReport ReportWith(double value, int val_windows) {
 }
 
 TEST(EvalJson, HasTheDocumentedKeysAndNoNonFiniteNumbers) {
-  const std::string json = ReportWith(1.5, 4).ToJson(20);
+  const YAML::Node j = YAML::Load(ReportWith(1.5, 4).ToJson(20));  // JSON is YAML
   for (const char* key : {"ade", "fde", "nll", "best_of_20_ade", "best_of_20_fde", "cv_ade",
                           "cv_fde", "cv_nll", "cv_best_of_20_ade", "cv_best_of_20_fde"})
-    EXPECT_NE(json.find("\n  \"" + std::string(key) + "\": 1.5,"), std::string::npos)
-        << key << " in " << json;
-  EXPECT_NE(json.find("\"val\": {\"windows\": 4, \"ade\": 1.5"), std::string::npos) << json;
+    EXPECT_EQ(j[key].as<double>(), 1.5) << key;
+  EXPECT_EQ(j["num_samples"].as<int>(), 20);
+  EXPECT_EQ(j["val"]["windows"].as<int>(), 4);
+  EXPECT_EQ(j["val"]["ade"].as<double>(), 1.5);
   for (double bad : {double(NAN), double(INFINITY), -double(INFINITY)}) {
     const std::string b = ReportWith(bad, 4).ToJson(20);
-    EXPECT_NE(b.find("\"ade\": null"), std::string::npos) << b;
+    EXPECT_TRUE(YAML::Load(b)["ade"].IsNull()) << b;
     EXPECT_EQ(b.find("nan"), std::string::npos) << b;
     EXPECT_EQ(b.find("inf"), std::string::npos) << b;
   }
   // No validation windows: the val block is null, not zeros.
-  EXPECT_NE(ReportWith(1.5, 0).ToJson(20).find("\"val\": null"), std::string::npos);
+  EXPECT_TRUE(YAML::Load(ReportWith(1.5, 0).ToJson(20))["val"].IsNull());
 }
 
 TEST(EvalJson, EmptySplitsAreErrors) {

@@ -4,13 +4,12 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <iomanip>
 #include <random>
-#include <sstream>
 
 #include "core/ego_frame.h"
 #include "core/error.h"
 #include "core/file_io.h"
+#include "core/json.h"
 #include "core/log.h"
 #include "core/matrix_normal.h"
 #include "inference/engine/artifact.h"
@@ -68,20 +67,6 @@ double Fde(const Eigen::Matrix<double, Eigen::Dynamic, 2>& path, const WindowSet
   return (path.row(w.predicted - 1).transpose() - w.Future(n, w.predicted - 1)).norm();
 }
 
-/// A JSON number, or null for NaN and inf (which JSON cannot hold).
-std::string Num(double v) {
-  std::ostringstream os;
-  os << std::setprecision(6) << v;
-  return std::isfinite(v) ? os.str() : "null";
-}
-
-/// A JSON array of numbers (null for non-finite entries).
-std::string NumList(const std::vector<double>& v) {
-  std::string out = "[";
-  for (std::size_t i = 0; i < v.size(); ++i) out += (i ? ", " : "") + Num(v[i]);
-  return out + "]";
-}
-
 /// `node` as one line of YAML flow text.
 std::string Flow(const YAML::Node& node) {
   YAML::Emitter e;
@@ -128,33 +113,34 @@ void CheckSameDataAsTraining(const ExperimentConfig& config, const std::string& 
 }  // namespace
 
 std::string EvalReport::ToJson(int num_samples) const {
-  std::ostringstream os;
-  os << "{\n  \"windows\": " << windows << ",\n  \"num_samples\": " << num_samples << ",\n"
-     << "  \"ade\": " << Num(model.ade) << ",\n  \"fde\": " << Num(model.fde) << ",\n"
-     << "  \"nll\": " << Num(model.nll) << ",\n"
-     << "  \"best_of_20_ade\": " << Num(model.best_of_n_ade) << ",\n"
-     << "  \"best_of_20_fde\": " << Num(model.best_of_n_fde) << ",\n"
-     << "  \"cv_ade\": " << Num(cv.ade) << ",\n  \"cv_fde\": " << Num(cv.fde) << ",\n"
-     << "  \"cv_nll\": " << Num(cv.nll) << ",\n"
-     << "  \"cv_best_of_20_ade\": " << Num(cv.best_of_n_ade) << ",\n"
-     << "  \"cv_best_of_20_fde\": " << Num(cv.best_of_n_fde) << ",\n"
-     << "  \"calibration\": {\"horizon_s\": " << NumList(horizon_s)
-     << ", \"nominal_1sigma\": " << Num(1 - std::exp(-0.5))
-     << ", \"nominal_2sigma\": " << Num(1 - std::exp(-2.0))
-     << ",\n    \"within_1sigma\": " << NumList(model.within_1sigma)
-     << ",\n    \"within_2sigma\": " << NumList(model.within_2sigma)
-     << ",\n    \"cv_within_1sigma\": " << NumList(cv.within_1sigma)
-     << ",\n    \"cv_within_2sigma\": " << NumList(cv.within_2sigma) << "},\n"
-     << "  \"val\": ";
+  JsonObject j;
+  j.Set("windows", windows).Set("num_samples", num_samples);
+  j.Set("covariance_scale", covariance_scale);
+  j.Set("ade", model.ade).Set("fde", model.fde).Set("nll", model.nll);
+  j.Set("best_of_20_ade", model.best_of_n_ade).Set("best_of_20_fde", model.best_of_n_fde);
+  j.Set("cv_ade", cv.ade).Set("cv_fde", cv.fde).Set("cv_nll", cv.nll);
+  j.Set("cv_best_of_20_ade", cv.best_of_n_ade).Set("cv_best_of_20_fde", cv.best_of_n_fde);
+  const auto calibration = [&](const Metrics& m, const Metrics& c) {
+    JsonObject o;
+    o.Set("horizon_s", horizon_s)
+        .Set("nominal_1sigma", 1 - std::exp(-0.5))
+        .Set("nominal_2sigma", 1 - std::exp(-2.0));
+    o.Set("within_1sigma", m.within_1sigma).Set("within_2sigma", m.within_2sigma);
+    o.Set("cv_within_1sigma", c.within_1sigma).Set("cv_within_2sigma", c.within_2sigma);
+    return o;
+  };
+  j.Set("calibration", calibration(model, cv));
   if (val_windows > 0) {
-    os << "{\"windows\": " << val_windows << ", \"ade\": " << Num(val_model.ade)
-       << ", \"fde\": " << Num(val_model.fde) << ", \"nll\": " << Num(val_model.nll)
-       << ", \"cv_ade\": " << Num(val_cv.ade) << ", \"cv_fde\": " << Num(val_cv.fde)
-       << ", \"cv_nll\": " << Num(val_cv.nll) << "}\n}\n";
+    JsonObject v;
+    v.Set("windows", val_windows);
+    v.Set("ade", val_model.ade).Set("fde", val_model.fde).Set("nll", val_model.nll);
+    v.Set("cv_ade", val_cv.ade).Set("cv_fde", val_cv.fde).Set("cv_nll", val_cv.nll);
+    v.Set("calibration", calibration(val_model, val_cv));
+    j.Set("val", v);
   } else {
-    os << "null\n}\n";  // no validation windows
+    j.Set("val", std::nan(""));  // null: no validation windows
   }
-  return os.str();
+  return j.Dump() + "\n";
 }
 
 EvalReport EvaluateOn(const std::string& artifact, const WindowSet& train, const WindowSet& test,
@@ -181,6 +167,7 @@ EvalReport EvaluateOn(const std::string& artifact, const WindowSet& train, const
 
   EvalReport rep;
   rep.windows = count;
+  rep.covariance_scale = model.covariance_scale();
   rep.horizon_s.assign(times.data(), times.data() + f);
   for (Metrics* m : {&rep.model, &rep.cv}) {
     m->within_1sigma.assign(static_cast<std::size_t>(f), 0.0);

@@ -22,6 +22,7 @@ struct Metrics {
 
 struct EvalReport {
   int windows = 0;
+  double covariance_scale = 1.0;  ///< of the evaluated artifact (1: not calibrated)
   std::vector<double> horizon_s;  ///< time of each future step after the last observed point (s)
   Metrics model, cv;
   /// The same metrics on the validation windows (for choosing hyper-parameters; never the test).
