@@ -38,17 +38,8 @@ navigate() {  # navigate RUN SCENARIO [key=value ...]
   "$BIN" navigate "configs/navigation/$scenario.yaml" video.enabled=false "$@" --run-dir "$OUT/$run" \
     > "$OUT/$run.out" 2>&1 || { tail -5 "$OUT/$run.out"; exit 1; }
 }
-wait_all() {  # waits for every given process; when one failed, stops the others and the script
-  local pid
-  for pid in "$@"; do
-    wait "$pid" || {
-      kill "$@" 2> /dev/null || true
-      echo "a run failed (see $OUT/*.out)" >&2
-      exit 1
-    }
-  done
-}
-overrides() { [ -z "$1" ] || tr '+' '\n' <<< "$1"; }  # one override per line
+# shellcheck source=experiments/select_lib.sh
+source "$ROOT/experiments/select_lib.sh"
 
 settings=("" "$@")  # "" = the configs as committed
 for i in "${!settings[@]}"; do
