@@ -152,6 +152,9 @@ if [ "${FORESIGHT_WITH_TORCH:-1}" = "1" ] || [ "${FORESIGHT_WITH_TORCH}" = "ON" 
   expect_error "unknown key 'train.learning_rat'" train "$TMP/typo.yaml" --run-dir "$TMP/r0"
   expect_error "'train.epochs'" train default train.epochs=zero --run-dir "$TMP/r0"
   expect_error "'train.epochs'" train default train.epochs=0 --run-dir "$TMP/r0"
+  expect_error "predictor.train_overrides: <embedded configs/navigation/predictor.yaml>: unknown key 'network.componets'" \
+    navigate configs/navigation/sim2.yaml "predictor.train_overrides=[network.componets=3]" \
+    predictor.artifact="$TMP/pred/model.h5" --episodes 1 --run-dir "$TMP/nav6"
   expect_error "'augment.speed_scales': value 1" train default "augment.speed_scales=[0.8,1]" --run-dir "$TMP/r0"
   expect_error "augment.speed_scales" train default "augment.speed_scales=[-2]" --run-dir "$TMP/r0"
   expect_error "cannot open config file" train "$TMP/missing.yaml"

@@ -22,6 +22,8 @@ struct PredictorConfig {
   std::string artifact = "runs/navigation_predictor/model.h5";
   std::string train_config =
       "default";  ///< "default": the embedded configs/navigation/predictor.yaml
+  /// `key.path=value` overrides of train_config (a predictor variant without another file).
+  std::vector<std::string> train_overrides;
   /// Training tracks: "scenario" records the simulated crowd of this config's scenario without the
   /// robot; "replay" reads `replay` (a recorded file other than the one navigated).
   std::string tracks = "scenario";
@@ -40,6 +42,8 @@ struct PredictorConfig {
     a->Visit("train_config", &train_config, config::Range::Any(),
              "SPAN config used to train a missing artifact ('default': the embedded "
              "configs/navigation/predictor.yaml)");
+    a->Visit("train_overrides", &train_overrides, config::Range::Any(),
+             "key.path=value overrides of train_config (used only when the artifact is trained)");
     a->Visit("tracks", &tracks, config::Range::Any(), "training tracks: scenario | replay");
     a->Visit("record_episodes", &record_episodes, config::Range::Closed(1, 10000),
              "simulated runs recorded");

@@ -15,6 +15,23 @@
 namespace foresight::nav {
 namespace fs = std::filesystem;
 
+namespace {
+/// The predictor's SPAN config: train_config (or the embedded default) plus `overrides`; an Error
+/// names both keys.
+span::ExperimentConfig LoadTrainConfig(const PredictorConfig& p,
+                                       const std::string& embedded_default,
+                                       const std::vector<std::string>& overrides) {
+  try {
+    return p.train_config == "default"
+               ? config::ExperimentConfigFromYaml<span::ExperimentConfig>(
+                     embedded_default, "<embedded configs/navigation/predictor.yaml>", overrides)
+               : config::LoadExperimentConfig<span::ExperimentConfig>(p.train_config, overrides);
+  } catch (const Error& e) {
+    Fail("predictor.train_config with predictor.train_overrides: ", e.what());
+  }
+}
+}  // namespace
+
 std::string EnsurePredictor(const ExperimentConfig& c, const std::string& embedded_default) {
   const PredictorConfig& p = c.predictor;
   if (fs::exists(p.artifact)) return p.artifact;
@@ -23,6 +40,8 @@ std::string EnsurePredictor(const ExperimentConfig& c, const std::string& embedd
                   " does not exist; to train it automatically name it <run dir>/model.h5");
   const std::string run_dir =
       artifact.parent_path().empty() ? "." : artifact.parent_path().string();
+  (void)LoadTrainConfig(p, embedded_default,
+                        p.train_overrides);  // refuse bad keys before recording
   fs::create_directories(run_dir);
   const std::string tracks_file = fs::absolute(fs::path(run_dir) / "tracks.h5").string();
   if (!fs::exists(tracks_file)) {
@@ -49,14 +68,12 @@ std::string EnsurePredictor(const ExperimentConfig& c, const std::string& embedd
               " points) -> ", tracks_file);
   }
   const TrackSet stored = ReadTrackStore(tracks_file);
-  const std::vector<std::string> data = {
-      "data.format=track_store", "data.root=", "data.train_files=[" + tracks_file + "]",
-      "data.seconds_per_step=" + std::to_string(stored.seconds_per_step)};
-  const span::ExperimentConfig span =
-      p.train_config == "default"
-          ? config::ExperimentConfigFromYaml<span::ExperimentConfig>(
-                embedded_default, "<embedded configs/navigation/predictor.yaml>", data)
-          : config::LoadExperimentConfig<span::ExperimentConfig>(p.train_config, data);
+  std::vector<std::string> overrides = p.train_overrides;  // the data keys below win
+  overrides.insert(
+      overrides.end(),
+      {"data.format=track_store", "data.root=", "data.train_files=[" + tracks_file + "]",
+       "data.seconds_per_step=" + std::to_string(stored.seconds_per_step)});
+  const span::ExperimentConfig span = LoadTrainConfig(p, embedded_default, overrides);
   const bool resume = fs::exists(run_dir + "/checkpoints/last.pt");
   std::cout << "training the SPAN predictor into " << run_dir << (resume ? " (resuming)" : "")
             << "\n";
