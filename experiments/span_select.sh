@@ -35,17 +35,8 @@ train() {  # train RUN CONFIG [key=value ...]
   "$BIN" train "$config" --run-dir "$OUT/$run" train.progress=none eval.plot_tracks=0 "$@" \
     > "$OUT/$run.out" 2>&1 || { tail -5 "$OUT/$run.out"; exit 1; }
 }
-wait_all() {  # waits for every given process; when one failed, stops the others and the script
-  local pid
-  for pid in "$@"; do
-    wait "$pid" || {
-      kill "$@" 2> /dev/null || true
-      echo "a run failed (see $OUT/*.out)" >&2
-      exit 1
-    }
-  done
-}
-overrides() { [ -z "$1" ] || tr '+' '\n' <<< "$1"; }  # one override per line
+# shellcheck source=experiments/select_lib.sh
+source "$ROOT/experiments/select_lib.sh"
 
 # Inner folds, one line each: SCENE GROUP TRAIN_FILES VAL_FILES HELD_OUT_FILES (YAML flow lists).
 folds() {
