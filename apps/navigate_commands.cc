@@ -70,16 +70,18 @@ void AddNavigateCommand(CLI::App* app) {
                   (embedded ? std::string("sim1") : fs::path(args->config).stem().string());
     StartRunDirectory(out, config::ToYaml(c), false, nav::kRunRules);
     const bool needs_predictor = c.Uses(nav::Method::kSpan);
-    if (needs_predictor && !fs::exists(c.predictor.artifact)) {
 #ifdef FORESIGHT_WITH_TORCH
+    if (needs_predictor) {
+      // Trains a missing predictor; checks one it trained before against the config.
       nav::EnsurePredictor(c, kEmbeddedNavigationPredictorConfig);
       log::SetFile(out + "/log.txt");  // the predictor's training logged into its own run directory
+    }
 #else
+    if (needs_predictor && !fs::exists(c.predictor.artifact))
       Fail("predictor.artifact: ", c.predictor.artifact,
            " not found; this build has no LibTorch to train it (train it with a LibTorch build "
            "first)");
 #endif
-    }
     const int episodes = args->episodes > 0 ? args->episodes : c.episodes;
     std::cout << "navigating " << c.scenario.name << ": " << episodes << " episodes x "
               << c.methods.size() << " methods -> " << out << "\n";

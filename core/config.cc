@@ -200,6 +200,28 @@ YAML::Node ParseYaml(const std::string& text, const std::string& source) {
   return node;
 }
 
+namespace {
+std::string Flow(const YAML::Node& node) {
+  YAML::Emitter e;
+  e.SetSeqFormat(YAML::Flow);
+  e.SetMapFormat(YAML::Flow);
+  e << node;
+  return e.c_str();
+}
+}  // namespace
+
+std::string FirstDifference(const YAML::Node& a, const YAML::Node& b, const std::string& path) {
+  if (a.IsMap() && b.IsMap()) {
+    for (const auto& kv : a) {
+      const std::string key = kv.first.as<std::string>();
+      const std::string d = FirstDifference(kv.second, b[key], internal::JoinPath(path, key));
+      if (!d.empty()) return d;
+    }
+    return "";
+  }
+  return Flow(a) == Flow(b) ? "" : path + " = " + Flow(a) + ", not " + Flow(b);
+}
+
 YAML::Node LoadYamlFile(const std::string& path) {
   // Configs are a few kilobytes; a huge file is a mistake (and would take gigabytes to parse).
   constexpr std::uintmax_t kMaxConfigBytes = 1 << 20;

@@ -334,6 +334,10 @@ YAML::Node ParseYaml(const std::string& text, const std::string& source);
 /// Reads a YAML file; errors name the file.
 YAML::Node LoadYamlFile(const std::string& path);
 
+/// "key.path = a, not b" for the first leaf (in a's key order) where two trees of the same config
+/// struct differ, with the values as one-line YAML; "" when they are equal. `path` prefixes keys.
+std::string FirstDifference(const YAML::Node& a, const YAML::Node& b, const std::string& path);
+
 /// Reads `node` (plus overrides) into a default-constructed T, strictly.
 template <typename T>
 T FromYaml(YAML::Node node, const std::string& source,

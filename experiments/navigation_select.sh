@@ -41,6 +41,11 @@ navigate() {  # navigate RUN SCENARIO [key=value ...]
 # shellcheck source=experiments/select_lib.sh
 source "$ROOT/experiments/select_lib.sh"
 
+# The configs' predictors are trained on first use: do that here, one scenario at a time, so that
+# two parallel runs below never train the same one. (A SETTING naming another predictor.artifact
+# must bring it trained, as navigation_predictor.sh does.)
+for scenario in $SCENARIOS; do navigate "first_$scenario" "$scenario" "methods=[span]" --episodes 1; done
+
 settings=("" "$@")  # "" = the configs as committed
 for i in "${!settings[@]}"; do
   mapfile -t o < <(overrides "${settings[$i]}")

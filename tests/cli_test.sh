@@ -155,6 +155,16 @@ if [ "${FORESIGHT_WITH_TORCH:-1}" = "1" ] || [ "${FORESIGHT_WITH_TORCH}" = "ON" 
   expect_error "predictor.train_overrides: <embedded configs/navigation/predictor.yaml>: unknown key 'network.componets'" \
     navigate configs/navigation/sim2.yaml "predictor.train_overrides=[network.componets=3]" \
     predictor.artifact="$TMP/pred/model.h5" --episodes 1 --run-dir "$TMP/nav6"
+  [ ! -e "$TMP/pred/tracks.h5" ] || fail "a bad predictor.train_overrides key was found only after recording tracks"
+  # train_overrides reach the predictor navigate trains, and a later change to them is refused
+  # instead of silently reusing the predictor trained before.
+  PRED=(predictor.artifact="$TMP/pred2/model.h5" predictor.record_episodes=1 predictor.record_duration=30)
+  "$BIN" navigate configs/navigation/sim2.yaml "methods=[span]" max_time=1 video.enabled=false "${PRED[@]}" \
+    'predictor.train_overrides=["train.epochs=1", "network.hidden=[8]"]' --episodes 1 --run-dir "$TMP/nav10" \
+    >/dev/null 2>"$TMP/nav10.log" || { cat "$TMP/nav10.log"; fail "navigate with predictor.train_overrides"; }
+  grep -q "hidden: \[8\]" "$TMP/pred2/config.yaml" || fail "predictor.train_overrides did not reach the predictor's config"
+  expect_error "was trained with train.epochs = 1, not 2" navigate configs/navigation/sim2.yaml "methods=[span]" \
+    "${PRED[@]}" 'predictor.train_overrides=["train.epochs=2", "network.hidden=[8]"]' --episodes 1 --run-dir "$TMP/nav11"
   expect_error "'augment.speed_scales': value 1" train default "augment.speed_scales=[0.8,1]" --run-dir "$TMP/r0"
   expect_error "augment.speed_scales" train default "augment.speed_scales=[-2]" --run-dir "$TMP/r0"
   expect_error "cannot open config file" train "$TMP/missing.yaml"

@@ -80,6 +80,16 @@ bool CrowdForecast::Collides(int k, const Eigen::Vector2d& x, double radius,
       if (d.squaredNorm() >= outer * outer) continue;
       if (threshold.Exceeds(d, cov_[jc], radius)) return true;
     } else {
+      // sum_r alpha_r bound_r <= max_r bound_r: when no component's bound exceeds epsilon (the
+      // erf-free test, with the quick reject of one component), neither does the mixture's.
+      bool any = false;
+      for (int r = 0; r < r_ && !any; ++r) {
+        const std::size_t j = Index(n, k, r), jc = Index(n, kc, r);
+        const Eigen::Vector2d d = x - mean_[j];
+        const double outer = radius + std::max(0.0, c) * M_SQRT2 * reach_[jc];
+        any = d.squaredNorm() < outer * outer && threshold.Exceeds(d, cov_[jc], radius);
+      }
+      if (!any) continue;
       double bound = 0.0;
       for (int r = 0; r < r_; ++r) {
         const std::size_t j = Index(n, k, r), jc = Index(n, kc, r);

@@ -58,12 +58,14 @@ struct NetConfig {
   }
 };
 
-/// Training-set augmentation by exact symmetries of the ego-frame samples (an extension of the
-/// thesis). Every training window also enters at each speed scale s (positions relative to the
-/// present times s: the same path walked s times as fast) and, with `mirror`, reflected about
-/// the heading (ego y -> -y). Inputs and ridge targets are linear in the positions, so the
-/// augmented samples are exactly those of the scaled or mirrored windows. Validation and test
-/// windows are never augmented.
+/// Training-set augmentation (an extension of the thesis). Every training window also enters at
+/// each speed scale s (positions relative to the present times s at the same times: a walk s times
+/// as fast along a path s times as large, turn radii included) and, with `mirror`, reflected about
+/// the heading (ego y -> -y; about the world x axis through the present point when
+/// rotate_to_heading is off). Inputs and ridge targets are linear in the positions, so a copy is
+/// the sample of the transformed window, except where the ego frame's 1 mm threshold for a
+/// heading would fall differently (near-standing windows). Validation and test windows are never
+/// augmented.
 struct AugmentConfig {
   std::vector<double> speed_scales = {};  ///< extra scales besides 1 (empty: none)
   bool mirror = false;

@@ -4,7 +4,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -13,6 +16,7 @@
 #include "inference/prediction/span_predictor.h"
 #include "tests/test_util.h"
 #include "training/span/calibration.h"
+#include "training/span/eval.h"
 #include "training/span/pipeline.h"
 
 namespace foresight::span {
@@ -72,7 +76,8 @@ TEST(SpanCalibration, ScaledNllIsTheEngineNllOfTheScaledArtifact) {
     for (const double c : {0.3, 1.0, 4.0}) {
       const Predictor scaled = Predictor::Load(RandomArtifact(dir, components, c));
       EXPECT_DOUBLE_EQ(scaled.covariance_scale(), c);
-      EXPECT_NEAR(ScaledNll(terms, c), EngineNll(scaled, w), 1e-9)
+      const double engine = EngineNll(scaled, w);
+      EXPECT_NEAR(ScaledNll(terms, c), engine, 1e-9 * std::max(1.0, std::abs(engine)))
           << components << " components, c = " << c;
       // The terms do not depend on the scale stored in the artifact they come from.
       const std::vector<PointTerms> again = CovarianceScaleTerms(scaled, w);
@@ -127,7 +132,10 @@ TEST(SpanCalibration, LoadRefusesAScaleOutOfRange) {
   testing::TempDir dir;
   for (const double bad : {0.0, -1.0, 1e9, std::nan("")}) {
     const std::string path = RandomArtifact(dir, 1, bad);
-    testing::ExpectErrorContains([&] { (void)Predictor::Load(path); }, {"covariance_scale"});
+    std::ostringstream value;
+    value << bad;
+    testing::ExpectErrorContains([&] { (void)Predictor::Load(path); },
+                                 {path, "/model/covariance_scale is " + value.str()});
   }
 }
 
@@ -142,13 +150,19 @@ TEST(SpanCalibration, ExportFitsTheScaleOnValidationWindows) {
   c.train.progress = ProgressStyle::kNone;
   c.calibrate_covariance = true;
   TrainRun(c, dir.path(), false);
-  const Predictor model = Predictor::Load(ExportRun(dir.path()));
+  const std::string artifact = ExportRun(dir.path());
+  const Predictor model = Predictor::Load(artifact);
   EXPECT_NE(model.covariance_scale(), 1.0);
+  EXPECT_FALSE(std::filesystem::exists(dir.File("model.uncalibrated.h5")));
+  // Evaluation reports the artifact's scale.
+  c.eval.plot_tracks = 0;
+  EXPECT_EQ(Evaluate(c, artifact, dir.path()).covariance_scale, model.covariance_scale());
   // The fitted scale is the one the validation windows choose, independently recomputed.
   const TrackSplit split = LoadPedestrianSplits(c.data, static_cast<std::uint64_t>(c.seed));
   const std::vector<PointTerms> terms =
       CovarianceScaleTerms(model, MakeWindows(split.val, c.windows));
   EXPECT_NEAR(model.covariance_scale(), FitCovarianceScale(terms), 1e-6 * model.covariance_scale());
+  EXPECT_LT(ScaledNll(terms, model.covariance_scale()), ScaledNll(terms, 1.0));
 }
 
 }  // namespace

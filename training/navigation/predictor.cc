@@ -9,6 +9,8 @@
 #include "core/log.h"
 #include "datasets/crowd_replay.h"
 #include "datasets/track_store.h"
+#include "inference/engine/artifact.h"
+#include "inference/prediction/span_predictor.h"
 #include "training/span/eval.h"
 #include "training/span/pipeline.h"
 
@@ -30,11 +32,32 @@ span::ExperimentConfig LoadTrainConfig(const PredictorConfig& p,
     Fail("predictor.train_config with predictor.train_overrides: ", e.what());
   }
 }
+/// An artifact this command trained (its run directory holds the recorded tracks.h5) must still be
+/// what train_config and train_overrides describe: else editing them would silently keep using the
+/// old predictor. Artifacts trained elsewhere are the user's choice and are not checked.
+void CheckTrainedAsConfigured(const PredictorConfig& p, const std::string& embedded_default) {
+  const fs::path dir = fs::path(p.artifact).parent_path();
+  if (!fs::exists((dir.empty() ? fs::path(".") : dir) / "tracks.h5")) return;
+  const span::ExperimentConfig trained = config::ExperimentConfigFromYaml<span::ExperimentConfig>(
+      Artifact::Open(p.artifact, span::kModelType).config_yaml(), p.artifact + ":/config");
+  const auto tree = [](span::ExperimentConfig c) {
+    c.data = {};  // set from the recorded tracks when training
+    return config::ParseYaml(config::ToYaml(c), "resolved config");
+  };
+  const std::string d = config::FirstDifference(
+      tree(trained), tree(LoadTrainConfig(p, embedded_default, p.train_overrides)), "");
+  FS_THROW_UNLESS(d.empty(), "predictor.artifact: ", p.artifact, " was trained with ", d,
+                  " from predictor.train_config and predictor.train_overrides; delete its run "
+                  "directory to retrain, or name another predictor.artifact");
+}
 }  // namespace
 
 std::string EnsurePredictor(const ExperimentConfig& c, const std::string& embedded_default) {
   const PredictorConfig& p = c.predictor;
-  if (fs::exists(p.artifact)) return p.artifact;
+  if (fs::exists(p.artifact)) {
+    CheckTrainedAsConfigured(p, embedded_default);
+    return p.artifact;
+  }
   const fs::path artifact(p.artifact);
   FS_THROW_UNLESS(artifact.filename() == "model.h5", "predictor.artifact: ", p.artifact,
                   " does not exist; to train it automatically name it <run dir>/model.h5");

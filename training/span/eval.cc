@@ -67,30 +67,6 @@ double Fde(const Eigen::Matrix<double, Eigen::Dynamic, 2>& path, const WindowSet
   return (path.row(w.predicted - 1).transpose() - w.Future(n, w.predicted - 1)).norm();
 }
 
-/// `node` as one line of YAML flow text.
-std::string Flow(const YAML::Node& node) {
-  YAML::Emitter e;
-  e.SetSeqFormat(YAML::Flow);
-  e.SetMapFormat(YAML::Flow);
-  e << node;
-  return e.c_str();
-}
-
-/// "key.path = trained, not given" for the first leaf where `trained` and `given` differ, else "".
-/// Both come from the same config struct, so they have the same keys.
-std::string FirstDifference(const YAML::Node& trained, const YAML::Node& given,
-                            const std::string& path) {
-  if (trained.IsMap() && given.IsMap()) {
-    for (const auto& kv : trained) {
-      const std::string key = kv.first.as<std::string>();
-      const std::string d = FirstDifference(kv.second, given[key], path + "." + key);
-      if (!d.empty()) return d;
-    }
-    return "";
-  }
-  return Flow(trained) == Flow(given) ? "" : path + " = " + Flow(trained) + ", not " + Flow(given);
-}
-
 /// The test split is held out only when the tracks, windows and seed are the training run's: the
 /// data, windows and seed sections of `config` must equal those stored in the artifact's /config
 /// (data.root, where the files are, may differ).
@@ -103,7 +79,7 @@ void CheckSameDataAsTraining(const ExperimentConfig& config, const std::string& 
   };
   const YAML::Node t = tree(trained), g = tree(config);
   for (const char* section : {"data", "windows", "seed"}) {
-    const std::string d = FirstDifference(t[section], g[section], section);
+    const std::string d = config::FirstDifference(t[section], g[section], section);
     FS_THROW_UNLESS(d.empty(), artifact, ": the model was trained with ", d,
                     " as given; evaluate with the run's config.yaml (the data, windows and seed "
                     "sections must match training, or the test split is not held out)");

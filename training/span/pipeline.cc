@@ -244,10 +244,13 @@ std::string ExportRun(const std::string& run_dir) {
   const std::string out = run_dir + "/model.h5";
   PredictorWeights w = WeightsFromCheckpoint(ModelSpecOf(c), 2 * c.windows.observed, ckpt,
                                              run_dir + "/normalisation.h5");
-  Predictor::Save(out, w, config::ToYaml(c), c.seed);
-  // Prove the artifact loads in the engine before reporting success.
-  const Predictor model = Predictor::Load(out);
   if (c.calibrate_covariance) {
+    // The scale is fitted with the engine on an uncalibrated copy; model.h5 is written once, so
+    // a failure here (no data, no validation windows) leaves no uncalibrated model.h5 behind.
+    const std::string uncalibrated = run_dir + "/model.uncalibrated.h5";
+    Predictor::Save(uncalibrated, w, config::ToYaml(c), c.seed);
+    const Predictor model = Predictor::Load(uncalibrated);
+    fs::remove(uncalibrated);
     const TrackSplit split = LoadPedestrianSplits(c.data, static_cast<std::uint64_t>(c.seed));
     const WindowSet val = MakeWindows(split.val, c.windows);
     FS_THROW_UNLESS(val.size() > 0, run_dir,
@@ -257,9 +260,10 @@ std::string ExportRun(const std::string& run_dir) {
     log::Info("covariance scale fitted on ", val.size(),
               " validation windows: c = ", w.covariance_scale, " (validation NLL per point ",
               ScaledNll(terms, 1.0), " -> ", ScaledNll(terms, w.covariance_scale), ")");
-    Predictor::Save(out, w, config::ToYaml(c), c.seed);
-    (void)Predictor::Load(out);
   }
+  Predictor::Save(out, w, config::ToYaml(c), c.seed);
+  // Prove the artifact loads in the engine before reporting success.
+  (void)Predictor::Load(out);
   log::Info("exported ", ckpt, " -> ", out);
   return out;
 }
