@@ -7,6 +7,16 @@
 
 namespace foresight::constrained {
 
+Eigen::VectorXd RuleTimes(TimeRule rule, double horizon, int k) {
+  FS_THROW_UNLESS(k >= 1, "RuleTimes: need >= 1 time point, got ", k);
+  FS_THROW_UNLESS(std::isfinite(horizon) && horizon > 0, "RuleTimes: horizon must be > 0, got ",
+                  horizon);
+  const double h = horizon / k, shift = rule == TimeRule::kMidpoint ? 0.5 : 0.0;
+  Eigen::VectorXd t(k);
+  for (int i = 0; i < k; ++i) t[i] = (i + 1 - shift) * h;
+  return t;
+}
+
 CollisionCost::CollisionCost(const occupancy::Map* map, const TimeBasis& basis,
                              Eigen::VectorXd times, int order)
     : map_(map), basis_(basis), times_(std::move(times)), order_(order) {
@@ -83,9 +93,13 @@ double CollisionCost::Component(const ComponentParams& c, Workspace* ws,
     const Eigen::Matrix2d A = s * L;
     ws->points.noalias() = A * rule_.points;
     ws->points.colwise() += mu;
+    if (gradient == nullptr) {  // the value alone: no gradients of the map are computed
+      map_->ProbabilityBatch(ws->points, &ws->map, ws->batch.probability);
+      total += rule_.weights.dot(ws->batch.probability);
+      continue;
+    }
     map_->QueryBatch(ws->points, &ws->map, &ws->batch);
     total += rule_.weights.dot(ws->batch.probability);
-    if (gradient == nullptr) continue;
     Eigen::Vector2d g_sum = Eigen::Vector2d::Zero();  // sum_q beta_q g_q
     Eigen::Matrix2d gz = Eigen::Matrix2d::Zero();     // sum_q beta_q g_q z_q'
     for (int q = 0; q < nq; ++q) {

@@ -23,6 +23,14 @@
 
 namespace foresight::constrained {
 
+/// Where the rectangle rule of C = 1/T int_0^T (...) dt puts its K points on (0, T]:
+/// kRight at t_k = k T / K (the predicted steps when K = f: first order, error O(1/K));
+/// kMidpoint at t_k = (k - 1/2) T / K (second order, O(1/K^2), for the same K evaluations).
+enum class TimeRule { kRight, kMidpoint };
+
+/// The K time points of `rule` on (0, horizon]. Error unless K >= 1 and horizon > 0 (finite).
+Eigen::VectorXd RuleTimes(TimeRule rule, double horizon, int k);
+
 class CollisionCost {
  public:
   struct Workspace {

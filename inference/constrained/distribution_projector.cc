@@ -75,9 +75,25 @@ DistributionProjector::DistributionProjector(const occupancy::Map* map, const Ti
   options_.solver.epsilon = options_.epsilon - options_.margin;
 }
 
+DistributionProjector::DistributionProjector(const occupancy::Map* map, const TimeBasis& basis,
+                                             Eigen::VectorXd times, const ProjectorOptions& options,
+                                             Eigen::VectorXd check_times)
+    : DistributionProjector(map, basis, std::move(times), options) {
+  FS_THROW_UNLESS(options_.check_order >= 1 && options_.check_order <= 64,
+                  "DistributionProjector: check_order must be in [1, 64] with check times, got ",
+                  options_.check_order);
+  FS_THROW_UNLESS(options_.check_rounds >= 0,
+                  "DistributionProjector: check_rounds must be >= 0, got ", options_.check_rounds);
+  check_.emplace(map, basis, std::move(check_times), options_.check_order);
+}
+
 DistributionProjector::Workspace DistributionProjector::MakeWorkspace() const {
   Workspace ws;
   ws.cost = cost_.MakeWorkspace();
+  if (check_) {
+    ws.check = check_->MakeWorkspace();
+    ws.check.offset.resize(2, check_->times().size());
+  }
   ws.cost.offset.resize(2, cost_.times().size());
   ws.gradient.Resize(cost_.basis());
   ws.component.mean.resize(cost_.basis(), 2);
@@ -85,25 +101,43 @@ DistributionProjector::Workspace DistributionProjector::MakeWorkspace() const {
   return ws;
 }
 
-void DistributionProjector::SetOffset(const TrajectoryDistribution& d, Workspace* ws) const {
-  FS_THROW_UNLESS(d.basis_size() == cost_.basis(), "DistributionProjector: the distribution has ",
-                  d.basis_size(), " basis functions, the projector's basis has ", cost_.basis());
-  const Eigen::VectorXd& t = cost_.times();
-  if (ws->cost.offset.cols() != t.size()) ws->cost.offset.resize(2, t.size());
-  for (Eigen::Index k = 0; k < t.size(); ++k) {
-    ws->cost.offset.col(k) = d.origin() + t[k] * d.velocity();
-  }
+void DistributionProjector::SetOffset(const TrajectoryDistribution& d, const Eigen::VectorXd& t,
+                                      Eigen::Matrix2Xd* offset) {
+  if (offset->cols() != t.size()) offset->resize(2, t.size());
+  for (Eigen::Index k = 0; k < t.size(); ++k) offset->col(k) = d.origin() + t[k] * d.velocity();
 }
+
+namespace {
+void CheckBasis(const TrajectoryDistribution& d, const CollisionCost& cost) {
+  FS_THROW_UNLESS(d.basis_size() == cost.basis(), "DistributionProjector: the distribution has ",
+                  d.basis_size(), " basis functions, the projector's basis has ", cost.basis());
+}
+}  // namespace
 
 double DistributionProjector::Cost(const TrajectoryDistribution& d, Workspace* ws) const {
   FS_THROW_UNLESS(ws != nullptr, "DistributionProjector::Cost: workspace is null");
-  SetOffset(d, ws);
+  CheckBasis(d, cost_);
+  SetOffset(d, cost_.times(), &ws->cost.offset);
   double total = 0;
   for (int r = 0; r < d.components(); ++r) {
     FillComponentParams(d, r, &ws->component);
     total += d.alpha(r) * cost_.Component(ws->component, &ws->cost, nullptr);
   }
   return total;
+}
+
+double DistributionProjector::CheckCost(const TrajectoryDistribution& d, Workspace* ws) const {
+  try {
+    SetOffset(d, check_->times(), &ws->check.offset);
+    double total = 0;
+    for (int r = 0; r < d.components(); ++r) {
+      FillComponentParams(d, r, &ws->component);
+      total += d.alpha(r) * check_->Component(ws->component, &ws->check, nullptr);
+    }
+    return total;
+  } catch (const std::exception&) {
+    return std::nan("");
+  }
 }
 
 TrackProjection DistributionProjector::Project(const TrajectoryDistribution& prior,
@@ -115,7 +149,49 @@ TrackProjection DistributionProjector::Project(const TrajectoryDistribution& pri
       out->components() == prior.components() && out->basis_size() == prior.basis_size(),
       "DistributionProjector::Project: out has ", out->components(), " components of basis ",
       out->basis_size(), ", the prior ", prior.components(), " of basis ", prior.basis_size());
-  SetOffset(prior, ws);  // checks the basis size
+  CheckBasis(prior, cost_);
+  const double target0 = options_.solver.epsilon;  // epsilon - margin
+  if (!check_) {
+    TrackProjection result = ProjectOnce(prior, out, ws, options_.epsilon, target0);
+    result.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return result;
+  }
+  // `out` may be the prior: keep a copy for the repeated solves.
+  const TrajectoryDistribution prior_copy = prior;
+  TrackProjection result = ProjectOnce(prior_copy, out, ws, options_.epsilon, target0);
+  double target = target0;
+  int evaluations = result.evaluations;
+  for (int round = 0;; ++round) {
+    result.checked_cost = CheckCost(*out, ws);
+    result.check_rounds = round;
+    result.evaluations = evaluations;
+    if (!std::isfinite(result.checked_cost)) {
+      result.feasible = false;
+      result.status = "failed";
+      break;
+    }
+    if (result.checked_cost <= options_.epsilon) break;
+    // The check finds the result above epsilon: lower the target by the excess and solve again.
+    target -= result.checked_cost - target0;
+    if (round == options_.check_rounds || !(target > 0)) {
+      result.feasible = false;
+      if (result.status != "failed") result.status = "infeasible";
+      break;
+    }
+    const bool prior_changed = result.changed;
+    result = ProjectOnce(prior_copy, out, ws, target + options_.margin, target);
+    result.changed = result.changed || prior_changed;
+    evaluations += result.evaluations;
+  }
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+TrackProjection DistributionProjector::ProjectOnce(const TrajectoryDistribution& prior,
+                                                   TrajectoryDistribution* out, Workspace* ws,
+                                                   double mixture_limit, double target) const {
+  SetOffset(prior, cost_.times(), &ws->cost.offset);
   const int R = prior.components();
   // The prior's components, copied before `out` (which may be the prior) is written.
   std::vector<ComponentParams> params(static_cast<std::size_t>(R));
@@ -124,11 +200,7 @@ TrackProjection DistributionProjector::Project(const TrajectoryDistribution& pri
 
   TrackProjection result;
   result.components.resize(static_cast<std::size_t>(R));
-  const auto finish = [&]() {
-    result.seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    return result;
-  };
+  const auto finish = [&]() { return result; };
   const auto worst = [&](const char* s) {
     static const char* const kOrder[] = {"compliant_prior", "solved", "infeasible", "failed"};
     int now = 0, next = 0;
@@ -160,8 +232,8 @@ TrackProjection DistributionProjector::Project(const TrajectoryDistribution& pri
     }
     return finish();
   }
-  if (result.prior_cost <= options_.epsilon) {
-    result.feasible = true;
+  if (result.prior_cost <= mixture_limit) {
+    result.feasible = result.prior_cost <= options_.epsilon;
     result.status = "compliant_prior";
     for (int r = 0; r < R; ++r) {
       ProjectionSummary& s = result.components[static_cast<std::size_t>(r)];
@@ -179,7 +251,8 @@ TrackProjection DistributionProjector::Project(const TrajectoryDistribution& pri
                                                         ComponentGradient* g) {
     return cost->Component(p, cost_ws, g);
   };
-  const double target = options_.solver.epsilon;
+  ProjectionOptions solver = options_.solver;
+  solver.epsilon = target;
   for (int r = 0; r < R; ++r) {
     const auto k = static_cast<std::size_t>(r);
     ProjectionSummary& s = result.components[k];
@@ -189,7 +262,7 @@ TrackProjection DistributionProjector::Project(const TrajectoryDistribution& pri
       continue;
     }
     try {
-      s = ProjectComponent(params[k], constraint, options_.solver, &ws->component);
+      s = ProjectComponent(params[k], constraint, solver, &ws->component);
       if (s.status == ProjectionStatus::kSolved || s.status == ProjectionStatus::kInfeasible) {
         SetFromComponentParams(ws->component, r, out);
       }

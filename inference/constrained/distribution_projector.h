@@ -16,6 +16,8 @@
 ///   TrackProjection r = projector.Project(prior, &out, &ws);  // never throws on solver failure
 
 #include <Eigen/Core>
+#include <cmath>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -40,13 +42,22 @@ struct ProjectorOptions {
   double margin = 2e-4;      ///< solve to epsilon - margin so the returned C is truly <= epsilon
   int order = 6;             ///< Gauss-Hermite points per axis
   ProjectionOptions solver;  ///< its epsilon is overwritten with epsilon - margin
+  /// Verification by a second, more accurate operator (0: off): Gauss-Hermite order `check_order`
+  /// on the constructor's `check_times`. The solver drives the configured operator down and so
+  /// seeks out its quadrature error (mass between the nodes); when the check operator finds the
+  /// result above epsilon, the solve is repeated from the prior with the component target lowered
+  /// by the excess (C_check - (epsilon - margin)), at most `check_rounds` times.
+  int check_order = 0;
+  int check_rounds = 3;
 };
 
 /// Outcome of one track's projection (expected outcomes are values here, never exceptions).
 struct TrackProjection {
   bool changed = false;   ///< false: the prior's mixture C already met epsilon (returned unchanged)
-  bool feasible = false;  ///< mixture C of the returned distribution <= epsilon
+  bool feasible = false;  ///< mixture C of the returned distribution <= epsilon (and checked C)
   double prior_cost = 0, cost = 0;  ///< mixture C before / after
+  double checked_cost = NAN;        ///< C of the result under the check operator (NaN: no check)
+  int check_rounds = 0;             ///< repeated solves the check asked for
   double kl = 0;                    ///< sum_r alpha_r KL_r
   double seconds = 0;               ///< wall time of Project (steady_clock)
   int evaluations = 0;              ///< objective evaluations over components
@@ -63,10 +74,11 @@ struct TrackProjection {
 class DistributionProjector {
  public:
   struct Workspace {
-    CollisionCost::Workspace cost;  ///< its offset holds origin + v t_k of the current track
-    ComponentGradient gradient;     ///< sized scratch for callers of cost() with a gradient
-                                    ///< (Project's solver owns its own)
-    ComponentParams component;      ///< scratch: one component in the optimiser's parameters
+    CollisionCost::Workspace cost;   ///< its offset holds origin + v t_k of the current track
+    CollisionCost::Workspace check;  ///< the same for the check operator (when there is one)
+    ComponentGradient gradient;      ///< sized scratch for callers of cost() with a gradient
+                                     ///< (Project's solver owns its own)
+    ComponentParams component;       ///< scratch: one component in the optimiser's parameters
   };
 
   /// @param map occupancy map (kept by pointer; must outlive this). @param basis the predictor's
@@ -75,6 +87,10 @@ class DistributionProjector {
   /// solver limits).
   DistributionProjector(const occupancy::Map* map, const TimeBasis& basis, Eigen::VectorXd times,
                         const ProjectorOptions& options);
+  /// With a check operator (options.check_order > 0) on `check_times` (error when the order is
+  /// out of [1, 64] or check_times is empty).
+  DistributionProjector(const occupancy::Map* map, const TimeBasis& basis, Eigen::VectorXd times,
+                        const ProjectorOptions& options, Eigen::VectorXd check_times);
 
   const ProjectorOptions& options() const { return options_; }
   const CollisionCost& cost() const { return cost_; }
@@ -92,11 +108,19 @@ class DistributionProjector {
                           Workspace* ws) const;
 
  private:
-  /// Writes origin + v t_k into ws->cost.offset.
-  void SetOffset(const TrajectoryDistribution& d, Workspace* ws) const;
+  /// Writes origin + v t_k of `times` into *offset.
+  static void SetOffset(const TrajectoryDistribution& d, const Eigen::VectorXd& times,
+                        Eigen::Matrix2Xd* offset);
+  /// One projection: nothing when the prior's mixture C <= mixture_limit, else every component
+  /// with C_r > target is solved to target.
+  TrackProjection ProjectOnce(const TrajectoryDistribution& prior, TrajectoryDistribution* out,
+                              Workspace* ws, double mixture_limit, double target) const;
+  /// Mixture C of d under the check operator (NaN if it throws or d holds NaN).
+  double CheckCost(const TrajectoryDistribution& d, Workspace* ws) const;
 
   ProjectorOptions options_;
   CollisionCost cost_;
+  std::optional<CollisionCost> check_;
 };
 
 }  // namespace foresight::constrained

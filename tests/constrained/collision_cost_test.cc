@@ -444,5 +444,83 @@ TEST(CollisionCost, Errors) {
                                {"Component", "workspace", "null"});
 }
 
+// ---- the rectangle rule in time ---------------------------------------------------------------
+
+TEST(RuleTimes, PointsAndErrors) {
+  const Eigen::VectorXd right = RuleTimes(TimeRule::kRight, 3.0, 3);
+  const Eigen::VectorXd mid = RuleTimes(TimeRule::kMidpoint, 3.0, 3);
+  ASSERT_EQ(right.size(), 3);
+  ASSERT_EQ(mid.size(), 3);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_DOUBLE_EQ(right[i], i + 1.0);
+    EXPECT_DOUBLE_EQ(mid[i], i + 0.5);
+  }
+  testing::ExpectErrorContains([] { RuleTimes(TimeRule::kRight, 1.0, 0); },
+                               {"RuleTimes", "time point"});
+  testing::ExpectErrorContains([] { RuleTimes(TimeRule::kMidpoint, 0.0, 4); },
+                               {"RuleTimes", "horizon"});
+  testing::ExpectErrorContains([] { RuleTimes(TimeRule::kMidpoint, NAN, 4); },
+                               {"RuleTimes", "horizon"});
+}
+
+// The time average of a smooth function: the right-end rule's error halves when K doubles (first
+// order), the midpoint rule's quarters (second order); exact integral in closed form.
+TEST(RuleTimes, ConvergeAtTheirOrders) {
+  const double horizon = 4.8;
+  auto g = [](double t) { return std::exp(-0.5 * (t - 2.0) * (t - 2.0)) + 0.1 * t; };
+  // 1/T int_0^T g = (sqrt(pi/2) (erf((T - 2)/sqrt 2) + erf(2/sqrt 2)) + 0.05 T^2) / T
+  const double exact = (std::sqrt(M_PI / 2) * (std::erf((horizon - 2) / std::sqrt(2.0)) +
+                                               std::erf(2 / std::sqrt(2.0))) +
+                        0.05 * horizon * horizon) /
+                       horizon;
+  auto error = [&](TimeRule rule, int k) {
+    const Eigen::VectorXd t = RuleTimes(rule, horizon, k);
+    double sum = 0;
+    for (Eigen::Index i = 0; i < t.size(); ++i) sum += g(t[i]);
+    return std::abs(sum / k - exact);
+  };
+  for (int k : {15, 30, 60}) {
+    const double right_ratio = error(TimeRule::kRight, k) / error(TimeRule::kRight, 2 * k);
+    const double mid_ratio = error(TimeRule::kMidpoint, k) / error(TimeRule::kMidpoint, 2 * k);
+    EXPECT_NEAR(right_ratio, 2.0, 0.2) << "K = " << k;
+    EXPECT_NEAR(mid_ratio, 4.0, 0.2) << "K = " << k;
+    EXPECT_LT(error(TimeRule::kMidpoint, k), 0.2 * error(TimeRule::kRight, k)) << "K = " << k;
+  }
+}
+
+// The cost's time average on a smooth wall: with 12 points the midpoint rule is closer to the
+// continuous C = 1/T int_0^T E[p] dt (per-time expectation by fine 1-D quadrature, the time
+// integral by composite Simpson) than the right-end rule, and both converge as K grows.
+TEST(RuleTimes, MidpointCostIsCloserToTheContinuousIntegral) {
+  const double k_wall = 4, horizon = 4.8;
+  const SmoothHalfPlane map(kNormal, kOffset, k_wall);
+  const TimeBasis basis = Basis(8);
+  const ComponentParams c = RandomComponent(basis, 6, {-1.5, -1}, {1.5, 1.5});
+  auto expected_at = [&](double t) {
+    Eigen::Vector2d mu;
+    Eigen::Matrix2d cov;
+    PositionAt(c, basis, t, &mu, &cov);
+    return ExpectedSigmoid(kNormal.dot(mu), std::sqrt(kNormal.dot(cov * kNormal)), k_wall, kOffset);
+  };
+  const int n = 200;  // Simpson intervals in time
+  double integral = 0;
+  for (int i = 0; i <= n; ++i)
+    integral += expected_at(i * horizon / n) * (i == 0 || i == n ? 1 : (i % 2 == 1 ? 4 : 2));
+  const double continuous = integral * horizon / n / 3 / horizon;
+  auto cost = [&](TimeRule rule, int k) {
+    const CollisionCost op(&map, basis, RuleTimes(rule, horizon, k), 16);
+    CollisionCost::Workspace ws = op.MakeWorkspace();
+    return op.Component(c, &ws, nullptr);
+  };
+  const double right12 = std::abs(cost(TimeRule::kRight, 12) - continuous);
+  const double mid12 = std::abs(cost(TimeRule::kMidpoint, 12) - continuous);
+  const double mid96 = std::abs(cost(TimeRule::kMidpoint, 96) - continuous);
+  std::cout << "continuous C " << continuous << ": |error| right 12 " << right12 << ", midpoint 12 "
+            << mid12 << ", midpoint 96 " << mid96 << "\n";
+  EXPECT_GT(right12, 1e-3);  // the case is one where the rule matters
+  EXPECT_LT(mid12, 0.5 * right12);
+  EXPECT_LT(mid96, 1e-4);
+}
+
 }  // namespace
 }  // namespace foresight::constrained

@@ -330,6 +330,65 @@ TEST(DistributionProjector, ImpossibleConstraintIsReportedNotThrown) {
   for (const ProjectionSummary& s : r.components) EXPECT_FALSE(s.feasible());
 }
 
+// The solver drives the configured operator down and so seeks out its quadrature error: with a
+// crude one-point rule (C from the mean alone) on a sharp wall, the plain projection's result
+// violates under an accurate
+// order-20 operator (built here, apart from the projector). With that operator as the check, the
+// projector solves again with a lowered target until the accurate C meets epsilon too.
+TEST(DistributionProjector, CheckOperatorCatchesTheErrorTheSolverExploits) {
+  const SmoothHalfPlane map(Eigen::Vector2d(1, 0), kWall, 40.0);
+  ProjectorOptions options;
+  options.order = 1;
+  options.margin = 0.002;
+  options.solver.max_seconds = 0;  // deterministic: evaluations only
+  const CollisionCost accurate(&map, Basis(), Times(), 20);
+  CollisionCost::Workspace aws = accurate.MakeWorkspace();
+  auto accurate_cost = [&](const TrajectoryDistribution& d) {
+    aws.offset.resize(2, Times().size());
+    for (Eigen::Index k = 0; k < Times().size(); ++k)
+      aws.offset.col(k) = d.origin() + Times()[k] * d.velocity();
+    double c = 0;
+    for (int r = 0; r < d.components(); ++r)
+      c += d.alpha(r) * accurate.Component(ToComponentParams(d, r), &aws, nullptr);
+    return c;
+  };
+  const TrajectoryDistribution prior = TwoComponents(1.0);
+
+  const DistributionProjector plain(&map, Basis(), Times(), options);
+  auto pws = plain.MakeWorkspace();
+  TrajectoryDistribution plain_out = prior;
+  const TrackProjection p = plain.Project(prior, &plain_out, &pws);
+  ASSERT_TRUE(p.feasible) << p.status;
+  EXPECT_TRUE(std::isnan(p.checked_cost));
+  ASSERT_GT(accurate_cost(plain_out), options.epsilon) << "the case must exploit the crude rule";
+
+  options.check_order = 20;
+  const DistributionProjector checked(&map, Basis(), Times(), options, Times());
+  auto cws = checked.MakeWorkspace();
+  TrajectoryDistribution out = prior;
+  const TrackProjection r = checked.Project(prior, &out, &cws);
+  ASSERT_TRUE(r.feasible) << r.status << " checked C " << r.checked_cost;
+  EXPECT_EQ(r.status, "solved");
+  EXPECT_GE(r.check_rounds, 1);
+  EXPECT_LE(r.cost, options.epsilon);
+  EXPECT_LE(r.checked_cost, options.epsilon);
+  EXPECT_NEAR(r.checked_cost, accurate_cost(out), 1e-12);
+
+  // No repeated solve allowed: the same failing check makes the result infeasible, not compliant.
+  options.check_rounds = 0;
+  const DistributionProjector strict(&map, Basis(), Times(), options, Times());
+  auto sws = strict.MakeWorkspace();
+  TrajectoryDistribution strict_out = prior;
+  const TrackProjection s = strict.Project(prior, &strict_out, &sws);
+  EXPECT_FALSE(s.feasible);
+  EXPECT_EQ(s.status, "infeasible");
+  EXPECT_GT(s.checked_cost, options.epsilon);
+
+  options.check_order = 0;
+  ExpectErrorContains([&] { DistributionProjector(&map, Basis(), Times(), options, Times()); },
+                      {"DistributionProjector", "check_order"});
+}
+
 TEST(DistributionProjector, NonFinitePriorFails) {
   const SmoothHalfPlane map = Wall();
   const DistributionProjector projector(&map, Basis(), Times(), ProjectorOptions{});

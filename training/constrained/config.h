@@ -12,6 +12,7 @@
 #include "core/config.h"
 #include "datasets/map_tracks.h"
 #include "datasets/windows.h"
+#include "inference/constrained/collision_cost.h"
 #include "models/occupancy/raster_map.h"
 #include "models/span/span_config.h"
 #include "training/train_config.h"
@@ -88,6 +89,16 @@ struct ConstraintConfig {
   double margin = 2e-4;   ///< solve to epsilon - margin so the returned C is truly <= epsilon
   int order = 6;          ///< Gauss-Hermite points per axis
   int substeps = 1;       ///< rectangle-rule time points per prediction step
+  TimeRule time_rule =
+      TimeRule::kRight;  ///< where the rectangle rule's points sit in each interval
+  /// Choose order and substeps on validation windows: the cheapest (order^2 x substeps) candidate
+  /// whose C is within `accuracy` of the converged C on every one of `choice_windows` priors.
+  bool choose_quadrature = false;
+  double accuracy = 1e-3;
+  int choice_windows = 40;
+  int check_order = 0;     ///< verify every result with this Gauss-Hermite order (0: no check)
+  int check_substeps = 4;  ///< midpoints per prediction step of the check operator
+  int check_rounds = 3;    ///< repeated solves with a lowered target when the check fails
   int restarts = 2;  ///< SLSQP restarts from the lowest-cost point when no feasible one was found
   int max_evaluations = 300;  ///< SLSQP objective evaluations per component
   double max_seconds = 1.0;   ///< wall-time limit per component (s)
@@ -101,6 +112,24 @@ struct ConstraintConfig {
     a->Visit("order", &order, Range::Closed(1, 40), "Gauss-Hermite points per axis");
     a->Visit("substeps", &substeps, Range::Closed(1, 64),
              "time points of the rectangle rule per prediction step (1: at the predicted steps)");
+    a->VisitEnum(
+        "time_rule", &time_rule,
+        config::EnumNames<TimeRule>{{TimeRule::kRight, "right"}, {TimeRule::kMidpoint, "midpoint"}},
+        "rectangle-rule points at the right end (thesis: the predicted steps) or the "
+        "middle of each time interval (second order)");
+    a->Visit("choose_quadrature", &choose_quadrature, Range::Any(),
+             "choose order and substeps on validation windows (overrides both; see accuracy)");
+    a->Visit("accuracy", &accuracy, Range::Open(0, 1),
+             "largest |C - converged C| allowed on the validation priors when choosing");
+    a->Visit("choice_windows", &choice_windows, Range::Closed(1, 100000),
+             "validation windows (evenly spread) the quadrature choice is made on");
+    a->Visit("check_order", &check_order, Range::Closed(0, 64),
+             "verify each result with this Gauss-Hermite order; above epsilon, solve again with "
+             "the target lowered by the excess (0: no check)");
+    a->Visit("check_substeps", &check_substeps, Range::Closed(1, 64),
+             "midpoint time points per prediction step of the check operator");
+    a->Visit("check_rounds", &check_rounds, Range::Closed(0, 20),
+             "repeated solves at most when the check finds the result above epsilon");
     a->Visit("restarts", &restarts, Range::Closed(0, 100),
              "SLSQP restarts from the lowest-cost point seen when it stops infeasible");
     a->Visit("max_evaluations", &max_evaluations, Range::Closed(1, 100000),
