@@ -72,13 +72,25 @@ DistributionProjector::DistributionProjector(const occupancy::Map* map, const Ti
   FS_THROW_UNLESS(std::isfinite(s.max_seconds) && s.max_seconds >= 0,
                   "DistributionProjector: solver.max_seconds must be finite and >= 0, got ",
                   s.max_seconds);
+  FS_THROW_UNLESS(options_.check_order == 0, "DistributionProjector: check_order ",
+                  options_.check_order,
+                  " needs the check operator's times (the constructor with "
+                  "check_times)");
   options_.solver.epsilon = options_.epsilon - options_.margin;
 }
+
+namespace {
+ProjectorOptions WithoutCheck(ProjectorOptions o) {
+  o.check_order = 0;
+  return o;
+}
+}  // namespace
 
 DistributionProjector::DistributionProjector(const occupancy::Map* map, const TimeBasis& basis,
                                              Eigen::VectorXd times, const ProjectorOptions& options,
                                              Eigen::VectorXd check_times)
-    : DistributionProjector(map, basis, std::move(times), options) {
+    : DistributionProjector(map, basis, std::move(times), WithoutCheck(options)) {
+  options_.check_order = options.check_order;
   FS_THROW_UNLESS(options_.check_order >= 1 && options_.check_order <= 64,
                   "DistributionProjector: check_order must be in [1, 64] with check times, got ",
                   options_.check_order);
@@ -108,6 +120,14 @@ void DistributionProjector::SetOffset(const TrajectoryDistribution& d, const Eig
 }
 
 namespace {
+/// No component ended infeasible or failed.
+bool AllSolved(const TrackProjection& r) {
+  for (const ProjectionSummary& s : r.components)
+    if (s.status == ProjectionStatus::kInfeasible || s.status == ProjectionStatus::kFailed)
+      return false;
+  return true;
+}
+
 void CheckBasis(const TrajectoryDistribution& d, const CollisionCost& cost) {
   FS_THROW_UNLESS(d.basis_size() == cost.basis(), "DistributionProjector: the distribution has ",
                   d.basis_size(), " basis functions, the projector's basis has ", cost.basis());
@@ -151,47 +171,61 @@ TrackProjection DistributionProjector::Project(const TrajectoryDistribution& pri
       out->basis_size(), ", the prior ", prior.components(), " of basis ", prior.basis_size());
   CheckBasis(prior, cost_);
   const double target0 = options_.solver.epsilon;  // epsilon - margin
+  const auto seconds = [&start] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
   if (!check_) {
-    TrackProjection result = ProjectOnce(prior, out, ws, options_.epsilon, target0);
-    result.seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    TrackProjection result =
+        ProjectOnce(prior, out, ws, cost_, &ws->cost, options_.epsilon, target0);
+    result.seconds = seconds();
     return result;
   }
-  // `out` may be the prior: keep a copy for the repeated solves.
-  const TrajectoryDistribution prior_copy = prior;
-  TrackProjection result = ProjectOnce(prior_copy, out, ws, options_.epsilon, target0);
-  double target = target0;
+  // `out` may be the prior: the repeated solves start from a copy then.
+  std::optional<TrajectoryDistribution> prior_copy;
+  if (out == &prior) prior_copy = prior;
+  const TrajectoryDistribution& from = prior_copy ? *prior_copy : prior;
+  TrackProjection result = ProjectOnce(from, out, ws, cost_, &ws->cost, options_.epsilon, target0);
+  bool changed = result.changed;
   int evaluations = result.evaluations;
+  double target = target0;
   for (int round = 0;; ++round) {
     result.checked_cost = CheckCost(*out, ws);
     result.check_rounds = round;
     result.evaluations = evaluations;
-    if (!std::isfinite(result.checked_cost)) {
+    result.changed = changed;
+    if (!std::isfinite(result.checked_cost) || result.status == "failed") {
       result.feasible = false;
       result.status = "failed";
       break;
     }
-    if (result.checked_cost <= options_.epsilon) break;
-    // The check finds the result above epsilon: lower the target by the excess and solve again.
-    target -= result.checked_cost - target0;
-    if (round == options_.check_rounds || !(target > 0)) {
-      result.feasible = false;
-      if (result.status != "failed") result.status = "infeasible";
+    // The check operator is the more accurate one: its verdict is the result's.
+    if (result.checked_cost <= options_.epsilon) {
+      result.feasible = true;
+      result.status = changed ? "solved" : "compliant_prior";
       break;
     }
-    const bool prior_changed = result.changed;
-    result = ProjectOnce(prior_copy, out, ws, target + options_.margin, target);
-    result.changed = result.changed || prior_changed;
+    result.feasible = false;
+    result.status = "infeasible";
+    // A solve against the check operator itself found no compliant point: a lower target will not.
+    if (round == options_.check_rounds || (round > 0 && !AllSolved(result))) break;
+    // Solve again from the prior against the check operator (every component it finds above the
+    // target); after a first such round, with the target lowered by the excess it left.
+    if (round > 0) target -= result.checked_cost - target0;
+    if (!(target > 0)) break;
+    result = ProjectOnce(from, out, ws, *check_, &ws->check, -HUGE_VAL, target);
+    changed = true;
     evaluations += result.evaluations;
   }
-  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.seconds = seconds();
   return result;
 }
 
 TrackProjection DistributionProjector::ProjectOnce(const TrajectoryDistribution& prior,
                                                    TrajectoryDistribution* out, Workspace* ws,
+                                                   const CollisionCost& op,
+                                                   CollisionCost::Workspace* op_ws,
                                                    double mixture_limit, double target) const {
-  SetOffset(prior, cost_.times(), &ws->cost.offset);
+  SetOffset(prior, op.times(), &op_ws->offset);
   const int R = prior.components();
   // The prior's components, copied before `out` (which may be the prior) is written.
   std::vector<ComponentParams> params(static_cast<std::size_t>(R));
@@ -216,7 +250,7 @@ TrackProjection DistributionProjector::ProjectOnce(const TrajectoryDistribution&
   try {
     for (int r = 0; r < R; ++r) {
       const auto k = static_cast<std::size_t>(r);
-      prior_costs[k] = cost_.Component(params[k], &ws->cost, nullptr);
+      prior_costs[k] = op.Component(params[k], op_ws, nullptr);
       result.prior_cost += prior.alpha(r) * prior_costs[k];
     }
   } catch (const std::exception&) {
@@ -245,8 +279,8 @@ TrackProjection DistributionProjector::ProjectOnce(const TrajectoryDistribution&
 
   result.changed = true;
   result.status = "solved";
-  CollisionCost::Workspace* cost_ws = &ws->cost;
-  const CollisionCost* cost = &cost_;
+  CollisionCost::Workspace* cost_ws = op_ws;
+  const CollisionCost* cost = &op;
   const ConstraintFunction constraint = [cost, cost_ws](const ComponentParams& p,
                                                         ComponentGradient* g) {
     return cost->Component(p, cost_ws, g);

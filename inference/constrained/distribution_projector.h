@@ -45,8 +45,11 @@ struct ProjectorOptions {
   /// Verification by a second, more accurate operator (0: off): Gauss-Hermite order `check_order`
   /// on the constructor's `check_times`. The solver drives the configured operator down and so
   /// seeks out its quadrature error (mass between the nodes); when the check operator finds the
-  /// result above epsilon, the solve is repeated from the prior with the component target lowered
-  /// by the excess (C_check - (epsilon - margin)), at most `check_rounds` times.
+  /// result above epsilon, the solve is repeated from the prior against the check operator itself
+  /// (every component it finds above epsilon - margin), and after that with the target lowered by
+  /// the excess the last solve left (C_check - (epsilon - margin)): at most `check_rounds` repeated
+  /// solves, stopping early once a solve against the check operator ends without a compliant
+  /// point. The check operator's verdict is the result's (`feasible`, `status`).
   int check_order = 0;
   int check_rounds = 3;
 };
@@ -54,8 +57,8 @@ struct ProjectorOptions {
 /// Outcome of one track's projection (expected outcomes are values here, never exceptions).
 struct TrackProjection {
   bool changed = false;   ///< false: the prior's mixture C already met epsilon (returned unchanged)
-  bool feasible = false;  ///< mixture C of the returned distribution <= epsilon (and checked C)
-  double prior_cost = 0, cost = 0;  ///< mixture C before / after
+  bool feasible = false;  ///< mixture C of the result <= epsilon (with a check: the checked C)
+  double prior_cost = 0, cost = 0;  ///< mixture C before / after (the configured operator)
   double checked_cost = NAN;        ///< C of the result under the check operator (NaN: no check)
   int check_rounds = 0;             ///< repeated solves the check asked for
   double kl = 0;                    ///< sum_r alpha_r KL_r
@@ -64,8 +67,10 @@ struct TrackProjection {
   /// Per component: kAlreadyFeasible when C_r <= epsilon - margin or when the mixture already met
   /// epsilon (nothing projected), else the solver's outcome.
   std::vector<ProjectionSummary> components;
-  /// "compliant_prior" | "solved" | "infeasible" | "failed": the worst outcome over components,
-  /// and never "solved" or "compliant_prior" unless `feasible`.
+  /// "compliant_prior" | "solved" | "infeasible" | "failed": the worst outcome over components
+  /// (with a check operator: its verdict on the result, so "infeasible" may come with every
+  /// component solved under the configured operator), and never "solved" or "compliant_prior"
+  /// unless `feasible`.
   std::string status;
 };
 
@@ -88,7 +93,7 @@ class DistributionProjector {
   DistributionProjector(const occupancy::Map* map, const TimeBasis& basis, Eigen::VectorXd times,
                         const ProjectorOptions& options);
   /// With a check operator (options.check_order > 0) on `check_times` (error when the order is
-  /// out of [1, 64] or check_times is empty).
+  /// out of [1, 64] or check_times is empty). The constructor above refuses check_order != 0.
   DistributionProjector(const occupancy::Map* map, const TimeBasis& basis, Eigen::VectorXd times,
                         const ProjectorOptions& options, Eigen::VectorXd check_times);
 
@@ -111,10 +116,13 @@ class DistributionProjector {
   /// Writes origin + v t_k of `times` into *offset.
   static void SetOffset(const TrajectoryDistribution& d, const Eigen::VectorXd& times,
                         Eigen::Matrix2Xd* offset);
-  /// One projection: nothing when the prior's mixture C <= mixture_limit, else every component
-  /// with C_r > target is solved to target.
+  /// One projection against operator `op` (cost_ or *check_, with its workspace): nothing when
+  /// the prior's mixture C <= mixture_limit, else every component with C_r > target is solved to
+  /// target. result.cost and result.feasible are judged by the configured operator.
   TrackProjection ProjectOnce(const TrajectoryDistribution& prior, TrajectoryDistribution* out,
-                              Workspace* ws, double mixture_limit, double target) const;
+                              Workspace* ws, const CollisionCost& op,
+                              CollisionCost::Workspace* op_ws, double mixture_limit,
+                              double target) const;
   /// Mixture C of d under the check operator (NaN if it throws or d holds NaN).
   double CheckCost(const TrajectoryDistribution& d, Workspace* ws) const;
 

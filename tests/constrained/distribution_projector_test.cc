@@ -389,6 +389,51 @@ TEST(DistributionProjector, CheckOperatorCatchesTheErrorTheSolverExploits) {
                       {"DistributionProjector", "check_order"});
 }
 
+// A prior the crude rule calls compliant (its mean stays left of the wall) while its spread puts
+// mass beyond it: the check rejects it, and the repeated solve against the check operator itself
+// makes it compliant. Also with out == &prior.
+TEST(DistributionProjector, CheckRejectsAPriorTheCrudeRuleCallsCompliant) {
+  const SmoothHalfPlane map(Eigen::Vector2d(1, 0), kWall, 40.0);
+  ProjectorOptions options;
+  options.order = 1;
+  options.solver.max_seconds = 0;
+  const DistributionProjector plain(&map, Basis(), Times(), options);
+  auto pws = plain.MakeWorkspace();
+  options.check_order = 20;
+  const DistributionProjector checked(&map, Basis(), Times(), options, Times());
+  auto cws = checked.MakeWorkspace();
+  ExpectErrorContains([&] { DistributionProjector(&map, Basis(), Times(), options); },
+                      {"DistributionProjector", "check_order 20", "check_times"});
+  ProjectorOptions accurate_options;
+  accurate_options.order = 20;
+  const DistributionProjector accurate(&map, Basis(), Times(), accurate_options);
+  auto aws = accurate.MakeWorkspace();
+
+  // Component 0 of TwoComponents ending 0.1 m short of the wall, with 3x the spread.
+  TrajectoryDistribution prior = TwoComponents(/*x_drift=*/0.12);
+  prior.SetComponent(0, prior.mean(0), 3 * prior.chol_u(0), prior.chol_v(0));
+  ASSERT_LE(plain.Cost(prior, &pws), options.epsilon);
+  ASSERT_GT(accurate.Cost(prior, &aws), options.epsilon) << "the prior must fool the crude rule";
+  TrajectoryDistribution p_out = prior;
+  const TrackProjection p = plain.Project(prior, &p_out, &pws);
+  EXPECT_EQ(p.status, "compliant_prior");
+
+  for (const bool alias : {false, true}) {
+    TrajectoryDistribution d = prior;
+    TrajectoryDistribution other = prior;
+    TrajectoryDistribution* out = alias ? &d : &other;
+    const TrackProjection r = checked.Project(d, out, &cws);
+    ASSERT_TRUE(r.feasible) << r.status << " checked C " << r.checked_cost << " alias " << alias;
+    EXPECT_EQ(r.status, "solved");
+    EXPECT_TRUE(r.changed);
+    EXPECT_EQ(r.check_rounds, 1);
+    EXPECT_GT(r.evaluations, 0);
+    EXPECT_LE(r.checked_cost, options.epsilon);
+    EXPECT_NEAR(r.checked_cost, accurate.Cost(*out, &aws), 1e-12);
+    EXPECT_NEAR(r.cost, plain.Cost(*out, &pws), 1e-12);  // `cost` stays the configured operator's
+  }
+}
+
 TEST(DistributionProjector, NonFinitePriorFails) {
   const SmoothHalfPlane map = Wall();
   const DistributionProjector projector(&map, Basis(), Times(), ProjectorOptions{});

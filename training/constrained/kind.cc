@@ -51,7 +51,7 @@ ExperimentKind Kind() {
     const auto c = LoadRunConfig<ExperimentConfig>(run_dir, overrides);
     return EvaluateConstrainedRun(c, run_dir);
   };
-  k.no_step_hint = "its projection times are in eval.json (solve_time_ms, check_time_ms)";
+  k.no_step_hint = "its projection times are in eval.json (solve_time_ms, unprojected_time_ms)";
   return k;
 }
 
