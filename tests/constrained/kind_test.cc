@@ -65,6 +65,18 @@ TEST(ConstrainedRun, InterruptedInTheFirstEpochResumesAndEvaluates) {
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 8);
 
   const ExperimentKind kind = constrained::Kind();
+  // The quadrature chosen on validation windows, midpoints in time, every result checked.
+  const std::string checked =
+      kind.evaluate(run, {"constraint.time_rule=midpoint", "constraint.choose_quadrature=true",
+                          "constraint.choice_windows=4", "constraint.check_order=32"});
+  for (const char* key :
+       {"\"quadrature_choice\"", "\"truth\"", "\"cvp_converged\"", "\"check_order\": 32",
+        "\"time_rule\": \"midpoint\"", "\"windows_solved_again_after_check\"",
+        "\"max_abs_error_vs_continuous_monte_carlo\""})
+    EXPECT_NE(checked.find(key), std::string::npos) << key;
+  // A check no more accurate than the rule it checks is refused, naming the key.
+  ExpectErrorContains([&] { kind.evaluate(run, {"constraint.check_order=6"}); },
+                      {"constraint.check_order", "must exceed"});
   for (const char* o : {"map.kind=grid", "seed=3", "split.test_fraction=0.5", "windows.stride=1"})
     ExpectErrorContains([&] { kind.evaluate(run, {o}); }, {o, "train a new run"});
 }

@@ -393,9 +393,10 @@ std::string EvaluateConstrained(const ExperimentConfig& c, const ConstrainedData
   const Eigen::VectorXd check_times =
       RuleTimes(TimeRule::kMidpoint, horizon, f * c.constraint.check_substeps);
   constexpr int kReferenceOrder = 20;
-  ProjectorOptions po_ref = po;
+  ProjectorOptions po_plain = po;  // the configured operator alone (no check)
+  po_plain.check_order = 0;
+  ProjectorOptions po_ref = po_plain;
   po_ref.order = kReferenceOrder;
-  po_ref.check_order = 0;
   ProjectorOptions po_converged = po_ref;
   po_converged.order = kConvergedOrder;
 
@@ -417,7 +418,8 @@ std::string EvaluateConstrained(const ExperimentConfig& c, const ConstrainedData
                                              r.map.get(), prior.basis(), times, po);
       r.reference =
           std::make_unique<DistributionProjector>(r.map.get(), prior.basis(), times, po_ref);
-      r.fine = std::make_unique<DistributionProjector>(r.map.get(), prior.basis(), fine_times, po);
+      r.fine =
+          std::make_unique<DistributionProjector>(r.map.get(), prior.basis(), fine_times, po_plain);
       r.converged = std::make_unique<DistributionProjector>(r.map.get(), prior.basis(),
                                                             converged_times, po_converged);
       r.ws = r.projector->MakeWorkspace();
