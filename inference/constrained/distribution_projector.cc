@@ -96,6 +96,10 @@ DistributionProjector::DistributionProjector(const occupancy::Map* map, const Ti
                   options_.check_order);
   FS_THROW_UNLESS(options_.check_rounds >= 0,
                   "DistributionProjector: check_rounds must be >= 0, got ", options_.check_rounds);
+  FS_THROW_UNLESS(std::isfinite(options_.check_slack) && options_.check_slack >= 0 &&
+                      options_.check_slack < options_.margin,
+                  "DistributionProjector: check_slack must be in [0, margin = ", options_.margin,
+                  "), got ", options_.check_slack);
   check_.emplace(map, basis, std::move(check_times), options_.check_order);
 }
 
@@ -199,7 +203,7 @@ TrackProjection DistributionProjector::Project(const TrajectoryDistribution& pri
       break;
     }
     // The check operator is the more accurate one: its verdict is the result's.
-    if (result.checked_cost <= options_.epsilon) {
+    if (result.checked_cost <= options_.epsilon - options_.check_slack) {
       result.feasible = true;
       result.status = changed ? "solved" : "compliant_prior";
       break;
@@ -212,7 +216,8 @@ TrackProjection DistributionProjector::Project(const TrajectoryDistribution& pri
     // target); after a first such round, with the target lowered by the excess it left.
     if (round > 0) target -= result.checked_cost - target0;
     if (!(target > 0)) break;
-    result = ProjectOnce(from, out, ws, *check_, &ws->check, -HUGE_VAL, target);
+    const TrajectoryDistribution previous = *out;  // the warm start: the last solution
+    result = ProjectOnce(from, out, ws, *check_, &ws->check, -HUGE_VAL, target, &previous);
     changed = true;
     evaluations += result.evaluations;
   }
@@ -224,12 +229,16 @@ TrackProjection DistributionProjector::ProjectOnce(const TrajectoryDistribution&
                                                    TrajectoryDistribution* out, Workspace* ws,
                                                    const CollisionCost& op,
                                                    CollisionCost::Workspace* op_ws,
-                                                   double mixture_limit, double target) const {
+                                                   double mixture_limit, double target,
+                                                   const TrajectoryDistribution* start) const {
   SetOffset(prior, op.times(), &op_ws->offset);
   const int R = prior.components();
   // The prior's components, copied before `out` (which may be the prior) is written.
   std::vector<ComponentParams> params(static_cast<std::size_t>(R));
   for (int r = 0; r < R; ++r) params[static_cast<std::size_t>(r)] = ToComponentParams(prior, r);
+  std::vector<ComponentParams> starts;
+  if (start != nullptr)
+    for (int r = 0; r < R; ++r) starts.push_back(ToComponentParams(*start, r));
   if (out != &prior) *out = prior;
 
   TrackProjection result;
@@ -296,7 +305,9 @@ TrackProjection DistributionProjector::ProjectOnce(const TrajectoryDistribution&
       continue;
     }
     try {
-      s = ProjectComponent(params[k], constraint, solver, &ws->component);
+      s = starts.empty()
+              ? ProjectComponent(params[k], constraint, solver, &ws->component)
+              : ProjectComponent(params[k], constraint, solver, &ws->component, starts[k]);
       if (s.status == ProjectionStatus::kSolved || s.status == ProjectionStatus::kInfeasible) {
         SetFromComponentParams(ws->component, r, out);
       }

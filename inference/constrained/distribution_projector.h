@@ -52,6 +52,9 @@ struct ProjectorOptions {
   /// point. The check operator's verdict is the result's (`feasible`, `status`).
   int check_order = 0;
   int check_rounds = 3;
+  /// The check accepts C_check <= epsilon - check_slack (the check operator's own error bound, so
+  /// that the true C meets epsilon); in [0, margin).
+  double check_slack = 0;
 };
 
 /// Outcome of one track's projection (expected outcomes are values here, never exceptions).
@@ -118,11 +121,12 @@ class DistributionProjector {
                         Eigen::Matrix2Xd* offset);
   /// One projection against operator `op` (cost_ or *check_, with its workspace): nothing when
   /// the prior's mixture C <= mixture_limit, else every component with C_r > target is solved to
-  /// target. result.cost and result.feasible are judged by the configured operator.
+  /// target. SLSQP warm-started at `start`'s components when given (the previous solution).
+  /// result.cost and result.feasible are judged by the configured operator.
   TrackProjection ProjectOnce(const TrajectoryDistribution& prior, TrajectoryDistribution* out,
                               Workspace* ws, const CollisionCost& op,
                               CollisionCost::Workspace* op_ws, double mixture_limit,
-                              double target) const;
+                              double target, const TrajectoryDistribution* start = nullptr) const;
   /// Mixture C of d under the check operator (NaN if it throws or d holds NaN).
   double CheckCost(const TrajectoryDistribution& d, Workspace* ws) const;
 

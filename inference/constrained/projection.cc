@@ -175,6 +175,12 @@ struct OptDeleter {
 
 ProjectionSummary ProjectComponent(const ComponentParams& prior, const ConstraintFunction& cost,
                                    const ProjectionOptions& options, ComponentParams* out) {
+  return ProjectComponent(prior, cost, options, out, prior);
+}
+
+ProjectionSummary ProjectComponent(const ComponentParams& prior, const ConstraintFunction& cost,
+                                   const ProjectionOptions& options, ComponentParams* out,
+                                   const ComponentParams& warm_start) {
   // Bad arguments are caller errors and throw; everything after them is reported as a status.
   FS_THROW_UNLESS(out != nullptr, "ProjectComponent: out is null");
   FS_THROW_UNLESS(static_cast<bool>(cost), "ProjectComponent: the constraint function is empty");
@@ -202,7 +208,12 @@ ProjectionSummary ProjectComponent(const ComponentParams& prior, const Constrain
   const auto elapsed = [&start] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };
-  const ComponentParams prior_copy = prior;  // `out` may alias `prior`
+  const ComponentParams prior_copy = prior;  // `out` may alias `prior` (or `start`)
+  const bool warm = &warm_start != &prior && AllFinite(warm_start) &&
+                    warm_start.chol_v(0, 0) > 0 &&
+                    warm_start.chol_v(1, 1) > 0 && warm_start.mean.rows() == prior.mean.rows() &&
+                    warm_start.mean.cols() == 2 && warm_start.log_u.size() == prior.log_u.size();
+  const ComponentParams start_copy = warm ? warm_start : ComponentParams{};
   ProjectionSummary summary;
   summary.status = ProjectionStatus::kFailed;
   const auto finish_with_prior = [&](ProjectionStatus status) {
@@ -231,7 +242,19 @@ ProjectionSummary ProjectComponent(const ComponentParams& prior, const Constrain
   }
 
   const int m = prior.basis();
-  Eigen::VectorXd theta = prior_copy.ToVector();
+  const Eigen::VectorXd prior_theta = prior_copy.ToVector();
+  Eigen::VectorXd theta = prior_theta;
+  // The warm start's C and KL (a start that cannot be evaluated is dropped: the prior is used).
+  double start_cost = NAN, start_kl = NAN;
+  if (warm) {
+    try {
+      start_cost = cost(start_copy, nullptr);
+      start_kl = MatrixNormalKl(start_copy, prior_copy, nullptr);
+    } catch (...) {
+      start_cost = NAN;
+    }
+  }
+  const bool use_start = warm && std::isfinite(start_cost) && std::isfinite(start_kl);
   const unsigned n = static_cast<unsigned>(theta.size());
   std::unique_ptr<nlopt_opt_s, OptDeleter> opt(nlopt_create(NLOPT_LD_SLSQP, n));
   if (!opt) return finish_with_prior(ProjectionStatus::kFailed);
@@ -249,6 +272,22 @@ ProjectionSummary ProjectComponent(const ComponentParams& prior, const Constrain
   pb.fallback = theta;
   pb.fallback_cost = summary.prior_cost;
   pb.fallback_kl = 0;
+  if (use_start) {
+    theta = start_copy.ToVector();
+    if (start_cost < pb.min_cost) {
+      pb.min_cost = start_cost;
+      pb.fallback = theta;
+      pb.fallback_cost = start_cost;
+      pb.fallback_kl = start_kl;
+      pb.fallback_moved = true;
+    }
+    if (start_cost <= pb.feasible_limit) {
+      pb.have_feasible = true;
+      pb.best_feasible = theta;
+      pb.best_feasible_kl = start_kl;
+      pb.best_feasible_cost = start_cost;
+    }
+  }
 
   // Box bounds around the prior keep every exp() finite during SLSQP's line searches: the
   // log-variances of U and the log-diagonal of L_V move by at most kLogRange, the means are free.
@@ -257,9 +296,10 @@ ProjectionSummary ProjectComponent(const ComponentParams& prior, const Constrain
   Eigen::VectorXd upper = Eigen::VectorXd::Constant(n, HUGE_VAL);
   for (int i = 2 * m; i < static_cast<int>(n); ++i) {
     if (i == 3 * m + 1) continue;  // L_V(1, 0) is not a log
-    lower[i] = theta[i] - kLogRange;
-    upper[i] = theta[i] + kLogRange;
+    lower[i] = prior_theta[i] - kLogRange;
+    upper[i] = prior_theta[i] + kLogRange;
   }
+  theta = theta.cwiseMax(lower).cwiseMin(upper);  // a warm start lies inside; the prior does
   nlopt_result r = nlopt_set_lower_bounds(opt.get(), lower.data());
   if (r > 0) r = nlopt_set_upper_bounds(opt.get(), upper.data());
   if (r > 0) r = nlopt_set_min_objective(opt.get(), Objective, &pb);

@@ -374,6 +374,20 @@ TEST(DistributionProjector, CheckOperatorCatchesTheErrorTheSolverExploits) {
   EXPECT_LE(r.checked_cost, options.epsilon);
   EXPECT_NEAR(r.checked_cost, accurate_cost(out), 1e-12);
 
+  // With a slack the check accepts only C_check <= epsilon - slack; a slack of the margin or more
+  // is refused.
+  ProjectorOptions slack = options;
+  slack.check_slack = 0.0015;
+  const DistributionProjector slacked(&map, Basis(), Times(), slack, Times());
+  auto kws = slacked.MakeWorkspace();
+  TrajectoryDistribution slack_out = prior;
+  const TrackProjection k = slacked.Project(prior, &slack_out, &kws);
+  ASSERT_TRUE(k.feasible) << k.status << " checked C " << k.checked_cost;
+  EXPECT_LE(k.checked_cost, options.epsilon - slack.check_slack);
+  slack.check_slack = options.margin;
+  ExpectErrorContains([&] { DistributionProjector(&map, Basis(), Times(), slack, Times()); },
+                      {"DistributionProjector", "check_slack"});
+
   // No repeated solve allowed: the same failing check makes the result infeasible, not compliant.
   options.check_rounds = 0;
   const DistributionProjector strict(&map, Basis(), Times(), options, Times());

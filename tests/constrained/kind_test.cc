@@ -68,9 +68,10 @@ TEST(ConstrainedRun, InterruptedInTheFirstEpochResumesAndEvaluates) {
   // The quadrature chosen on validation windows, midpoints in time, every result checked.
   const std::string checked =
       kind.evaluate(run, {"constraint.time_rule=midpoint", "constraint.choose_quadrature=true",
-                          "constraint.choice_windows=4", "constraint.check_order=32"});
+                          "constraint.choice_windows=4", "constraint.check_order=32",
+                          "constraint.choose_check=true"});
   for (const char* key :
-       {"\"quadrature_choice\"", "\"truth\"", "\"cvp_converged\"", "\"check_order\": 32",
+       {"\"quadrature_choice\"", "\"truth\"", "\"cvp_converged\"", "\"check_order\"",
         "\"time_rule\": \"midpoint\"", "\"windows_solved_again_after_check\"",
         "\"max_abs_error_vs_continuous_monte_carlo\""})
     EXPECT_NE(checked.find(key), std::string::npos) << key;
@@ -94,6 +95,12 @@ TEST(ConstrainedRun, ConfigRulesNameTheKey) {
             "model: constrained\nconstraint: {margin: 0}\n", "bad.yaml");
       },
       {"bad.yaml", "constraint.margin"});
+  ExpectErrorContains(
+      [] {
+        config::ExperimentConfigFromYaml<constrained::ExperimentConfig>(
+            "model: constrained\nconstraint: {choose_check: true}\n", "bad.yaml");
+      },
+      {"bad.yaml", "constraint.choose_check", "choose_quadrature"});
 }
 
 }  // namespace

@@ -193,6 +193,43 @@ TEST(ProjectComponent, ViolatingPriorIsProjectedOntoTheConstraint) {
   }
 }
 
+// A warm start: from a feasible point (the hand-built mean shift) the result is at least as good
+// and reaches the cold solve's optimum; from the cold optimum itself it stays there in fewer
+// evaluations; an invalid start (NaN) is ignored.
+TEST(ProjectComponent, WarmStartIsNeverWorseThanTheStart) {
+  const int m = 6;
+  const ComponentParams prior = MakePrior(m);
+  const HalfPlane h = MakeHalfPlane(m, 0.8);
+  ProjectionOptions opt;
+  opt.max_seconds = 0;
+  ComponentParams cold;
+  const ProjectionSummary sc = ProjectComponent(prior, AsFunction(h), opt, &cold);
+  ASSERT_EQ(sc.status, ProjectionStatus::kSolved);
+
+  const ComponentParams shifted = ShiftMeanToEpsilon(prior, h, opt.epsilon);
+  ComponentParams warm;
+  const ProjectionSummary sw = ProjectComponent(prior, AsFunction(h), opt, &warm, shifted);
+  ASSERT_EQ(sw.status, ProjectionStatus::kSolved);
+  EXPECT_LE(sw.kl, MatrixNormalKl(shifted, prior, nullptr));
+  EXPECT_NEAR(sw.kl, sc.kl, 1e-3 * (1 + sc.kl));
+  EXPECT_NEAR(sw.kl, MatrixNormalKl(warm, prior, nullptr), 1e-12);  // KL from the prior
+  EXPECT_LE(h(warm, nullptr), opt.epsilon + opt.tolerance);
+
+  ComponentParams again;
+  const ProjectionSummary sa = ProjectComponent(prior, AsFunction(h), opt, &again, cold);
+  ASSERT_EQ(sa.status, ProjectionStatus::kSolved);
+  EXPECT_LE(sa.kl, sc.kl * (1 + 1e-9));
+  EXPECT_LT(sa.evaluations, sc.evaluations);
+
+  ComponentParams bad = cold;
+  bad.mean(0, 0) = std::nan("");
+  ComponentParams ignored;
+  const ProjectionSummary sb = ProjectComponent(prior, AsFunction(h), opt, &ignored, bad);
+  EXPECT_EQ(sb.status, sc.status);
+  EXPECT_EQ(sb.evaluations, sc.evaluations);
+  EXPECT_DOUBLE_EQ(sb.kl, sc.kl);
+}
+
 TEST(ProjectComponent, OutMayAliasThePrior) {
   const int m = 5;
   ComponentParams p = MakePrior(m);

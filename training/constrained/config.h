@@ -97,6 +97,10 @@ struct ConstraintConfig {
   double accuracy = 1e-3;
   int choice_windows = 40;
   int check_order = 0;     ///< verify every result with this Gauss-Hermite order (0: no check)
+  /// With choose_quadrature: choose check_order and check_substeps on projected validation
+  /// windows the same way (within `accuracy` of the converged C).
+  bool choose_check = false;
+  double check_accuracy = 1e-3;  ///< the chosen check's largest error on the projected windows
   int check_substeps = 4;  ///< midpoints per prediction step of the check operator
   int check_rounds = 3;    ///< repeated solves with a lowered target when the check fails
   int restarts = 2;  ///< SLSQP restarts from the lowest-cost point when no feasible one was found
@@ -126,6 +130,12 @@ struct ConstraintConfig {
     a->Visit("check_order", &check_order, Range::Closed(0, 64),
              "verify each result with this Gauss-Hermite order; above epsilon, solve again with "
              "the target lowered by the excess (0: no check)");
+    a->Visit("choose_check", &choose_check, Range::Any(),
+             "with choose_quadrature: choose check_order and check_substeps on the projected "
+             "validation windows (overrides both)");
+    a->Visit("check_accuracy", &check_accuracy, Range::Open(0, 1),
+             "with choose_check: the largest |C - converged C| allowed of the check on the "
+             "projected validation windows; the check then accepts C <= epsilon - its error");
     a->Visit("check_substeps", &check_substeps, Range::Closed(1, 64),
              "midpoint time points per prediction step of the check operator");
     a->Visit("check_rounds", &check_rounds, Range::Closed(0, 20),

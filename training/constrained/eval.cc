@@ -8,6 +8,7 @@
 #include <fstream>
 #include <map>
 #include <memory>
+#include <numeric>
 #include <optional>
 #include <random>
 #include <sstream>
@@ -253,87 +254,167 @@ double CostWith(const occupancy::Map* map, const TimeBasis& basis, const Eigen::
   return op.Cost(d, &ws);
 }
 
-/// The quadrature chosen on validation windows (constraint.choose_quadrature).
-struct QuadratureChoice {
-  int order = 0, substeps = 0;
-  bool met = false;  ///< the chosen candidate's largest error is <= constraint.accuracy
-  int windows = 0;
-  std::vector<double> orders, substeps_tried, max_errors;  ///< every candidate, in trial order
-  JsonObject Json(double accuracy) const {
+/// The projector options of a run at Gauss-Hermite order `order`, without a check operator.
+ProjectorOptions PlainProjectorOptions(const ExperimentConfig& c, int order) {
+  ProjectorOptions po;
+  po.epsilon = c.constraint.epsilon;
+  po.margin = c.constraint.margin;
+  po.order = order;
+  po.solver.max_evaluations = c.constraint.max_evaluations;
+  po.solver.max_seconds = c.constraint.max_seconds;
+  po.solver.restarts = c.constraint.restarts;
+  // The solver accepts C within its tolerance of its target; the target sits `margin` below
+  // epsilon, so a tolerance below the margin keeps accepted points compliant.
+  po.solver.tolerance = std::min(po.solver.tolerance, 0.5 * c.constraint.margin);
+  return po;
+}
+
+/// Quadrature candidates (Gauss-Hermite order x time points per step) scored by their largest
+/// |C - converged C| over a set of distributions.
+struct Candidates {
+  std::vector<double> orders, substeps, max_errors;  ///< every candidate, in trial order
+  int windows = 0;                                   ///< distributions scored
+  int chosen = -1;
+  bool met = false;
+
+  Candidates(std::initializer_list<int> order_list, std::initializer_list<int> substep_list,
+             int above = 0) {
+    for (int o : order_list)
+      for (int st : substep_list)
+        if (o > above) {
+          orders.push_back(o);
+          substeps.push_back(st);
+          max_errors.push_back(0.0);
+        }
+  }
+  /// Scores every candidate on d (time points placed by `rule`; f prediction steps over horizon).
+  void Score(const occupancy::Map* map, const TimeBasis& basis, TimeRule rule, double horizon,
+             int f, const TrajectoryDistribution& d) {
+    const double converged =
+        CostWith(map, basis, RuleTimes(TimeRule::kMidpoint, horizon, f * kConvergedPointsPerStep),
+                 kConvergedOrder, d);
+    for (std::size_t k = 0; k < max_errors.size(); ++k) {
+      const double e = std::abs(CostWith(map, basis,
+                                         RuleTimes(rule, horizon, f * static_cast<int>(substeps[k])),
+                                         static_cast<int>(orders[k]), d) -
+                                converged);
+      // A non-finite cost or reference disqualifies the candidate.
+      max_errors[k] = std::isfinite(e) ? std::max(max_errors[k], e) : INFINITY;
+    }
+    ++windows;
+  }
+  /// The cheapest candidate (order^2 x substeps map queries per step) within `accuracy`; if none
+  /// is, the cheapest within 10 % of the most accurate one's error (met = false).
+  void Choose(double accuracy) {
+    if (max_errors.empty()) return;
+    const double lowest = *std::min_element(max_errors.begin(), max_errors.end());
+    met = lowest <= accuracy;
+    const double allowed = met ? accuracy : 1.1 * lowest;
+    double best_work = INFINITY;
+    for (std::size_t k = 0; k < max_errors.size(); ++k) {
+      const double work = orders[k] * orders[k] * substeps[k];
+      if (max_errors[k] <= allowed && work < best_work) {
+        chosen = static_cast<int>(k);
+        best_work = work;
+      }
+    }
+  }
+  int order() const { return static_cast<int>(orders[static_cast<std::size_t>(chosen)]); }
+  int substep() const { return static_cast<int>(substeps[static_cast<std::size_t>(chosen)]); }
+  double error() const { return max_errors[static_cast<std::size_t>(chosen)]; }
+  JsonObject Json() const {
     JsonObject o;
-    o.Set("accuracy", accuracy).Set("windows", windows).Set("order", order);
-    o.Set("substeps", substeps).Set("met", met);
-    o.Set("converged_order", kConvergedOrder);
-    o.Set("converged_points_per_step", kConvergedPointsPerStep);
-    o.Set("candidate_orders", orders).Set("candidate_substeps", substeps_tried);
+    o.Set("windows", windows).Set("met", met);
+    if (chosen >= 0) o.Set("order", order()).Set("substeps", substep()).Set("max_abs_error", error());
+    o.Set("candidate_orders", orders).Set("candidate_substeps", substeps);
     o.Set("candidate_max_abs_error", max_errors);
     return o;
   }
 };
 
-/// Chooses Gauss-Hermite order and time points per step on the priors of `choice_windows`
-/// validation windows (evenly spread over the split): the cheapest candidate (order^2 x substeps
-/// map queries per step) whose C is within `accuracy` of the converged C on every window; if none
-/// is, the cheapest within 10 % of the most accurate one's error (met = false). The test split is
-/// never read. `met` speaks of priors only: a projected result sits where the solver pushed it,
-/// often on a wall, where the chosen rule may be far less accurate (quadrature_accuracy_optimised
-/// measures that, and the check operator guards against it).
+/// The quadratures chosen on validation windows (constraint.choose_quadrature, choose_check).
+struct QuadratureChoice {
+  Candidates rule{{2, 3, 4, 5, 6, 8, 10, 12, 16, 20}, {1, 2, 3, 4}};
+  std::optional<Candidates> check;
+  double check_accuracy = 0;
+  JsonObject Json(double accuracy) const {
+    JsonObject o = rule.Json();
+    o.Set("accuracy", accuracy);
+    if (check) o.Set("check_accuracy", check_accuracy);
+    o.Set("converged_order", kConvergedOrder);
+    o.Set("converged_points_per_step", kConvergedPointsPerStep);
+    if (check) o.Set("check", check->Json());
+    return o;
+  }
+};
+
+/// Chooses the Gauss-Hermite order and time points per step on the priors of `choice_windows`
+/// validation windows (evenly spread over the split): the cheapest candidate whose C is within
+/// `accuracy` of the converged C on every window (Candidates::Choose). The test split is never
+/// read. `met` speaks of priors only: a projected result sits where the solver pushed it, often on
+/// a wall, where the chosen rule may be far less accurate. So with `choose_check`, validation
+/// windows (all of them, in a spread-out order) whose prior violates under the chosen rule are
+/// projected with it, up to `choice_windows` of them, and the check operator (midpoints; orders
+/// above the rule's) is chosen the same way on the projected results.
 QuadratureChoice ChooseQuadrature(const ExperimentConfig& c, const ConstrainedData& d,
                                   const span::Predictor& prior, const std::string& run_dir) {
   const std::vector<MapScene>& scenes = d.split.val;
   FitSceneMaps(c, scenes, run_dir);
   const int p = c.windows.observed, f = c.windows.predicted;
   const double horizon = f * d.val.windows.seconds_per_step;
-  static constexpr int kOrders[] = {2, 3, 4, 5, 6, 8, 10, 12, 16, 20};
-  static constexpr int kSubsteps[] = {1, 2, 3, 4};
   QuadratureChoice q;
-  for (int o : kOrders)
-    for (int st : kSubsteps) {
-      q.orders.push_back(o);
-      q.substeps_tried.push_back(st);
-      q.max_errors.push_back(0.0);
-    }
   const int n_val = d.val.windows.size();
-  q.windows = std::min(n_val, c.constraint.choice_windows);
+  const int n = std::min(n_val, c.constraint.choice_windows);
   std::vector<std::unique_ptr<occupancy::Map>> maps(scenes.size());
   span::Predictor::Workspace pws = prior.MakeWorkspace();
-  TrajectoryDistribution dist = prior.MakeDistribution();
-  const Eigen::VectorXd converged_times =
-      RuleTimes(TimeRule::kMidpoint, horizon, f * kConvergedPointsPerStep);
-  for (int i = 0; i < q.windows; ++i) {
-    const int w = static_cast<int>(static_cast<long>(i) * n_val / q.windows);
+  std::vector<TrajectoryDistribution> dists(static_cast<std::size_t>(n), prior.MakeDistribution());
+  std::vector<std::size_t> scene_of(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    const int w = static_cast<int>(static_cast<long>(i) * n_val / n);
+    const auto s = static_cast<std::size_t>(d.val.scene[static_cast<std::size_t>(w)]);
+    if (!maps[s]) maps[s] = occupancy::LoadMap(run_dir + "/" + SceneMapFile(scenes[s]));
+    scene_of[static_cast<std::size_t>(i)] = s;
+    prior.Predict(Rows(d.val.windows.past, w, p), &pws, &dists[static_cast<std::size_t>(i)]);
+    q.rule.Score(maps[s].get(), prior.basis(), c.constraint.time_rule, horizon, f,
+                 dists[static_cast<std::size_t>(i)]);
+  }
+  q.rule.Choose(c.constraint.accuracy);
+  log::Info("constrained: quadrature chosen on ", q.rule.windows, " validation priors: order ",
+            q.rule.order(), ", ", q.rule.substep(), " time points per step (max |C - converged| ",
+            q.rule.error(), q.rule.met ? ", meets " : ", misses ", c.constraint.accuracy, ")");
+  if (!c.constraint.choose_check) return q;
+
+  q.check.emplace(std::initializer_list<int>{8, 10, 12, 16, 20, 24},
+                  std::initializer_list<int>{1, 2, 4}, q.rule.order());
+  const Eigen::VectorXd times = RuleTimes(c.constraint.time_rule, horizon, f * q.rule.substep());
+  const ProjectorOptions po = PlainProjectorOptions(c, q.rule.order());
+  TrajectoryDistribution dist = prior.MakeDistribution(), opt = prior.MakeDistribution();
+  // Every validation window in a spread-out order (a stride coprime to their number), until
+  // `choice_windows` of them needed projecting.
+  long stride = 7919;
+  while (std::gcd(stride, static_cast<long>(n_val)) != 1) stride += 2;
+  for (long i = 0; i < n_val && q.check->windows < c.constraint.choice_windows; ++i) {
+    const int w = static_cast<int>(i * stride % n_val);
     const auto s = static_cast<std::size_t>(d.val.scene[static_cast<std::size_t>(w)]);
     if (!maps[s]) maps[s] = occupancy::LoadMap(run_dir + "/" + SceneMapFile(scenes[s]));
     prior.Predict(Rows(d.val.windows.past, w, p), &pws, &dist);
-    const double converged =
-        CostWith(maps[s].get(), prior.basis(), converged_times, kConvergedOrder, dist);
-    for (std::size_t k = 0; k < q.max_errors.size(); ++k) {
-      const int order = static_cast<int>(q.orders[k]), st = static_cast<int>(q.substeps_tried[k]);
-      const double e =
-          std::abs(CostWith(maps[s].get(), prior.basis(),
-                            RuleTimes(c.constraint.time_rule, horizon, f * st), order, dist) -
-                   converged);
-      // A non-finite cost or reference disqualifies the candidate.
-      q.max_errors[k] = std::isfinite(e) ? std::max(q.max_errors[k], e) : INFINITY;
-    }
+    const DistributionProjector projector(maps[s].get(), prior.basis(), times, po);
+    DistributionProjector::Workspace ws = projector.MakeWorkspace();
+    const TrackProjection tp = projector.Project(dist, &opt, &ws);
+    if (tp.changed) q.check->Score(maps[s].get(), prior.basis(), TimeRule::kMidpoint, horizon, f, opt);
   }
-  const double lowest = *std::min_element(q.max_errors.begin(), q.max_errors.end());
-  q.met = lowest <= c.constraint.accuracy;
-  const double allowed = q.met ? c.constraint.accuracy : 1.1 * lowest;
-  std::size_t best = 0;
-  double best_work = INFINITY;
-  for (std::size_t k = 0; k < q.max_errors.size(); ++k) {
-    const double work = q.orders[k] * q.orders[k] * q.substeps_tried[k];
-    if (q.max_errors[k] <= allowed && work < best_work) {
-      best = k;
-      best_work = work;
-    }
+  if (q.check->windows == 0 || q.check->orders.empty()) {
+    log::Info("constrained: no validation prior needed projecting; the check stays at order ",
+              c.constraint.check_order);
+    q.check.reset();
+    return q;
   }
-  q.order = static_cast<int>(q.orders[best]);
-  q.substeps = static_cast<int>(q.substeps_tried[best]);
-  log::Info("constrained: quadrature chosen on ", q.windows, " validation windows: order ", q.order,
-            ", ", q.substeps, " time points per step (max |C - converged| ", q.max_errors[best],
-            q.met ? ", meets " : ", misses ", c.constraint.accuracy, ")");
+  q.check->Choose(c.constraint.check_accuracy);
+  q.check_accuracy = c.constraint.check_accuracy;
+  log::Info("constrained: check chosen on ", q.check->windows, " projected validation windows: "
+            "order ", q.check->order(), ", ", q.check->substep(), " midpoints per step (max |C - "
+            "converged| ", q.check->error(), q.check->met ? ", meets " : ", misses ",
+            c.constraint.check_accuracy, ")");
   return q;
 }
 
@@ -363,10 +444,12 @@ std::string EvaluateConstrained(const ExperimentConfig& c, const ConstrainedData
   // Gauss-Hermite order and time points: configured, or chosen on validation windows.
   std::optional<QuadratureChoice> choice;
   if (c.constraint.choose_quadrature) choice = ChooseQuadrature(c, d, prior, run_dir);
-  const int order = choice ? choice->order : c.constraint.order;
-  const int substeps = choice ? choice->substeps : c.constraint.substeps;
-  FS_THROW_UNLESS(c.constraint.check_order == 0 || c.constraint.check_order > order,
-                  "constraint.check_order (", c.constraint.check_order,
+  const int order = choice ? choice->rule.order() : c.constraint.order;
+  const int substeps = choice ? choice->rule.substep() : c.constraint.substeps;
+  const bool check_chosen = choice && choice->check;
+  const int check_order = check_chosen ? choice->check->order() : c.constraint.check_order;
+  const int check_substeps = check_chosen ? choice->check->substep() : c.constraint.check_substeps;
+  FS_THROW_UNLESS(check_order == 0 || check_order > order, "constraint.check_order (", check_order,
                   ") must exceed the Gauss-Hermite order it checks (", order,
                   choice ? ", chosen on validation)" : ", constraint.order)");
   // The rectangle rule of C over (0, f dt]: `substeps` points per prediction step where the time
@@ -378,20 +461,12 @@ std::string EvaluateConstrained(const ExperimentConfig& c, const ConstrainedData
   const Eigen::VectorXd converged_times =
       RuleTimes(TimeRule::kMidpoint, horizon, f * kConvergedPointsPerStep);
   const Eigen::VectorXd steps = RuleTimes(TimeRule::kRight, horizon, f);  // for pictures
-  ProjectorOptions po;
-  po.epsilon = c.constraint.epsilon;
-  po.margin = c.constraint.margin;
-  po.order = order;
-  po.solver.max_evaluations = c.constraint.max_evaluations;
-  po.solver.max_seconds = c.constraint.max_seconds;
-  po.solver.restarts = c.constraint.restarts;
-  // The solver accepts C within its tolerance of its target; the target sits `margin` below
-  // epsilon, so a tolerance below the margin keeps accepted points compliant.
-  po.solver.tolerance = std::min(po.solver.tolerance, 0.5 * c.constraint.margin);
-  po.check_order = c.constraint.check_order;
+  ProjectorOptions po = PlainProjectorOptions(c, order);
+  po.check_order = check_order;
   po.check_rounds = c.constraint.check_rounds;
-  const Eigen::VectorXd check_times =
-      RuleTimes(TimeRule::kMidpoint, horizon, f * c.constraint.check_substeps);
+  // A chosen check accepts C <= epsilon - its validated error (capped below the margin).
+  if (check_chosen) po.check_slack = std::min(choice->check->error(), 0.5 * c.constraint.margin);
+  const Eigen::VectorXd check_times = RuleTimes(TimeRule::kMidpoint, horizon, f * check_substeps);
   constexpr int kReferenceOrder = 20;
   ProjectorOptions po_plain = po;  // the configured operator alone (no check)
   po_plain.check_order = 0;
@@ -584,10 +659,11 @@ std::string EvaluateConstrained(const ExperimentConfig& c, const ConstrainedData
   solve.Set("time_points", k).Set("substeps", substeps);
   solve.Set("time_rule", c.constraint.time_rule == TimeRule::kMidpoint ? "midpoint" : "right");
   solve.Set("statuses", status).Set("failures", failures);
-  solve.Set("check_order", c.constraint.check_order);
-  if (c.constraint.check_order > 0) {
+  solve.Set("check_order", check_order);
+  if (check_order > 0) {
+    solve.Set("check_substeps", check_substeps);
     solve.Set("check_time_points", static_cast<int>(check_times.size()));
-    solve.Set("check_rounds", c.constraint.check_rounds);
+    solve.Set("check_rounds", c.constraint.check_rounds).Set("check_slack", po.check_slack);
     solve.Set("windows_solved_again_after_check", check_resolved);
   }
   solve.Set("projected", static_cast<int>(solve_s.size()));
