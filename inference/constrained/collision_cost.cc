@@ -7,6 +7,10 @@
 
 namespace foresight::constrained {
 
+namespace {
+constexpr double kMinWeight = 1e-12;
+}  // namespace
+
 Eigen::VectorXd RuleTimes(TimeRule rule, double horizon, int k) {
   FS_THROW_UNLESS(k >= 1, "RuleTimes: need >= 1 time point, got ", k);
   FS_THROW_UNLESS(std::isfinite(horizon) && horizon > 0, "RuleTimes: horizon must be > 0, got ",
@@ -31,7 +35,9 @@ CollisionCost::CollisionCost(const occupancy::Map* map, const TimeBasis& basis,
                   "CollisionCost: order (Gauss-Hermite points per axis) must be in [1, 64], got ",
                   order_);
   phi_ = basis_.Design(times_);
-  rule_ = StandardNormalRule(order_);
+  // Points of weight below 1e-12 dropped: C (an expectation of p in [0, 1]) changes by at most
+  // order^2 1e-12 (4e-10 at order 20), while order 20 evaluates ~2x fewer points.
+  rule_ = PrunedRule(StandardNormalRule(order_), kMinWeight);
 }
 
 CollisionCost::Workspace CollisionCost::MakeWorkspace() const {

@@ -125,8 +125,8 @@ class DistributionProjector {
   /// result.cost and result.feasible are judged by the configured operator.
   TrackProjection ProjectOnce(const TrajectoryDistribution& prior, TrajectoryDistribution* out,
                               Workspace* ws, const CollisionCost& op,
-                              CollisionCost::Workspace* op_ws, double mixture_limit,
-                              double target, const TrajectoryDistribution* start = nullptr) const;
+                              CollisionCost::Workspace* op_ws, double mixture_limit, double target,
+                              const TrajectoryDistribution* start = nullptr) const;
   /// Mixture C of d under the check operator (NaN if it throws or d holds NaN).
   double CheckCost(const TrajectoryDistribution& d, Workspace* ws) const;
 

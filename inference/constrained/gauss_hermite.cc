@@ -81,4 +81,21 @@ StandardNormalRule2 StandardNormalRule(int order) {
   return rule;
 }
 
+StandardNormalRule2 PrunedRule(const StandardNormalRule2& rule, double min_weight) {
+  FS_THROW_UNLESS(std::isfinite(min_weight) && min_weight >= 0 && min_weight < 1,
+                  "PrunedRule: min_weight must be in [0, 1), got ", min_weight);
+  int kept = 0;
+  for (int q = 0; q < rule.size(); ++q) kept += rule.weights[q] >= min_weight;
+  StandardNormalRule2 out;
+  out.points.resize(2, kept);
+  out.weights.resize(kept);
+  int k = 0;
+  for (int q = 0; q < rule.size(); ++q) {
+    if (rule.weights[q] < min_weight) continue;
+    out.points.col(k) = rule.points.col(q);
+    out.weights[k++] = rule.weights[q];
+  }
+  return out;
+}
+
 }  // namespace foresight::constrained

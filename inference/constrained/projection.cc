@@ -209,8 +209,7 @@ ProjectionSummary ProjectComponent(const ComponentParams& prior, const Constrain
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };
   const ComponentParams prior_copy = prior;  // `out` may alias `prior` (or `start`)
-  const bool warm = &warm_start != &prior && AllFinite(warm_start) &&
-                    warm_start.chol_v(0, 0) > 0 &&
+  const bool warm = &warm_start != &prior && AllFinite(warm_start) && warm_start.chol_v(0, 0) > 0 &&
                     warm_start.chol_v(1, 1) > 0 && warm_start.mean.rows() == prior.mean.rows() &&
                     warm_start.mean.cols() == 2 && warm_start.log_u.size() == prior.log_u.size();
   const ComponentParams start_copy = warm ? warm_start : ComponentParams{};

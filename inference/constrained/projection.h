@@ -55,9 +55,10 @@ struct ProjectionSummary {
 /// throws for solver or numeric failures.
 ProjectionSummary ProjectComponent(const ComponentParams& prior, const ConstraintFunction& cost,
                                    const ProjectionOptions& options, ComponentParams* out);
-/// The same from a warm start `warm_start` (e.g. the solution under a cruder constraint): SLSQP starts
-/// there, and the result is never worse than it (it is a candidate like any point visited). The
-/// KL is still measured from `prior`; a non-finite or invalid start is ignored (the prior is used).
+/// The same from a warm start `warm_start` (e.g. the solution under a cruder constraint): SLSQP
+/// starts there, and the result is never worse than it (it is a candidate like any point visited).
+/// The KL is still measured from `prior`; a non-finite or invalid start is ignored (the prior is
+/// used).
 ProjectionSummary ProjectComponent(const ComponentParams& prior, const ConstraintFunction& cost,
                                    const ProjectionOptions& options, ComponentParams* out,
                                    const ComponentParams& warm_start);

@@ -133,6 +133,31 @@ TEST(GaussHermite, StandardNormalRuleMoments) {
   }
 }
 
+// Dropping the points of weight below 1e-12: few at low orders, most at high ones; the dropped
+// mass stays below n^2 1e-12 and the moments of the kept points are those of N(0, I) to that.
+TEST(GaussHermite, PrunedRuleDropsOnlyNegligibleWeights) {
+  int kept20 = 0;
+  for (int order : {4, 8, 12, 16, 20, 24, 32}) {
+    SCOPED_TRACE(order);
+    const StandardNormalRule2 full = StandardNormalRule(order);
+    const StandardNormalRule2 r = PrunedRule(full, 1e-12);
+    ASSERT_EQ(r.points.cols(), r.size());
+    EXPECT_LE(r.size(), full.size());
+    EXPECT_TRUE((r.weights.array() >= 1e-12).all());
+    const double dropped = 1.0 - r.weights.sum();
+    EXPECT_GE(dropped, -1e-14);
+    EXPECT_LE(dropped, order * order * 1e-12);
+    const Eigen::Matrix2d cov = r.points * r.weights.asDiagonal() * r.points.transpose();
+    EXPECT_TRUE(testing::MatricesNear(cov, Eigen::Matrix2d::Identity(), 1e-9));
+    if (order == 20) kept20 = r.size();
+  }
+  EXPECT_LT(kept20, 300);  // most of the 400 corner weights are below 1e-12
+  EXPECT_EQ(PrunedRule(StandardNormalRule(6), 0.0).size(), 36);
+  for (double bad : {-1e-3, 1.0, std::nan("")})
+    testing::ExpectErrorContains([bad] { PrunedRule(StandardNormalRule(4), bad); },
+                                 {"PrunedRule", "min_weight"});
+}
+
 TEST(GaussHermite, BadOrdersAreErrors) {
   for (int n : {0, -1, 65}) {
     testing::ExpectErrorContains([n] { GaussHermite(n); },

@@ -22,9 +22,10 @@ void ExperimentConfig::Validate(const std::string& source) const {
   FS_THROW_UNLESS(constraint.margin < constraint.epsilon, source, ": constraint.margin (",
                   constraint.margin, ") must be below constraint.epsilon (", constraint.epsilon,
                   ")");
-  FS_THROW_UNLESS(!constraint.choose_check || constraint.choose_quadrature, source,
-                  ": constraint.choose_check needs constraint.choose_quadrature (the check is chosen "
-                  "on windows projected with the chosen rule)");
+  FS_THROW_UNLESS(
+      !constraint.choose_check || constraint.choose_quadrature, source,
+      ": constraint.choose_check needs constraint.choose_quadrature (the check is chosen "
+      "on windows projected with the chosen rule)");
   CheckLayerWidths(network.hidden, source, "network.hidden");
   CheckLayerWidths(naive.hidden, source, "naive.hidden");
 }

@@ -96,13 +96,13 @@ struct ConstraintConfig {
   bool choose_quadrature = false;
   double accuracy = 1e-3;
   int choice_windows = 40;
-  int check_order = 0;     ///< verify every result with this Gauss-Hermite order (0: no check)
+  int check_order = 0;  ///< verify every result with this Gauss-Hermite order (0: no check)
   /// With choose_quadrature: choose check_order and check_substeps on projected validation
   /// windows the same way (within `accuracy` of the converged C).
   bool choose_check = false;
   double check_accuracy = 1e-3;  ///< the chosen check's largest error on the projected windows
-  int check_substeps = 4;  ///< midpoints per prediction step of the check operator
-  int check_rounds = 3;    ///< repeated solves with a lowered target when the check fails
+  int check_substeps = 4;        ///< midpoints per prediction step of the check operator
+  int check_rounds = 3;          ///< repeated solves with a lowered target when the check fails
   int restarts = 2;  ///< SLSQP restarts from the lowest-cost point when no feasible one was found
   int max_evaluations = 300;  ///< SLSQP objective evaluations per component
   double max_seconds = 1.0;   ///< wall-time limit per component (s)

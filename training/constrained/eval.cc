@@ -294,10 +294,10 @@ struct Candidates {
         CostWith(map, basis, RuleTimes(TimeRule::kMidpoint, horizon, f * kConvergedPointsPerStep),
                  kConvergedOrder, d);
     for (std::size_t k = 0; k < max_errors.size(); ++k) {
-      const double e = std::abs(CostWith(map, basis,
-                                         RuleTimes(rule, horizon, f * static_cast<int>(substeps[k])),
-                                         static_cast<int>(orders[k]), d) -
-                                converged);
+      const double e =
+          std::abs(CostWith(map, basis, RuleTimes(rule, horizon, f * static_cast<int>(substeps[k])),
+                            static_cast<int>(orders[k]), d) -
+                   converged);
       // A non-finite cost or reference disqualifies the candidate.
       max_errors[k] = std::isfinite(e) ? std::max(max_errors[k], e) : INFINITY;
     }
@@ -325,7 +325,8 @@ struct Candidates {
   JsonObject Json() const {
     JsonObject o;
     o.Set("windows", windows).Set("met", met);
-    if (chosen >= 0) o.Set("order", order()).Set("substeps", substep()).Set("max_abs_error", error());
+    if (chosen >= 0)
+      o.Set("order", order()).Set("substeps", substep()).Set("max_abs_error", error());
     o.Set("candidate_orders", orders).Set("candidate_substeps", substeps);
     o.Set("candidate_max_abs_error", max_errors);
     return o;
@@ -401,7 +402,8 @@ QuadratureChoice ChooseQuadrature(const ExperimentConfig& c, const ConstrainedDa
     const DistributionProjector projector(maps[s].get(), prior.basis(), times, po);
     DistributionProjector::Workspace ws = projector.MakeWorkspace();
     const TrackProjection tp = projector.Project(dist, &opt, &ws);
-    if (tp.changed) q.check->Score(maps[s].get(), prior.basis(), TimeRule::kMidpoint, horizon, f, opt);
+    if (tp.changed)
+      q.check->Score(maps[s].get(), prior.basis(), TimeRule::kMidpoint, horizon, f, opt);
   }
   if (q.check->windows == 0 || q.check->orders.empty()) {
     log::Info("constrained: no validation prior needed projecting; the check stays at order ",
@@ -411,10 +413,14 @@ QuadratureChoice ChooseQuadrature(const ExperimentConfig& c, const ConstrainedDa
   }
   q.check->Choose(c.constraint.check_accuracy);
   q.check_accuracy = c.constraint.check_accuracy;
-  log::Info("constrained: check chosen on ", q.check->windows, " projected validation windows: "
-            "order ", q.check->order(), ", ", q.check->substep(), " midpoints per step (max |C - "
-            "converged| ", q.check->error(), q.check->met ? ", meets " : ", misses ",
-            c.constraint.check_accuracy, ")");
+  log::Info("constrained: check chosen on ", q.check->windows,
+            " projected validation windows: "
+            "order ",
+            q.check->order(), ", ", q.check->substep(),
+            " midpoints per step (max |C - "
+            "converged| ",
+            q.check->error(), q.check->met ? ", meets " : ", misses ", c.constraint.check_accuracy,
+            ")");
   return q;
 }
 
