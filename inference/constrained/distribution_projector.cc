@@ -191,7 +191,13 @@ TrackProjection DistributionProjector::Project(const TrajectoryDistribution& pri
   TrackProjection result = ProjectOnce(from, out, ws, cost_, &ws->cost, options_.epsilon, target0);
   bool changed = result.changed;
   int evaluations = result.evaluations;
-  double target = target0;
+  // The repeated solves, each warm-started at the last solution: first (when the configured
+  // operator did solve) the configured operator again with its target lowered by the excess the
+  // check found, which is cheap and mends a small gap; then the check operator itself, and then
+  // the check operator with its target lowered by the excess it left.
+  double configured_target = target0, check_target = target0;
+  int check_solves = 0;
+  bool on_check = !result.changed;  // a prior the configured rule passed: straight to the check
   for (int round = 0;; ++round) {
     result.checked_cost = CheckCost(*out, ws);
     result.check_rounds = round;
@@ -210,14 +216,28 @@ TrackProjection DistributionProjector::Project(const TrajectoryDistribution& pri
     }
     result.feasible = false;
     result.status = "infeasible";
-    // A solve against the check operator itself found no compliant point: a lower target will not.
-    if (round == options_.check_rounds || (round > 0 && !AllSolved(result))) break;
-    // Solve again from the prior against the check operator (every component it finds above the
-    // target); after a first such round, with the target lowered by the excess it left.
-    if (round > 0) target -= result.checked_cost - target0;
-    if (!(target > 0)) break;
-    const TrajectoryDistribution previous = *out;  // the warm start: the last solution
-    result = ProjectOnce(from, out, ws, *check_, &ws->check, -HUGE_VAL, target, &previous);
+    if (round == options_.check_rounds) break;
+    const double excess = result.checked_cost - target0;
+    const TrajectoryDistribution previous = *out;
+    if (!on_check) {
+      on_check = true;
+      configured_target -= excess;
+      if (configured_target > 0) {
+        result =
+            ProjectOnce(from, out, ws, cost_, &ws->cost, -HUGE_VAL, configured_target, &previous);
+        changed = true;
+        evaluations += result.evaluations;
+        continue;
+      }
+    } else if (check_solves > 0) {
+      // A solve against the check operator itself found no compliant point: a lower target will
+      // not; else lower its target by the excess it left.
+      if (!AllSolved(result)) break;
+      check_target -= excess;
+      if (!(check_target > 0)) break;
+    }
+    result = ProjectOnce(from, out, ws, *check_, &ws->check, -HUGE_VAL, check_target, &previous);
+    ++check_solves;
     changed = true;
     evaluations += result.evaluations;
   }

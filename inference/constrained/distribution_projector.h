@@ -45,11 +45,13 @@ struct ProjectorOptions {
   /// Verification by a second, more accurate operator (0: off): Gauss-Hermite order `check_order`
   /// on the constructor's `check_times`. The solver drives the configured operator down and so
   /// seeks out its quadrature error (mass between the nodes); when the check operator finds the
-  /// result above epsilon, the solve is repeated from the prior against the check operator itself
-  /// (every component it finds above epsilon - margin), and after that with the target lowered by
-  /// the excess the last solve left (C_check - (epsilon - margin)): at most `check_rounds` repeated
-  /// solves, stopping early once a solve against the check operator ends without a compliant
-  /// point. The check operator's verdict is the result's (`feasible`, `status`).
+  /// result above epsilon, the solve is repeated, warm-started at the last solution: when the
+  /// configured operator had solved, first with it again and its target lowered by the excess
+  /// (C_check - (epsilon - margin)), cheap and enough for a small gap; then against the check
+  /// operator itself (every component it finds above epsilon - margin); then against it with the
+  /// target lowered by the excess it left: at most `check_rounds` repeated solves, stopping early
+  /// once a solve against the check operator ends without a compliant point. The check operator's
+  /// verdict is the result's (`feasible`, `status`).
   int check_order = 0;
   int check_rounds = 3;
   /// The check accepts C_check <= epsilon - check_slack (the check operator's own error bound, so
