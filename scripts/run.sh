@@ -46,6 +46,7 @@ rm -rf runs/otnet_quickstart
 ./build/bin/foresight bench runs/otnet_quickstart
 # Structurally constrained prediction (thesis ch 7): synthetic scenes with maps; the mixture prior,
 # KTM, constant velocity and the naive network, and the prior projected onto the collision chance
-# constraint (runs/constrained_quickstart/eval.json, tracks.csv, plots/window_*.png; about 15 s).
+# constraint, quadratures chosen on validation windows and every result checked
+# (runs/constrained_quickstart/eval.json, tracks.csv, plots/window_*.png; about 1.5 min).
 rm -rf runs/constrained_quickstart
 ./build/bin/foresight train configs/constrained/synthetic.yaml --run-dir runs/constrained_quickstart
