@@ -97,7 +97,7 @@ DistributionProjector::DistributionProjector(const occupancy::Map* map, const Ti
   FS_THROW_UNLESS(options_.check_rounds >= 0,
                   "DistributionProjector: check_rounds must be >= 0, got ", options_.check_rounds);
   FS_THROW_UNLESS(std::isfinite(options_.check_slack) && options_.check_slack >= 0 &&
-                      options_.check_slack < options_.margin,
+                      (options_.check_slack == 0 || options_.check_slack < options_.margin),
                   "DistributionProjector: check_slack must be in [0, margin = ", options_.margin,
                   "), got ", options_.check_slack);
   check_.emplace(map, basis, std::move(check_times), options_.check_order);
@@ -189,16 +189,20 @@ TrackProjection DistributionProjector::Project(const TrajectoryDistribution& pri
   if (out == &prior) prior_copy = prior;
   const TrajectoryDistribution& from = prior_copy ? *prior_copy : prior;
   TrackProjection result = ProjectOnce(from, out, ws, cost_, &ws->cost, options_.epsilon, target0);
+  const double prior_cost = result.prior_cost;  // the configured operator's, kept throughout
   bool changed = result.changed;
   int evaluations = result.evaluations;
   // The repeated solves, each warm-started at the last solution: first (when the configured
-  // operator did solve) the configured operator again with its target lowered by the excess the
-  // check found, which is cheap and mends a small gap; then the check operator itself, and then
-  // the check operator with its target lowered by the excess it left.
+  // operator did solve every component) the configured operator again with its target lowered by
+  // the excess the check found, which is cheap and mends a small gap; then the check operator
+  // itself, and then the check operator with its target lowered by the excess it left.
   double configured_target = target0, check_target = target0;
   int check_solves = 0;
-  bool on_check = !result.changed;  // a prior the configured rule passed: straight to the check
+  // A prior the configured rule passed, or a configured solve that ended infeasible: straight to
+  // the check operator.
+  bool on_check = !result.changed || !AllSolved(result);
   for (int round = 0;; ++round) {
+    result.prior_cost = prior_cost;
     result.checked_cost = CheckCost(*out, ws);
     result.check_rounds = round;
     result.evaluations = evaluations;
@@ -219,14 +223,29 @@ TrackProjection DistributionProjector::Project(const TrajectoryDistribution& pri
     if (round == options_.check_rounds) break;
     const double excess = result.checked_cost - target0;
     const TrajectoryDistribution previous = *out;
+    const TrackProjection last = result;
+    // A repeated solve that fails outright keeps the last result (infeasible by the check).
+    const auto solve_again = [&](const CollisionCost& op, CollisionCost::Workspace* op_ws,
+                                 double target) {
+      TrackProjection next = ProjectOnce(from, out, ws, op, op_ws, -HUGE_VAL, target, &previous);
+      evaluations += next.evaluations;
+      if (next.status == "failed") {
+        *out = previous;
+        return false;
+      }
+      result = next;
+      changed = true;
+      return true;
+    };
     if (!on_check) {
       on_check = true;
       configured_target -= excess;
       if (configured_target > 0) {
-        result =
-            ProjectOnce(from, out, ws, cost_, &ws->cost, -HUGE_VAL, configured_target, &previous);
-        changed = true;
-        evaluations += result.evaluations;
+        if (!solve_again(cost_, &ws->cost, configured_target)) {
+          result = last;
+          result.evaluations = evaluations;
+          break;
+        }
         continue;
       }
     } else if (check_solves > 0) {
@@ -236,10 +255,12 @@ TrackProjection DistributionProjector::Project(const TrajectoryDistribution& pri
       check_target -= excess;
       if (!(check_target > 0)) break;
     }
-    result = ProjectOnce(from, out, ws, *check_, &ws->check, -HUGE_VAL, check_target, &previous);
     ++check_solves;
-    changed = true;
-    evaluations += result.evaluations;
+    if (!solve_again(*check_, &ws->check, check_target)) {
+      result = last;
+      result.evaluations = evaluations;
+      break;
+    }
   }
   result.seconds = seconds();
   return result;

@@ -45,17 +45,18 @@ struct ProjectorOptions {
   /// Verification by a second, more accurate operator (0: off): Gauss-Hermite order `check_order`
   /// on the constructor's `check_times`. The solver drives the configured operator down and so
   /// seeks out its quadrature error (mass between the nodes); when the check operator finds the
-  /// result above epsilon, the solve is repeated, warm-started at the last solution: when the
-  /// configured operator had solved, first with it again and its target lowered by the excess
-  /// (C_check - (epsilon - margin)), cheap and enough for a small gap; then against the check
-  /// operator itself (every component it finds above epsilon - margin); then against it with the
-  /// target lowered by the excess it left: at most `check_rounds` repeated solves, stopping early
-  /// once a solve against the check operator ends without a compliant point. The check operator's
+  /// result above epsilon - check_slack, the solve is repeated, warm-started at the last solution:
+  /// when the configured operator had solved every component, first with it again and its target
+  /// lowered by the excess (C_check - (epsilon - margin)), cheap and enough for a small gap; then
+  /// against the check operator itself (every component it finds above epsilon - margin); then
+  /// against it with the target lowered by the excess it left: at most `check_rounds` repeated
+  /// solves, stopping early once a solve against the check operator ends without a compliant point
+  /// (a repeated solve that fails outright keeps the last result, infeasible). The check operator's
   /// verdict is the result's (`feasible`, `status`).
   int check_order = 0;
   int check_rounds = 3;
   /// The check accepts C_check <= epsilon - check_slack (the check operator's own error bound, so
-  /// that the true C meets epsilon); in [0, margin).
+  /// that the true C meets epsilon); 0, or in (0, margin).
   double check_slack = 0;
 };
 
@@ -64,11 +65,13 @@ struct TrackProjection {
   bool changed = false;   ///< false: the prior's mixture C already met epsilon (returned unchanged)
   bool feasible = false;  ///< mixture C of the result <= epsilon (with a check: the checked C)
   double prior_cost = 0, cost = 0;  ///< mixture C before / after (the configured operator)
-  double checked_cost = NAN;        ///< C of the result under the check operator (NaN: no check)
-  int check_rounds = 0;             ///< repeated solves the check asked for
-  double kl = 0;                    ///< sum_r alpha_r KL_r
-  double seconds = 0;               ///< wall time of Project (steady_clock)
-  int evaluations = 0;              ///< objective evaluations over components
+  // `components`, `kl` and `evaluations` (summed over every solve) describe the last solve, which
+  // may have been against the check operator.
+  double checked_cost = NAN;  ///< C of the result under the check operator (NaN: no check)
+  int check_rounds = 0;       ///< repeated solves the check asked for
+  double kl = 0;              ///< sum_r alpha_r KL_r
+  double seconds = 0;         ///< wall time of Project (steady_clock)
+  int evaluations = 0;        ///< objective evaluations over components
   /// Per component: kAlreadyFeasible when C_r <= epsilon - margin or when the mixture already met
   /// epsilon (nothing projected), else the solver's outcome.
   std::vector<ProjectionSummary> components;

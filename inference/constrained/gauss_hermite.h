@@ -26,7 +26,7 @@ struct StandardNormalRule2 {
 StandardNormalRule2 StandardNormalRule(int order);
 
 /// `rule` without the points whose weight is below `min_weight` (the tensor product's corners:
-/// at order 20 most of its 400 weights are below 1e-12). The dropped mass, at most n^2
+/// at 1e-12, none below order 11 and 124 of 400 at order 20). The dropped mass, at most n^2
 /// min_weight, bounds the change of any expectation of a function in [0, 1] (such as an occupancy
 /// probability); the weights are not renormalised. min_weight in [0, 1); Error otherwise.
 StandardNormalRule2 PrunedRule(const StandardNormalRule2& rule, double min_weight);

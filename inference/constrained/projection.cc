@@ -298,7 +298,9 @@ ProjectionSummary ProjectComponent(const ComponentParams& prior, const Constrain
     lower[i] = prior_theta[i] - kLogRange;
     upper[i] = prior_theta[i] + kLogRange;
   }
-  theta = theta.cwiseMax(lower).cwiseMin(upper);  // a warm start lies inside; the prior does
+  // The prior lies inside its bounds; a warm start from an earlier solve under the same bounds too,
+  // up to round-off.
+  theta = theta.cwiseMax(lower).cwiseMin(upper);
   nlopt_result r = nlopt_set_lower_bounds(opt.get(), lower.data());
   if (r > 0) r = nlopt_set_upper_bounds(opt.get(), upper.data());
   if (r > 0) r = nlopt_set_min_objective(opt.get(), Objective, &pb);

@@ -58,7 +58,8 @@ ProjectionSummary ProjectComponent(const ComponentParams& prior, const Constrain
 /// The same from a warm start `warm_start` (e.g. the solution under a cruder constraint): SLSQP
 /// starts there, and the result is never worse than it (it is a candidate like any point visited).
 /// The KL is still measured from `prior`; a non-finite or invalid start is ignored (the prior is
-/// used).
+/// used). As without a start, a callback that fails (throws, non-finite) returns the prior with
+/// kFailed.
 ProjectionSummary ProjectComponent(const ComponentParams& prior, const ConstraintFunction& cost,
                                    const ProjectionOptions& options, ComponentParams* out,
                                    const ComponentParams& warm_start);

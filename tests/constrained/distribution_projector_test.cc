@@ -445,6 +445,7 @@ TEST(DistributionProjector, CheckRejectsAPriorTheCrudeRuleCallsCompliant) {
     EXPECT_LE(r.checked_cost, options.epsilon);
     EXPECT_NEAR(r.checked_cost, accurate.Cost(*out, &aws), 1e-12);
     EXPECT_NEAR(r.cost, plain.Cost(*out, &pws), 1e-12);  // `cost` stays the configured operator's
+    EXPECT_NEAR(r.prior_cost, plain.Cost(prior, &pws), 1e-12);  // and so does `prior_cost`
   }
 }
 

@@ -98,7 +98,7 @@ struct ConstraintConfig {
   int choice_windows = 40;
   int check_order = 0;  ///< verify every result with this Gauss-Hermite order (0: no check)
   /// With choose_quadrature: choose check_order and check_substeps on projected validation
-  /// windows the same way (within `accuracy` of the converged C).
+  /// windows the same way (within `check_accuracy` of the converged C).
   bool choose_check = false;
   double check_accuracy = 1e-3;  ///< the chosen check's largest error on the projected windows
   int check_substeps = 4;        ///< midpoints per prediction step of the check operator
@@ -128,8 +128,8 @@ struct ConstraintConfig {
     a->Visit("choice_windows", &choice_windows, Range::Closed(1, 100000),
              "validation windows (evenly spread) the quadrature choice is made on");
     a->Visit("check_order", &check_order, Range::Closed(0, 64),
-             "verify each result with this Gauss-Hermite order; above epsilon, solve again with "
-             "the target lowered by the excess (0: no check)");
+             "verify each result with this Gauss-Hermite order; a result it finds above epsilon "
+             "is solved again (docs/constrained.md, the check operator; 0: no check)");
     a->Visit("choose_check", &choose_check, Range::Any(),
              "with choose_quadrature: choose check_order and check_substeps on the projected "
              "validation windows (overrides both)");

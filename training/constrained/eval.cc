@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -368,16 +369,13 @@ QuadratureChoice ChooseQuadrature(const ExperimentConfig& c, const ConstrainedDa
   const int n = std::min(n_val, c.constraint.choice_windows);
   std::vector<std::unique_ptr<occupancy::Map>> maps(scenes.size());
   span::Predictor::Workspace pws = prior.MakeWorkspace();
-  std::vector<TrajectoryDistribution> dists(static_cast<std::size_t>(n), prior.MakeDistribution());
-  std::vector<std::size_t> scene_of(static_cast<std::size_t>(n));
+  TrajectoryDistribution dist = prior.MakeDistribution(), opt = prior.MakeDistribution();
   for (int i = 0; i < n; ++i) {
-    const int w = static_cast<int>(static_cast<long>(i) * n_val / n);
+    const int w = static_cast<int>(static_cast<std::int64_t>(i) * n_val / n);
     const auto s = static_cast<std::size_t>(d.val.scene[static_cast<std::size_t>(w)]);
     if (!maps[s]) maps[s] = occupancy::LoadMap(run_dir + "/" + SceneMapFile(scenes[s]));
-    scene_of[static_cast<std::size_t>(i)] = s;
-    prior.Predict(Rows(d.val.windows.past, w, p), &pws, &dists[static_cast<std::size_t>(i)]);
-    q.rule.Score(maps[s].get(), prior.basis(), c.constraint.time_rule, horizon, f,
-                 dists[static_cast<std::size_t>(i)]);
+    prior.Predict(Rows(d.val.windows.past, w, p), &pws, &dist);
+    q.rule.Score(maps[s].get(), prior.basis(), c.constraint.time_rule, horizon, f, dist);
   }
   q.rule.Choose(c.constraint.accuracy);
   log::Info("constrained: quadrature chosen on ", q.rule.windows, " validation priors: order ",
@@ -389,12 +387,11 @@ QuadratureChoice ChooseQuadrature(const ExperimentConfig& c, const ConstrainedDa
                   std::initializer_list<int>{1, 2, 4}, q.rule.order());
   const Eigen::VectorXd times = RuleTimes(c.constraint.time_rule, horizon, f * q.rule.substep());
   const ProjectorOptions po = PlainProjectorOptions(c, q.rule.order());
-  TrajectoryDistribution dist = prior.MakeDistribution(), opt = prior.MakeDistribution();
   // Every validation window in a spread-out order (a stride coprime to their number), until
   // `choice_windows` of them needed projecting.
-  long stride = 7919;
-  while (std::gcd(stride, static_cast<long>(n_val)) != 1) stride += 2;
-  for (long i = 0; i < n_val && q.check->windows < c.constraint.choice_windows; ++i) {
+  std::int64_t stride = 7919;
+  while (std::gcd(stride, static_cast<std::int64_t>(n_val)) != 1) stride += 2;
+  for (std::int64_t i = 0; i < n_val && q.check->windows < c.constraint.choice_windows; ++i) {
     const int w = static_cast<int>(i * stride % n_val);
     const auto s = static_cast<std::size_t>(d.val.scene[static_cast<std::size_t>(w)]);
     if (!maps[s]) maps[s] = occupancy::LoadMap(run_dir + "/" + SceneMapFile(scenes[s]));
@@ -453,7 +450,14 @@ std::string EvaluateConstrained(const ExperimentConfig& c, const ConstrainedData
   const int order = choice ? choice->rule.order() : c.constraint.order;
   const int substeps = choice ? choice->rule.substep() : c.constraint.substeps;
   const bool check_chosen = choice && choice->check;
-  const int check_order = check_chosen ? choice->check->order() : c.constraint.check_order;
+  int check_order = check_chosen ? choice->check->order() : c.constraint.check_order;
+  if (choice && !check_chosen && check_order > 0 && check_order <= order) {
+    // No validation window needed projecting, and the configured check is no finer than the rule
+    // chosen: a check a few orders above it instead.
+    check_order = std::min(64, order + 4);
+    log::Info("constrained: constraint.check_order ", c.constraint.check_order,
+              " does not exceed the chosen order ", order, "; checking at order ", check_order);
+  }
   const int check_substeps = check_chosen ? choice->check->substep() : c.constraint.check_substeps;
   FS_THROW_UNLESS(check_order == 0 || check_order > order, "constraint.check_order (", check_order,
                   ") must exceed the Gauss-Hermite order it checks (", order,
