@@ -223,7 +223,6 @@ TrackProjection DistributionProjector::Project(const TrajectoryDistribution& pri
     if (round == options_.check_rounds) break;
     const double excess = result.checked_cost - target0;
     const TrajectoryDistribution previous = *out;
-    const TrackProjection last = result;
     // A repeated solve that fails outright keeps the last result (infeasible by the check).
     const auto solve_again = [&](const CollisionCost& op, CollisionCost::Workspace* op_ws,
                                  double target) {
@@ -231,9 +230,10 @@ TrackProjection DistributionProjector::Project(const TrajectoryDistribution& pri
       evaluations += next.evaluations;
       if (next.status == "failed") {
         *out = previous;
+        result.evaluations = evaluations;
         return false;
       }
-      result = next;
+      result = std::move(next);
       changed = true;
       return true;
     };
@@ -241,11 +241,7 @@ TrackProjection DistributionProjector::Project(const TrajectoryDistribution& pri
       on_check = true;
       configured_target -= excess;
       if (configured_target > 0) {
-        if (!solve_again(cost_, &ws->cost, configured_target)) {
-          result = last;
-          result.evaluations = evaluations;
-          break;
-        }
+        if (!solve_again(cost_, &ws->cost, configured_target)) break;
         continue;
       }
     } else if (check_solves > 0) {
@@ -256,11 +252,7 @@ TrackProjection DistributionProjector::Project(const TrajectoryDistribution& pri
       if (!(check_target > 0)) break;
     }
     ++check_solves;
-    if (!solve_again(*check_, &ws->check, check_target)) {
-      result = last;
-      result.evaluations = evaluations;
-      break;
-    }
+    if (!solve_again(*check_, &ws->check, check_target)) break;
   }
   result.seconds = seconds();
   return result;

@@ -114,6 +114,18 @@ void ExpectSameDistribution(const TrajectoryDistribution& x, const TrajectoryDis
   }
 }
 
+/// Projects a copy of `prior` with `projector` (a workspace of its own).
+struct Projected {
+  TrackProjection result;
+  TrajectoryDistribution out;
+};
+Projected ProjectCopy(const DistributionProjector& projector, const TrajectoryDistribution& prior) {
+  auto ws = projector.MakeWorkspace();
+  Projected p{TrackProjection{}, prior};
+  p.result = projector.Project(prior, &p.out, &ws);
+  return p;
+}
+
 // ---------------------------------------------------------------- CollisionCost offset
 
 TEST(CollisionCostOffset, EqualsShiftingTheMap) {
@@ -341,47 +353,37 @@ TEST(DistributionProjector, CheckOperatorCatchesTheErrorTheSolverExploits) {
   options.order = 1;
   options.margin = 0.002;
   options.solver.max_seconds = 0;  // deterministic: evaluations only
-  const CollisionCost accurate(&map, Basis(), Times(), 20);
-  CollisionCost::Workspace aws = accurate.MakeWorkspace();
-  auto accurate_cost = [&](const TrajectoryDistribution& d) {
-    aws.offset.resize(2, Times().size());
-    for (Eigen::Index k = 0; k < Times().size(); ++k)
-      aws.offset.col(k) = d.origin() + Times()[k] * d.velocity();
-    double c = 0;
-    for (int r = 0; r < d.components(); ++r)
-      c += d.alpha(r) * accurate.Component(ToComponentParams(d, r), &aws, nullptr);
-    return c;
-  };
+  ProjectorOptions accurate_options;
+  accurate_options.order = 20;
+  const DistributionProjector accurate(&map, Basis(), Times(), accurate_options);
+  auto aws = accurate.MakeWorkspace();
   const TrajectoryDistribution prior = TwoComponents(1.0);
 
-  const DistributionProjector plain(&map, Basis(), Times(), options);
-  auto pws = plain.MakeWorkspace();
-  TrajectoryDistribution plain_out = prior;
-  const TrackProjection p = plain.Project(prior, &plain_out, &pws);
+  const Projected plain =
+      ProjectCopy(DistributionProjector(&map, Basis(), Times(), options), prior);
+  const TrackProjection& p = plain.result;
   ASSERT_TRUE(p.feasible) << p.status;
   EXPECT_TRUE(std::isnan(p.checked_cost));
-  ASSERT_GT(accurate_cost(plain_out), options.epsilon) << "the case must exploit the crude rule";
+  ASSERT_GT(accurate.Cost(plain.out, &aws), options.epsilon)
+      << "the case must exploit the crude rule";
 
   options.check_order = 20;
-  const DistributionProjector checked(&map, Basis(), Times(), options, Times());
-  auto cws = checked.MakeWorkspace();
-  TrajectoryDistribution out = prior;
-  const TrackProjection r = checked.Project(prior, &out, &cws);
+  const Projected checked =
+      ProjectCopy(DistributionProjector(&map, Basis(), Times(), options, Times()), prior);
+  const TrackProjection& r = checked.result;
   ASSERT_TRUE(r.feasible) << r.status << " checked C " << r.checked_cost;
   EXPECT_EQ(r.status, "solved");
   EXPECT_GE(r.check_rounds, 1);
   EXPECT_LE(r.cost, options.epsilon);
   EXPECT_LE(r.checked_cost, options.epsilon);
-  EXPECT_NEAR(r.checked_cost, accurate_cost(out), 1e-12);
+  EXPECT_NEAR(r.checked_cost, accurate.Cost(checked.out, &aws), 1e-12);
 
   // With a slack the check accepts only C_check <= epsilon - slack; a slack of the margin or more
   // is refused.
   ProjectorOptions slack = options;
   slack.check_slack = 0.0015;
-  const DistributionProjector slacked(&map, Basis(), Times(), slack, Times());
-  auto kws = slacked.MakeWorkspace();
-  TrajectoryDistribution slack_out = prior;
-  const TrackProjection k = slacked.Project(prior, &slack_out, &kws);
+  const TrackProjection k =
+      ProjectCopy(DistributionProjector(&map, Basis(), Times(), slack, Times()), prior).result;
   ASSERT_TRUE(k.feasible) << k.status << " checked C " << k.checked_cost;
   EXPECT_LE(k.checked_cost, options.epsilon - slack.check_slack);
   slack.check_slack = options.margin;
@@ -390,10 +392,8 @@ TEST(DistributionProjector, CheckOperatorCatchesTheErrorTheSolverExploits) {
 
   // No repeated solve allowed: the same failing check makes the result infeasible, not compliant.
   options.check_rounds = 0;
-  const DistributionProjector strict(&map, Basis(), Times(), options, Times());
-  auto sws = strict.MakeWorkspace();
-  TrajectoryDistribution strict_out = prior;
-  const TrackProjection s = strict.Project(prior, &strict_out, &sws);
+  const TrackProjection s =
+      ProjectCopy(DistributionProjector(&map, Basis(), Times(), options, Times()), prior).result;
   EXPECT_FALSE(s.feasible);
   EXPECT_EQ(s.status, "infeasible");
   EXPECT_GT(s.checked_cost, options.epsilon);

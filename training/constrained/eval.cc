@@ -368,14 +368,17 @@ QuadratureChoice ChooseQuadrature(const ExperimentConfig& c, const ConstrainedDa
   const int n_val = d.val.windows.size();
   const int n = std::min(n_val, c.constraint.choice_windows);
   std::vector<std::unique_ptr<occupancy::Map>> maps(scenes.size());
+  const auto map_of_window = [&](int w) {  // loaded on first use
+    const auto s = static_cast<std::size_t>(d.val.scene[static_cast<std::size_t>(w)]);
+    if (!maps[s]) maps[s] = occupancy::LoadMap(run_dir + "/" + SceneMapFile(scenes[s]));
+    return maps[s].get();
+  };
   span::Predictor::Workspace pws = prior.MakeWorkspace();
   TrajectoryDistribution dist = prior.MakeDistribution(), opt = prior.MakeDistribution();
   for (int i = 0; i < n; ++i) {
     const int w = static_cast<int>(static_cast<std::int64_t>(i) * n_val / n);
-    const auto s = static_cast<std::size_t>(d.val.scene[static_cast<std::size_t>(w)]);
-    if (!maps[s]) maps[s] = occupancy::LoadMap(run_dir + "/" + SceneMapFile(scenes[s]));
     prior.Predict(Rows(d.val.windows.past, w, p), &pws, &dist);
-    q.rule.Score(maps[s].get(), prior.basis(), c.constraint.time_rule, horizon, f, dist);
+    q.rule.Score(map_of_window(w), prior.basis(), c.constraint.time_rule, horizon, f, dist);
   }
   q.rule.Choose(c.constraint.accuracy);
   log::Info("constrained: quadrature chosen on ", q.rule.windows, " validation priors: order ",
@@ -393,14 +396,12 @@ QuadratureChoice ChooseQuadrature(const ExperimentConfig& c, const ConstrainedDa
   while (std::gcd(stride, static_cast<std::int64_t>(n_val)) != 1) stride += 2;
   for (std::int64_t i = 0; i < n_val && q.check->windows < c.constraint.choice_windows; ++i) {
     const int w = static_cast<int>(i * stride % n_val);
-    const auto s = static_cast<std::size_t>(d.val.scene[static_cast<std::size_t>(w)]);
-    if (!maps[s]) maps[s] = occupancy::LoadMap(run_dir + "/" + SceneMapFile(scenes[s]));
+    const occupancy::Map* map = map_of_window(w);
     prior.Predict(Rows(d.val.windows.past, w, p), &pws, &dist);
-    const DistributionProjector projector(maps[s].get(), prior.basis(), times, po);
+    const DistributionProjector projector(map, prior.basis(), times, po);
     DistributionProjector::Workspace ws = projector.MakeWorkspace();
-    const TrackProjection tp = projector.Project(dist, &opt, &ws);
-    if (tp.changed)
-      q.check->Score(maps[s].get(), prior.basis(), TimeRule::kMidpoint, horizon, f, opt);
+    if (projector.Project(dist, &opt, &ws).changed)
+      q.check->Score(map, prior.basis(), TimeRule::kMidpoint, horizon, f, opt);
   }
   if (q.check->windows == 0 || q.check->orders.empty()) {
     log::Info("constrained: no validation prior needed projecting; the check stays at order ",
@@ -411,13 +412,9 @@ QuadratureChoice ChooseQuadrature(const ExperimentConfig& c, const ConstrainedDa
   q.check->Choose(c.constraint.check_accuracy);
   q.check_accuracy = c.constraint.check_accuracy;
   log::Info("constrained: check chosen on ", q.check->windows,
-            " projected validation windows: "
-            "order ",
-            q.check->order(), ", ", q.check->substep(),
-            " midpoints per step (max |C - "
-            "converged| ",
-            q.check->error(), q.check->met ? ", meets " : ", misses ", c.constraint.check_accuracy,
-            ")");
+            " projected validation windows: ", "order ", q.check->order(), ", ", q.check->substep(),
+            " midpoints per step ", "(max |C - converged| ", q.check->error(),
+            q.check->met ? ", meets " : ", misses ", c.constraint.check_accuracy, ")");
   return q;
 }
 
@@ -559,7 +556,9 @@ std::string EvaluateConstrained(const ExperimentConfig& c, const ConstrainedData
     // The run's verdict on the result: the check operator's C when there is one.
     const double opt_cost = std::isfinite(tp.checked_cost) ? tp.checked_cost : tp.cost;
     const double prior_converged = r.converged->Cost(dist, &*r.ws_converged);
-    const double opt_converged = r.converged->Cost(opt, &*r.ws_converged);
+    // An unchanged window's result is its prior: its converged C is already known.
+    const double opt_converged =
+        tp.changed ? r.converged->Cost(opt, &*r.ws_converged) : prior_converged;
     b_prior.Add(sp);
     b_prior.AddCost(tp.prior_cost, c.constraint.epsilon);
     b_prior.AddConvergedCost(prior_converged, c.constraint.epsilon);
@@ -589,21 +588,20 @@ std::string EvaluateConstrained(const ExperimentConfig& c, const ConstrainedData
       acc.Add(tp.prior_cost, MonteCarloCost(dist, times, *r.map, c.eval.accuracy_samples, &rng),
               r.reference->Cost(dist, &*r.ws_reference), r.fine->Cost(dist, &*r.ws_fine));
       acc.AddContinuous(
-          tp.prior_cost, r.converged->Cost(dist, &*r.ws_converged),
+          tp.prior_cost, prior_converged,
           ContinuousMonteCarloCost(dist, horizon, *r.map, c.eval.accuracy_samples, strata, &rng));
     }
     if (tp.changed) {
       const double reference = r.reference->Cost(opt, &*r.ws_reference);
       const double fine = r.fine->Cost(opt, &*r.ws_fine);
-      const double converged = opt_converged;
       opt_violating_reference += !(reference <= c.constraint.epsilon);
       opt_violating_fine += !(fine <= c.constraint.epsilon);
-      opt_violating_converged += !(converged <= c.constraint.epsilon);
+      opt_violating_converged += !(opt_converged <= c.constraint.epsilon);
       if (static_cast<int>(acc_opt.err_mc.size()) < c.eval.accuracy_windows) {
         acc_opt.Add(tp.cost, MonteCarloCost(opt, times, *r.map, c.eval.accuracy_samples, &rng),
                     reference, fine);
         acc_opt.AddContinuous(
-            tp.cost, converged,
+            tp.cost, opt_converged,
             ContinuousMonteCarloCost(opt, horizon, *r.map, c.eval.accuracy_samples, strata, &rng));
       }
     }
