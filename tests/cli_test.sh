@@ -124,7 +124,8 @@ for f in summary.json problems.csv ee_paths.png config.yaml log.txt; do
   [ -s "$PLAN/$f" ] || fail "plan output lacks $f"
 done
 check_json "$PLAN/summary.json"
-for k in '"GFCS (1 batch)"' '"GF"' '"RRT-Connect"' success_rate ee_length cspace_length time_s ee_ldj cspace_ldj; do
+for k in '"GFCS (1 batch)"' '"GF"' '"RRT-Connect"' success_rate ee_length cspace_length time_s ee_ldj cspace_ldj \
+         candidate_statuses '"reached"' '"timeout"' '"collision"'; do
   grep -q "$k" "$PLAN/summary.json" || fail "plan summary.json lacks $k"
 done
 [ "$(wc -l < "$PLAN/problems.csv")" -eq 4 ] || fail "plan problems.csv: expected a header and 3 rows"
@@ -135,6 +136,10 @@ expect_error "problems.source" plan default problems.source=lidar --run-dir "$TM
 expect_error "teleport" plan default "methods=[{name: x, kind: teleport}]" --run-dir "$TMP/plan4"
 expect_error "methods: 'GF' listed twice" plan default "methods=[{name: GF, kind: gf}, {name: GF, kind: gfcs}]" \
   --run-dir "$TMP/plan5"
+expect_error "'GF' sets uniform_share 0.5, which only a gfcs method with sampler: learned uses" plan default \
+  "methods=[{name: GF, kind: gf, uniform_share: 0.5}]" --run-dir "$TMP/plan7"
+expect_error "uniform_share" plan default "methods=[{name: G, kind: gfcs, sampler: learned, uniform_share: 2}]" \
+  energy_model=x.h5 --run-dir "$TMP/plan8"
 expect_error "missing MBM problems directory" plan configs/manipulation/box.yaml problems.family=no_such_family robot=builtin \
   problems.root="$TMP" --run-dir "$TMP/plan6"
 "$BIN" bench configs/manipulation/synthetic.yaml bench.repeats=1 --json | grep -q '"fabric_step_us"' ||

@@ -364,16 +364,24 @@ void LearnedSampler::Sample(const GfcsQuery& query, int intermediate_commands, i
                   model_.intermediate_commands());
   FS_THROW_UNLESS(has_world_, "LearnedSampler: call SetWorld before Sample");
   FS_THROW_UNLESS(count >= 0, "LearnedSampler: count ", count, " is negative");
-  SgldParams p = params_;
-  p.particles = std::max(p.particles, count);
-  if (ws_.max_particles < p.particles) ws_ = model_.MakeWorkspace(p.particles);
-  model_.Context(query, encoding_, &context_);
-  last_ = RunSgld(model_, context_, p, rng, &ws_);
+  FS_THROW_UNLESS(params_.uniform_share >= 0 && params_.uniform_share <= 1,
+                  "LearnedSampler: uniform_share ", params_.uniform_share, " is outside [0, 1]");
+  const int learned =
+      count - static_cast<int>(std::lround(params_.uniform_share * static_cast<double>(count)));
   const int D = model_.command_size();
   out->resize(D, count);
-  const int kept = std::min<int>(count, static_cast<int>(last_.u.cols()));
-  for (int c = 0; c < kept; ++c) out->col(c) = model_.CommandsToRadians(last_.u.col(c));
-  last_filled_ = count - kept;
+  int kept = 0;
+  last_ = SgldResult{};
+  if (learned > 0) {
+    SgldParams p = params_;
+    p.particles = std::max(p.particles, learned);
+    if (ws_.max_particles < p.particles) ws_ = model_.MakeWorkspace(p.particles);
+    model_.Context(query, encoding_, &context_);
+    last_ = RunSgld(model_, context_, p, rng, &ws_);
+    kept = std::min<int>(learned, static_cast<int>(last_.u.cols()));
+    for (int c = 0; c < kept; ++c) out->col(c) = model_.CommandsToRadians(last_.u.col(c));
+  }
+  last_filled_ = learned - kept;
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
   const JointVector& lo = model_.parts().lower;
   const JointVector& hi = model_.parts().upper;

@@ -124,6 +124,13 @@ struct SgldParams {
   int steps = 50;                  ///< Langevin steps
   double step_scale = 0.01;        ///< sigma2_k = step_scale (1 + k)^-0.5
   double max_dropped_share = 0.5;  ///< more non-finite particles than this share: Error
+  /// LearnedSampler only (RunSgld ignores it; not a config key here: the plan harness sets it per
+  /// method, methods[].uniform_share): the share of each requested batch drawn uniformly
+  /// in the joint limits instead of from SGLD, rounded to the nearest count. 0 is the thesis (the
+  /// whole first batch learned). A share above 0 is the defensive mixture of learned sampling
+  /// for planning (Ichter, Harrison and Pavone, ICRA 2018, keep uniform samples beside learned
+  /// ones): where the model's modes miss a problem the uniform part still explores.
+  double uniform_share = 0.0;
 
   template <class A>
   void Serialize(A* a) {
@@ -163,9 +170,11 @@ class LearnedSampler : public CommandSampler {
   std::string name() const override { return "learned"; }
   /// Computes the world encoding once (EnergyModel::EncodeWorld).
   void SetWorld(const World& world);
-  /// Runs SGLD with max(particles, count) particles; `out` [7n x count] the count lowest-energy
-  /// survivors in radians. When fewer than `count` particles survive (allowed by
-  /// max_dropped_share), the rest are uniform in the joint limits (counted in last_filled()).
+  /// Runs SGLD with max(particles, learned) particles, learned = count - round(uniform_share
+  /// count); `out` [7n x count] holds the `learned` lowest-energy survivors in radians, then
+  /// uniform draws in the joint limits. When fewer than `learned` particles survive (allowed by
+  /// max_dropped_share), uniform draws fill their places too (counted in last_filled(), which
+  /// does not count the configured uniform share).
   /// Error when intermediate_commands != the model's n or SetWorld was not called.
   void Sample(const GfcsQuery& query, int intermediate_commands, int count, std::mt19937_64* rng,
               Eigen::MatrixXd* out) override;

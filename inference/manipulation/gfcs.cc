@@ -182,6 +182,7 @@ GfcsSolution SolveGfcop(const Fabric& fabric, const GfcsQuery& query, CommandSam
   solution.evaluations = static_cast<int>(all.size());
   solution.pruned = static_cast<int>(
       std::count_if(all.begin(), all.end(), [](const GfcsCandidate& c) { return c.pruned; }));
+  for (const GfcsCandidate& c : all) ++solution.candidate_statuses[static_cast<int>(c.last_status)];
   // Pruned candidates cost more than the top_m-th exact cost of their batch: they sort last, so the
   // top m are those of an unpruned solve.
   std::stable_sort(all.begin(), all.end(), [](const GfcsCandidate& a, const GfcsCandidate& b) {

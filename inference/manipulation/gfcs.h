@@ -15,6 +15,7 @@
 /// in the top m; it is stopped there. The returned top m are exactly those of a full evaluation.
 
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <limits>
 #include <random>
@@ -116,12 +117,19 @@ enum class GfcsStatus {
 };
 const char* ToString(GfcsStatus status);
 
+/// How the evaluated candidates of a solve ended, by the status of their last rollout (a pruned
+/// candidate counts as kStopped): where a solve's budget went.
+using RolloutStatusCounts = std::array<int, kRolloutStatusCount>;
+
 struct GfcsSolution {
   GfcsStatus status = GfcsStatus::kNotSolved;
   std::string message;
   std::vector<GfcsCandidate> top;  ///< best first, at most top_m
   int evaluations = 0;
-  int pruned = 0;           ///< of the evaluations, stopped early (GfcsParams::prune)
+  int pruned = 0;  ///< of the evaluations, stopped early (GfcsParams::prune)
+  /// Every evaluated candidate's last status; a candidate reached the goal iff its count is in
+  /// kReached (intermediate timeouts are allowed).
+  RolloutStatusCounts candidate_statuses{};
   double solve_time_s = 0;  ///< wall time of SolveGfcop
   bool solved() const { return status == GfcsStatus::kSolved; }
 };

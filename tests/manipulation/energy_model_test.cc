@@ -533,5 +533,49 @@ TEST(LearnedSampler, ReturnsTheLowestEnergyParticlesInRadians) {
   EXPECT_EQ(s.last_result().u.cols(), 80);
 }
 
+TEST(LearnedSampler, UniformShareDrawsThatPartOfTheBatchUniformlyInTheLimits) {
+  const float target = -0.5f;
+  const EnergyModel m(AbsEnergy(2, target, 100.0f));
+  SgldParams p;
+  p.particles = 50;
+  p.steps = 30;
+  p.uniform_share = 0.25;
+  LearnedSampler s(m, p);
+  s.SetWorld(SomeWorld());
+  std::mt19937_64 rng(4);
+  Eigen::MatrixXd out;
+  s.Sample(SomeQuery(), 2, 20, &rng, &out);
+  ASSERT_EQ(out.rows(), 14);
+  ASSERT_EQ(out.cols(), 20);
+  EXPECT_EQ(s.last_filled(), 0);  // the configured uniform part is not a shortfall
+  const JointVector lo = m.parts().lower, hi = m.parts().upper;
+  const JointVector expect = m.Denormalise(JointVector::Constant(target));
+  // The first 15 are the lowest-energy SGLD particles, near the energy's minimum.
+  for (int c = 0; c < 15; ++c)
+    EXPECT_TRUE(out.col(c).isApprox(m.CommandsToRadians(s.last_result().u.col(c)))) << c;
+  // The last 5 are uniform in the limits: inside them, and spread where SGLD's are not.
+  double spread = 0;
+  for (int c = 15; c < 20; ++c)
+    for (int k = 0; k < 2; ++k)
+      for (int j = 0; j < kDof; ++j) {
+        const double v = out(7 * k + j, c);
+        EXPECT_GE(v, lo[j]);
+        EXPECT_LE(v, hi[j]);
+        spread += std::abs(v - expect[j]) / (hi[j] - lo[j]) / 70.0;
+      }
+  EXPECT_GT(spread, 0.15) << "uniform draws in [lo, hi] lie on average ~0.3 of the range away";
+  // share 1: no SGLD at all; share 0 is the thesis (tested above)
+  p.uniform_share = 1.0;
+  LearnedSampler all_uniform(m, p);
+  all_uniform.SetWorld(SomeWorld());
+  all_uniform.Sample(SomeQuery(), 2, 20, &rng, &out);
+  EXPECT_EQ(all_uniform.last_result().u.cols(), 0);
+  EXPECT_EQ(out.cols(), 20);
+  p.uniform_share = 1.5;
+  LearnedSampler bad(m, p);
+  bad.SetWorld(SomeWorld());
+  ExpectErrorContains([&] { bad.Sample(SomeQuery(), 2, 20, &rng, &out); }, {"uniform_share 1.5"});
+}
+
 }  // namespace
 }  // namespace foresight::manipulation

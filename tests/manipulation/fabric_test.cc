@@ -318,6 +318,14 @@ TEST(Gfcs, SolveIsDeterministicSortedAndBeatsOrMatchesItsFirstBatch) {
     }
   }
   EXPECT_EQ(a.solved(), !a.top.empty() && a.top.front().reached);
+  // Every evaluated candidate is counted once, by its last status; a solve is solved iff one
+  // candidate reached the goal (the top one then).
+  int counted = 0;
+  for (const int n : a.candidate_statuses) counted += n;
+  EXPECT_EQ(counted, a.evaluations);
+  EXPECT_EQ(a.solved(), a.candidate_statuses[static_cast<int>(RolloutStatus::kReached)] > 0);
+  EXPECT_EQ(a.candidate_statuses[static_cast<int>(RolloutStatus::kStopped)], a.pruned);
+  EXPECT_EQ(a.candidate_statuses, b.candidate_statuses);
 }
 
 TEST(Gfcs, APrunedCandidateCostsMoreThanItsBound) {

@@ -167,8 +167,12 @@ TEST(CrowdForecast, TablesThePredictorAndAgreesWithTheBoundByBruteForce) {
       if (std::abs(worst - 0.25) < 1e-6) continue;
       const bool hit = capped.Collides(k, x, 0.8, t);
       EXPECT_EQ(hit, worst > 0.25) << "k " << k << " x " << x.transpose();
-      if (components == 1) EXPECT_EQ(hit, per_step) << "k " << k << " x " << x.transpose();
-      if (k <= 5) EXPECT_EQ(hit, f.Collides(k, x, 0.8, t));
+      if (components == 1) {
+        EXPECT_EQ(hit, per_step) << "k " << k << " x " << x.transpose();
+      }
+      if (k <= 5) {
+        EXPECT_EQ(hit, f.Collides(k, x, 0.8, t));
+      }
       differs += hit != f.Collides(k, x, 0.8, t);
       ++compared;
     }

@@ -110,6 +110,9 @@ struct EvalConfig {
   }();
   int batch_size = 20;                ///< candidates per batch at test (thesis 20)
   std::vector<int> batches = {1, 5};  ///< budgets compared (thesis 1 and 5)
+  /// > 0: the learned sampler is also evaluated with this share of its batch drawn uniformly
+  /// (methods[].uniform_share of the plan harness), in rows beside the thesis's pure one.
+  double uniform_share = 0;
   std::vector<manipulation::PlanMethodConfig> baselines = {
       {"GF", manipulation::PlanMethodKind::kFabric, 1, 1.2}};
   double resolution = 0.05;
@@ -122,6 +125,9 @@ struct EvalConfig {
     a->Visit("problems", &problems, Range::Any(), "held-out problem sets");
     a->Visit("batch_size", &batch_size, Range::Closed(2, 100000), "candidates per batch at test");
     a->Visit("batches", &batches, Range::Any(), "GFCS budgets (batches) compared");
+    a->Visit("uniform_share", &uniform_share, Range::Closed(0, 1),
+             "> 0: also evaluate the learned sampler with this share of its batch drawn uniformly "
+             "in the joint limits (rows 'GFCS learned + uniform'); chosen on validation problems");
     a->Visit("baselines", &baselines, Range::Any(), "other methods in the same table");
     a->Visit("resolution", &resolution, Range::Closed(1e-4, 1.0),
              "C-space step of path validity checks (rad)");

@@ -240,6 +240,12 @@ std::string BudgetLabel(int batches) {
   return std::to_string(batches) + (batches == 1 ? " batch" : " batches");
 }
 
+/// "GFCS learned + 25 % uniform": the defensive mixture's rows.
+std::string MixedLabel(double uniform_share) {
+  return "GFCS learned + " + std::to_string(static_cast<int>(std::lround(100 * uniform_share))) +
+         " % uniform";
+}
+
 }  // namespace
 
 manipulation::ExperimentConfig EvalPlanConfig(const ExperimentConfig& c,
@@ -255,6 +261,10 @@ manipulation::ExperimentConfig EvalPlanConfig(const ExperimentConfig& c,
     mc.methods.push_back({"GFCS learned (" + BudgetLabel(b) + ")",
                           manipulation::PlanMethodKind::kGfcs, b, 1.2,
                           manipulation::GfcsSamplerKind::kLearned});
+    if (c.eval.uniform_share > 0)
+      mc.methods.push_back({MixedLabel(c.eval.uniform_share) + " (" + BudgetLabel(b) + ")",
+                            manipulation::PlanMethodKind::kGfcs, b, 1.2,
+                            manipulation::GfcsSamplerKind::kLearned, c.eval.uniform_share});
   }
   for (const manipulation::PlanMethodConfig& m : c.eval.baselines) mc.methods.push_back(m);
   mc.resolution = c.eval.resolution;
@@ -339,48 +349,55 @@ std::string EvaluateRun(const ExperimentConfig& c, const std::string& run_dir) {
       os << "       {\"name\": " << JsonString(report.methods[m].method)
          << ", \"metrics\": " << report.methods[m].summary.ToJson() << "}"
          << (m + 1 < report.methods.size() ? "," : "") << "\n";
-    os << "     ],\n     \"learned_minus_uniform\": [\n";
-    for (std::size_t b = 0; b < c.eval.batches.size(); ++b) {
-      const std::string uni = "GFCS uniform (" + BudgetLabel(c.eval.batches[b]) + ")";
-      const std::string lea = "GFCS learned (" + BudgetLabel(c.eval.batches[b]) + ")";
-      std::map<int, std::pair<const manipulation::PlanAttempt*, const manipulation::PlanAttempt*>>
-          by_problem;
-      for (const manipulation::PlanAttempt& a : report.attempts) {
-        if (a.method == uni) by_problem[a.problem].first = &a;
-        if (a.method == lea) by_problem[a.problem].second = &a;
-      }
-      // Pairs: every problem both ran; times only where neither errored (an error takes no time);
-      // cost_s over all pairs mixes the penalty of unsolved problems in, cost_both_solved_s not.
-      std::vector<double> cost, cost_solved, time, success;
-      int only_learned = 0, only_uniform = 0;
-      const auto errored = [](const manipulation::PlanAttempt& a) {
-        return a.status.rfind("error", 0) == 0;
-      };
-      for (const auto& [problem, pair] : by_problem) {
-        if (!pair.first || !pair.second) continue;
-        const bool su = pair.first->metrics.success, sl = pair.second->metrics.success;
-        only_learned += sl && !su;
-        only_uniform += su && !sl;
-        success.push_back(static_cast<double>(sl) - static_cast<double>(su));
-        if (!errored(*pair.first) && !errored(*pair.second))
-          time.push_back(pair.second->metrics.time_s - pair.first->metrics.time_s);
-        if (pair.first->gfcs_cost && pair.second->gfcs_cost) {
-          cost.push_back(*pair.second->gfcs_cost - *pair.first->gfcs_cost);
-          if (su && sl) cost_solved.push_back(cost.back());
+    // Paired differences of a learned variant against the uniform sampler, per budget.
+    const auto paired = [&](const std::string& key, const std::string& variant) {
+      os << "     ],\n     \"" << key << "\": [\n";
+      for (std::size_t b = 0; b < c.eval.batches.size(); ++b) {
+        const std::string uni = "GFCS uniform (" + BudgetLabel(c.eval.batches[b]) + ")";
+        const std::string lea = variant + " (" + BudgetLabel(c.eval.batches[b]) + ")";
+        std::map<int, std::pair<const manipulation::PlanAttempt*, const manipulation::PlanAttempt*>>
+            by_problem;
+        for (const manipulation::PlanAttempt& a : report.attempts) {
+          if (a.method == uni) by_problem[a.problem].first = &a;
+          if (a.method == lea) by_problem[a.problem].second = &a;
         }
+        // Pairs: every problem both ran; times only where neither errored (an error takes no
+        // time); cost_s over all pairs mixes the penalty of unsolved problems in,
+        // cost_both_solved_s not.
+        std::vector<double> cost, cost_solved, time, success;
+        int only_learned = 0, only_uniform = 0;
+        const auto errored = [](const manipulation::PlanAttempt& a) {
+          return a.status.rfind("error", 0) == 0;
+        };
+        for (const auto& [problem, pair] : by_problem) {
+          if (!pair.first || !pair.second) continue;
+          const bool su = pair.first->metrics.success, sl = pair.second->metrics.success;
+          only_learned += sl && !su;
+          only_uniform += su && !sl;
+          success.push_back(static_cast<double>(sl) - static_cast<double>(su));
+          if (!errored(*pair.first) && !errored(*pair.second))
+            time.push_back(pair.second->metrics.time_s - pair.first->metrics.time_s);
+          if (pair.first->gfcs_cost && pair.second->gfcs_cost) {
+            cost.push_back(*pair.second->gfcs_cost - *pair.first->gfcs_cost);
+            if (su && sl) cost_solved.push_back(cost.back());
+          }
+        }
+        const std::uint64_t seed = static_cast<std::uint64_t>(c.seed) + 1000 * i + 10 * b;
+        const auto stat = [&](const char* name, const std::vector<double>& d, int k) {
+          const PairedDifference p = Bootstrap(d, seed + k);
+          return std::string("\"") + name + "\": {\"n\": " + std::to_string(p.n) +
+                 ", \"mean\": " + Num(p.mean) + ", \"ci95\": [" + Num(p.lo) + ", " + Num(p.hi) +
+                 "]";
+        };
+        os << "       {\"batches\": " << c.eval.batches[b] << ", " << stat("cost_s", cost, 0)
+           << "}, " << stat("cost_both_solved_s", cost_solved, 1) << "}, "
+           << stat("solve_time_s", time, 2) << "}, " << stat("success", success, 3)
+           << ", \"only_learned\": " << only_learned << ", \"only_uniform\": " << only_uniform
+           << "}}" << (b + 1 < c.eval.batches.size() ? "," : "") << "\n";
       }
-      const std::uint64_t seed = static_cast<std::uint64_t>(c.seed) + 1000 * i + 10 * b;
-      const auto stat = [&](const char* key, const std::vector<double>& d, int k) {
-        const PairedDifference p = Bootstrap(d, seed + k);
-        return std::string("\"") + key + "\": {\"n\": " + std::to_string(p.n) +
-               ", \"mean\": " + Num(p.mean) + ", \"ci95\": [" + Num(p.lo) + ", " + Num(p.hi) + "]";
-      };
-      os << "       {\"batches\": " << c.eval.batches[b] << ", " << stat("cost_s", cost, 0) << "}, "
-         << stat("cost_both_solved_s", cost_solved, 1) << "}, " << stat("solve_time_s", time, 2)
-         << "}, " << stat("success", success, 3) << ", \"only_learned\": " << only_learned
-         << ", \"only_uniform\": " << only_uniform << "}}"
-         << (b + 1 < c.eval.batches.size() ? "," : "") << "\n";
-    }
+    };
+    paired("learned_minus_uniform", "GFCS learned");
+    if (c.eval.uniform_share > 0) paired("mixed_minus_uniform", MixedLabel(c.eval.uniform_share));
     os << "     ]}" << (i + 1 < c.eval.problems.size() ? "," : "") << "\n";
   }
   const std::string loop = ReadText(run_dir + "/loop_summary.json");

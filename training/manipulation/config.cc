@@ -35,6 +35,11 @@ void ExperimentConfig::Validate(const std::string& path) const {
     FS_THROW_UNLESS(m.sampler != GfcsSamplerKind::kLearned || !energy_model.empty(), path,
                     ": methods: '", m.name,
                     "' uses the learned sampler, but energy_model (the artifact) is empty");
+  for (const PlanMethodConfig& m : methods)
+    FS_THROW_UNLESS(m.uniform_share == 0 ||
+                        (m.kind == PlanMethodKind::kGfcs && m.sampler == GfcsSamplerKind::kLearned),
+                    path, ": methods: '", m.name, "' sets uniform_share ", m.uniform_share,
+                    ", which only a gfcs method with sampler: learned uses");
   FS_THROW_UNLESS(fabric.t_max >= fabric.dt, path, ": fabric.t_max (", fabric.t_max,
                   ") is below fabric.dt (", fabric.dt, ")");
 }

@@ -61,6 +61,9 @@ struct PlanMethodConfig {
   int batches = 1;                                      ///< gfcs: batches evaluated
   double time_budget = 1.2;                             ///< planners: seconds
   GfcsSamplerKind sampler = GfcsSamplerKind::kUniform;  ///< gfcs: first batch
+  /// gfcs with the learned sampler: share of the first batch drawn uniformly in the joint limits
+  /// (SgldParams::uniform_share; 0 = the thesis).
+  double uniform_share = 0;
 
   template <class A>
   void Serialize(A* a) {
@@ -79,6 +82,9 @@ struct PlanMethodConfig {
                  config::EnumNames<GfcsSamplerKind>{{GfcsSamplerKind::kUniform, "uniform"},
                                                     {GfcsSamplerKind::kLearned, "learned"}},
                  "gfcs: first batch uniform in the joint limits, or SGLD on energy_model");
+    a->Visit("uniform_share", &uniform_share, config::Range::Closed(0, 1),
+             "gfcs, sampler learned: share of the first batch drawn uniformly in the joint limits "
+             "beside the SGLD samples (0: the thesis)");
   }
 };
 

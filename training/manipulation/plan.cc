@@ -36,6 +36,7 @@ struct Trajectory {
   std::string status;
   TimedPath joints;
   double generation_time_s = 0;
+  RolloutStatusCounts candidates{};  ///< GFCS: how its evaluated candidates ended
 };
 
 TimedPath ToTimedPath(const std::vector<JointVector>& states, double dt) {
@@ -61,6 +62,7 @@ Trajectory RunGfcs(const Fabric& fabric, const ManipulationProblem& problem,
   const GfcsSolution solution = SolveGfcop(fabric, query, sampler, params);
   Trajectory t;
   t.generation_time_s = Seconds(started);
+  t.candidates = solution.candidate_statuses;
   if (solution.status == GfcsStatus::kError) {
     t.status = "error: " + solution.message;
     return t;
@@ -190,8 +192,15 @@ void WriteSummaryJson(const std::string& path, const ExperimentConfig& c,
   os << "],\n  \"methods\": [\n";
   for (std::size_t i = 0; i < report.methods.size(); ++i) {
     os << "    {\"name\": \"" << report.methods[i].method
-       << "\", \"metrics\": " << report.methods[i].summary.ToJson() << "}"
-       << (i + 1 < report.methods.size() ? "," : "") << "\n";
+       << "\", \"metrics\": " << report.methods[i].summary.ToJson();
+    if (c.methods[i].kind == PlanMethodKind::kGfcs) {
+      os << ", \"candidate_statuses\": {";
+      for (int k = 0; k < kRolloutStatusCount; ++k)
+        os << (k ? ", " : "") << "\"" << ToString(static_cast<RolloutStatus>(k))
+           << "\": " << report.methods[i].candidate_statuses[k];
+      os << "}";
+    }
+    os << "}" << (i + 1 < report.methods.size() ? "," : "") << "\n";
   }
   os << "  ]";
   if (c.reactivity.enabled)
@@ -239,6 +248,7 @@ PlanReport RunPlanExperiment(const ExperimentConfig& c, const std::string& run_d
   PlanReport report;
   report.problems = static_cast<int>(problems.size());
   std::vector<std::vector<PathMetrics>> per_method(c.methods.size());
+  std::vector<RolloutStatusCounts> candidate_statuses(c.methods.size(), RolloutStatusCounts{});
   std::vector<PlanProblemPicture> pictures;
   KinematicsData ee_data = robot.MakeData();
   const EndEffectorFn ee = [&](const JointVector& q) {
@@ -248,14 +258,21 @@ PlanReport RunPlanExperiment(const ExperimentConfig& c, const std::string& run_d
 
   const JointLimits& limits = robot.limits();
   UniformSampler uniform(limits.lower, limits.upper);
+  // One learned sampler per method that uses it (each with the method's uniform share).
   std::optional<EnergyModel> energy;
-  std::optional<LearnedSampler> learned;
-  for (const PlanMethodConfig& m : c.methods)
-    if (m.kind == PlanMethodKind::kGfcs && m.sampler == GfcsSamplerKind::kLearned && !energy) {
+  std::vector<std::optional<LearnedSampler>> learned(c.methods.size());
+  for (std::size_t m = 0; m < c.methods.size(); ++m) {
+    const PlanMethodConfig& method = c.methods[m];
+    if (method.kind != PlanMethodKind::kGfcs || method.sampler != GfcsSamplerKind::kLearned)
+      continue;
+    if (!energy) {
       energy.emplace(EnergyModel::Load(c.energy_model));
-      learned.emplace(*energy, c.sgld);
       log::Info("learned sampler: ", c.energy_model);
     }
+    SgldParams sgld = c.sgld;
+    sgld.uniform_share = method.uniform_share;
+    learned[m].emplace(*energy, sgld);
+  }
 
   // Reactivity is measured on the first GFCS method's solutions.
   int reactive_method = -1;
@@ -290,11 +307,11 @@ PlanReport RunPlanExperiment(const ExperimentConfig& c, const std::string& run_d
           case PlanMethodKind::kGfcs: {
             CommandSampler* sampler = &uniform;
             double encode_s = 0;  // the world's encoding is part of the learned method's time
-            if (method.sampler == GfcsSamplerKind::kLearned) {
+            if (learned[m]) {
               const auto started = std::chrono::steady_clock::now();
-              learned->SetWorld(problem.world);
+              learned[m]->SetWorld(problem.world);
               encode_s = Seconds(started);
-              sampler = &*learned;
+              sampler = &*learned[m];
             }
             t = RunGfcs(fabric, problem, c, method, sampler, seed, &best);
             t.generation_time_s += encode_s;
@@ -340,6 +357,7 @@ PlanReport RunPlanExperiment(const ExperimentConfig& c, const std::string& run_d
       }
       line << " " << method.name << "=" << attempt.status;
       per_method[m].push_back(attempt.metrics);
+      for (int k = 0; k < kRolloutStatusCount; ++k) candidate_statuses[m][k] += t.candidates[k];
 
       // Reactivity: GFCS's commands re-run by the fabric with obstacles on the solved path.
       if (c.reactivity.enabled && static_cast<int>(m) == reactive_method &&
@@ -367,7 +385,7 @@ PlanReport RunPlanExperiment(const ExperimentConfig& c, const std::string& run_d
     if (static_cast<int>(pictures.size()) < c.plot_problems) pictures.push_back(picture);
   }
   for (std::size_t m = 0; m < c.methods.size(); ++m)
-    report.methods.push_back({c.methods[m].name, Summarise(per_method[m])});
+    report.methods.push_back({c.methods[m].name, Summarise(per_method[m]), candidate_statuses[m]});
 
   WriteSummaryJson((fs::path(run_dir) / "summary.json").string(), c, report);
   WriteProblemsCsv((fs::path(run_dir) / "problems.csv").string(), report);

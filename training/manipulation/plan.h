@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "inference/manipulation/gfcs.h"
 #include "inference/manipulation/mbm_problem.h"
 #include "inference/manipulation/metrics.h"
 #include "inference/manipulation/robot_model.h"
@@ -41,6 +42,9 @@ struct PlanAttempt {
 struct PlanMethodResult {
   std::string method;
   manipulation::MetricSummary summary;
+  /// GFCS: how every evaluated candidate ended, summed over problems (summary.json
+  /// "candidate_statuses").
+  manipulation::RolloutStatusCounts candidate_statuses{};
 };
 
 struct PlanReport {
