@@ -2,8 +2,10 @@
 # Chooses the share of the learned sampler's first batch drawn uniformly (eval.uniform_share of
 # configs/gfcs/all_families.yaml; 0 is the thesis) on validation problems, never on the held-out
 # 51-75 the table reports: a loop like experiments/gfcs.sh's trained on problems 1-40 of every
-# family (runs/gfcs_select_loop; reused when its model.h5 exists), then GFCS with 1 batch on
-# problems 41-50, which that model has not seen. Writes results/gfcs_select.md.
+# family (runs/gfcs_select_loop_1-40; reused when its model.h5 exists), then GFCS with 1 batch on
+# problems 41-50, which that model has not seen. Writes results/gfcs_select.md. The comparison
+# uses the loop config's sampler settings (particles, steps, step_scale) and the manipulation
+# configs' fabric and GFCS settings, which are the same defaults as the loop config's.
 #   experiments/gfcs_select.sh
 #   SHARES="0.25 0.5" experiments/gfcs_select.sh
 #   RUN=runs/gfcs_all FIRST=1 LAST=50 experiments/gfcs_select.sh   (another model, other problems;
@@ -12,26 +14,37 @@
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BIN="${FORESIGHT_BIN:-$ROOT/build/bin/foresight}"
-RUN="${RUN:-$ROOT/runs/gfcs_select_loop}"
 SHARES="${SHARES:-0.25 0.5}"
 FIRST="${FIRST:-41}"
 LAST="${LAST:-50}"
+RUN="${RUN:-$ROOT/runs/gfcs_select_loop_1-$((FIRST - 1))}"
 FAMILIES="table_under_pick box bookshelf_tall cage bookshelf_thin bookshelf_small"
 OUT="$ROOT/runs/gfcs_select"
 cd "$ROOT"
-mkdir -p "$OUT" results runs
+mkdir -p "$OUT" results runs "$(dirname "$RUN")"
+fail() { tail -n 30 "$1" >&2; echo "failed: see $1" >&2; exit 1; }
 if [ ! -f "$RUN/model.h5" ]; then
+  [ "$FIRST" -gt 1 ] || { echo "FIRST=$FIRST: no problems before it to train the loop on" >&2; exit 1; }
   train=""
   for f in $FAMILIES; do train+="${train:+, }{family: ${f}_panda, first: 1, last: $((FIRST - 1))}"; done
   rm -rf "$RUN"
   "$BIN" train configs/gfcs/all_families.yaml --run-dir "$RUN" --no-eval "train_problems=[$train]" \
-    > "$RUN.out" 2>&1
+    > "$RUN.out" 2>&1 || fail "$RUN.out"
 fi
+# A reused model must not have trained on the problems compared here.
+python3 - "$RUN/config.yaml" "$FIRST" <<'PY' || exit 1
+import sys, yaml
+c, first = yaml.safe_load(open(sys.argv[1])), int(sys.argv[2])
+seen = [p for p in c.get("train_problems", []) if p.get("source", "mbm") == "mbm" and p["last"] >= first]
+if seen:
+    sys.exit(f"{sys.argv[1]}: the model trained on problems up to {seen[0]['last']} of "
+             f"{seen[0]['family']}, not before FIRST={first}")
+PY
 # The sampler's SGLD settings are the loop config's (sampler: particles, steps).
-read -r PARTICLES STEPS < <(python3 -c "
+read -r PARTICLES STEPS SCALE < <(python3 -c "
 import yaml, sys
 s = yaml.safe_load(open('$RUN/config.yaml')).get('sampler', {})
-print(s.get('particles', 200), s.get('steps', 50))")
+print(s.get('particles', 200), s.get('steps', 50), s.get('step_scale', 0.01))")
 methods="{name: uniform, kind: gfcs, batches: 1}, {name: learned, kind: gfcs, batches: 1, sampler: learned}"
 for s in $SHARES; do
   methods+=", {name: \"learned+$s\", kind: gfcs, batches: 1, sampler: learned, uniform_share: $s}"
@@ -39,8 +52,8 @@ done
 for f in $FAMILIES; do
   rm -rf "$OUT/$f"
   "$BIN" plan "configs/manipulation/$f.yaml" --problems "$FIRST-$LAST" "methods=[$methods]" \
-    "energy_model=$RUN/model.h5" "sgld.particles=$PARTICLES" "sgld.steps=$STEPS" plot_problems=0 \
-    --run-dir "$OUT/$f" > "$OUT/$f.out" 2>&1
+    "energy_model=$RUN/model.h5" "sgld.particles=$PARTICLES" "sgld.steps=$STEPS" "sgld.step_scale=$SCALE" \
+    plot_problems=0 --run-dir "$OUT/$f" > "$OUT/$f.out" 2>&1 || fail "$OUT/$f.out"
 done
 python3 - "$OUT" "$FIRST" "$LAST" "$RUN" $FAMILIES > results/gfcs_select.md <<'PY'
 import csv, sys
@@ -49,12 +62,14 @@ rows, totals = [], {}
 for fam in families:
     per = {}
     for r in csv.DictReader(open(f"{out}/{fam}/problems.csv")):
-        m = per.setdefault(r["method"], {"n": 0, "ok": 0, "cost": 0.0})
+        m = per.setdefault(r["method"], {"n": 0, "ok": 0, "cost": 0.0, "errors": 0})
         m["n"] += 1
         m["ok"] += int(r["success"])
-        m["cost"] += float(r["gfcs_cost"] or 0)
+        # an errored attempt has no cost: it counts as unsolved (the penalty M) and is counted
+        m["errors"] += r["status"].startswith("error")
+        m["cost"] += float(r["gfcs_cost"]) if r["gfcs_cost"] else 100.0
     for name, m in per.items():
-        t = totals.setdefault(name, {"n": 0, "ok": 0, "cost": 0.0})
+        t = totals.setdefault(name, {"n": 0, "ok": 0, "cost": 0.0, "errors": 0})
         for k in t:
             t[k] += m[k]
     rows.append((fam, per))
@@ -74,6 +89,9 @@ for fam, per in rows:
 cells = [f"**{totals[n]['ok']}/{totals[n]['n']}** / {totals[n]['cost'] / totals[n]['n']:.1f}"
          for n in names]
 print("| all | " + " | ".join(cells) + " |")
+errors = {n: t["errors"] for n, t in totals.items() if t["errors"]}
+if errors:
+    print(f"\nErrored attempts (counted as unsolved, cost M): {errors}.")
 learned = [n for n in names if n.startswith("learned")]
 best = max(learned, key=lambda n: (totals[n]["ok"], -totals[n]["cost"]))
 share = best.split("+")[1] if "+" in best else "0"

@@ -143,7 +143,7 @@ enum class RolloutStatus {
   kNonFinite,   ///< the acceleration became non-finite (the last finite state is returned)
   kStopped,     ///< the caller's time limit (below t_max) passed first: the outcome is unknown
 };
-inline constexpr int kRolloutStatusCount = 6;
+inline constexpr int kRolloutStatusCount = static_cast<int>(RolloutStatus::kStopped) + 1;
 const char* ToString(RolloutStatus status);
 
 struct RolloutResult {

@@ -127,8 +127,9 @@ struct GfcsSolution {
   std::vector<GfcsCandidate> top;  ///< best first, at most top_m
   int evaluations = 0;
   int pruned = 0;  ///< of the evaluations, stopped early (GfcsParams::prune)
-  /// Every evaluated candidate's last status; a candidate reached the goal iff its count is in
-  /// kReached (intermediate timeouts are allowed).
+  /// Every evaluated candidate's last status (a candidate reached the goal iff it is counted in
+  /// kReached; intermediate timeouts are allowed). With penalty >= commands t_max, the solve is
+  /// solved iff the kReached count is positive.
   RolloutStatusCounts candidate_statuses{};
   double solve_time_s = 0;  ///< wall time of SolveGfcop
   bool solved() const { return status == GfcsStatus::kSolved; }

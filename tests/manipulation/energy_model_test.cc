@@ -550,9 +550,16 @@ TEST(LearnedSampler, UniformShareDrawsThatPartOfTheBatchUniformlyInTheLimits) {
   EXPECT_EQ(s.last_filled(), 0);  // the configured uniform part is not a shortfall
   const JointVector lo = m.parts().lower, hi = m.parts().upper;
   const JointVector expect = m.Denormalise(JointVector::Constant(target));
+  EXPECT_EQ(s.last_result().u.cols(), 50);  // SGLD ran its configured particles
   // The first 15 are the lowest-energy SGLD particles, near the energy's minimum.
-  for (int c = 0; c < 15; ++c)
+  double learned_spread = 0;
+  for (int c = 0; c < 15; ++c) {
     EXPECT_TRUE(out.col(c).isApprox(m.CommandsToRadians(s.last_result().u.col(c)))) << c;
+    for (int k = 0; k < 2; ++k)
+      for (int j = 0; j < kDof; ++j)
+        learned_spread += std::abs(out(7 * k + j, c) - expect[j]) / (hi[j] - lo[j]) / 210.0;
+  }
+  EXPECT_LT(learned_spread, 0.05);
   // The last 5 are uniform in the limits: inside them, and spread where SGLD's are not.
   double spread = 0;
   for (int c = 15; c < 20; ++c)
@@ -570,7 +577,24 @@ TEST(LearnedSampler, UniformShareDrawsThatPartOfTheBatchUniformlyInTheLimits) {
   all_uniform.SetWorld(SomeWorld());
   all_uniform.Sample(SomeQuery(), 2, 20, &rng, &out);
   EXPECT_EQ(all_uniform.last_result().u.cols(), 0);
-  EXPECT_EQ(out.cols(), 20);
+  EXPECT_EQ(all_uniform.last_filled(), 0);
+  ASSERT_EQ(out.cols(), 20);
+  for (int c = 0; c < 20; ++c)
+    for (int k = 0; k < 2; ++k)
+      for (int j = 0; j < kDof; ++j) {
+        EXPECT_GE(out(7 * k + j, c), lo[j]);
+        EXPECT_LE(out(7 * k + j, c), hi[j]);
+      }
+  // The uniform count is rounded to the nearest (half away from zero): 0.5 x 5 -> 3 uniform.
+  p.uniform_share = 0.5;
+  LearnedSampler half(m, p);
+  half.SetWorld(SomeWorld());
+  half.Sample(SomeQuery(), 2, 5, &rng, &out);
+  ASSERT_EQ(out.cols(), 5);
+  for (int c = 0; c < 2; ++c)
+    EXPECT_TRUE(out.col(c).isApprox(m.CommandsToRadians(half.last_result().u.col(c)))) << c;
+  for (int c = 2; c < 5; ++c)
+    EXPECT_FALSE(out.col(c).isApprox(m.CommandsToRadians(half.last_result().u.col(c)))) << c;
   p.uniform_share = 1.5;
   LearnedSampler bad(m, p);
   bad.SetWorld(SomeWorld());

@@ -318,8 +318,8 @@ TEST(Gfcs, SolveIsDeterministicSortedAndBeatsOrMatchesItsFirstBatch) {
     }
   }
   EXPECT_EQ(a.solved(), !a.top.empty() && a.top.front().reached);
-  // Every evaluated candidate is counted once, by its last status; a solve is solved iff one
-  // candidate reached the goal (the top one then).
+  // Every evaluated candidate is counted once, by its last status; with the default penalty (M =
+  // 100 s > commands x t_max) a solve is solved iff one candidate reached the goal.
   int counted = 0;
   for (const int n : a.candidate_statuses) counted += n;
   EXPECT_EQ(counted, a.evaluations);

@@ -47,9 +47,10 @@ void ExperimentConfig::Validate(const std::string& path) const {
                     m.name, "' is GFCS (GFCS rows come from eval.batches)");
     FS_THROW_UNLESS(names.insert(m.name).second, path, ": eval.baselines: '", m.name,
                     "' listed twice");
-    FS_THROW_UNLESS(
-        m.name.rfind("GFCS uniform (", 0) != 0 && m.name.rfind("GFCS learned (", 0) != 0, path,
-        ": eval.baselines: '", m.name, "' is the name of a generated GFCS row");
+    FS_THROW_UNLESS(m.name.rfind("GFCS uniform (", 0) != 0 && m.name.rfind("GFCS learned ", 0) != 0,
+                    path, ": eval.baselines: '", m.name, "' is the name of a generated GFCS row");
+    FS_THROW_UNLESS(m.uniform_share == 0, path, ": eval.baselines: '", m.name,
+                    "' sets uniform_share (only the learned GFCS rows use it: eval.uniform_share)");
   }
   FS_THROW_UNLESS(fabric.t_max >= fabric.dt, path, ": fabric.t_max (", fabric.t_max,
                   ") is below fabric.dt (", fabric.dt, ")");

@@ -242,8 +242,9 @@ std::string BudgetLabel(int batches) {
 
 /// "GFCS learned + 25 % uniform": the defensive mixture's rows.
 std::string MixedLabel(double uniform_share) {
-  return "GFCS learned + " + std::to_string(static_cast<int>(std::lround(100 * uniform_share))) +
-         " % uniform";
+  std::ostringstream os;
+  os << "GFCS learned + " << std::setprecision(3) << 100 * uniform_share << " % uniform";
+  return os.str();
 }
 
 }  // namespace
