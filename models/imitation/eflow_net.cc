@@ -10,7 +10,6 @@ namespace foresight::imitation {
 
 namespace {
 
-const auto kDouble = torch::TensorOptions().dtype(torch::kFloat64);
 const auto kLong = torch::TensorOptions().dtype(torch::kInt64);
 
 Eigen::VectorXd ToEigenVector(const torch::Tensor& t) {

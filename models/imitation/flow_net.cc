@@ -8,8 +8,6 @@ namespace foresight::imitation {
 
 namespace {
 
-const auto kDouble = torch::TensorOptions().dtype(torch::kFloat64);
-
 bool AllFinite(const torch::Tensor& t) { return torch::isfinite(t).all().item<bool>(); }
 
 }  // namespace

@@ -27,6 +27,9 @@
 
 namespace foresight::imitation {
 
+/// Options of the double-precision tensors the imitation networks hold and return.
+inline const torch::TensorOptions kDouble = torch::TensorOptions().dtype(torch::kFloat64);
+
 /// Regularises ||z - z_e|| as sqrt(||z - z_e||^2 + kGoalEpsilon^2) (length units of z): at the
 /// goal (z = z_e up to rounding, ~1e-16) the velocity is 0 (below speed * 1e-6) with a finite
 /// gradient, and elsewhere the relative change of the velocity is kGoalEpsilon^2 / (2 ||z -

@@ -16,8 +16,6 @@ namespace {
 using testing::ExpectErrorContains;
 using testing::TempDir;
 
-const auto kDouble = torch::TensorOptions().dtype(torch::kFloat64);
-
 EFlowNet RandomNet(int d, std::uint64_t seed) {
   EFlowNetOptions o;
   o.dimension = d;

@@ -20,8 +20,6 @@ namespace {
 
 using testing::ExpectErrorContains;
 
-const auto kDouble = torch::TensorOptions().dtype(torch::kFloat64);
-
 /// Centres of a regular grid over [lo, hi]^2 with n per axis, in RbfGrid order (x fastest).
 torch::Tensor GridCentres(double lo, double hi, int n) {
   torch::Tensor c = torch::empty({n * n, 2}, kDouble);
