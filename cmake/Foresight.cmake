@@ -94,9 +94,8 @@ endfunction()
 # foresight_unity_torch_free_libraries(): builds each torch-free library with more than one source
 # as unity translation units (CMake's UNITY_BUILD, batches of 8): its sources share one parse of
 # Eigen and the standard headers. Both builds of scripts/test.sh compile these libraries, so this
-# is where a unity build saves most. LibTorch libraries are grouped by kind instead
-# (cmake/TorchPch.cmake, _foresight_unity_groups) and tests keep one unit per source (each test file is read on its
-# own). -DFORESIGHT_UNITY_BUILD=OFF builds every source alone (the fuzz build does: it checks that
+# is where a unity build saves most. LibTorch libraries are grouped by kind instead (cmake/
+# TorchPch.cmake) and tests keep one unit per source (each test file is read on its own). -DFORESIGHT_UNITY_BUILD=OFF builds every source alone (the fuzz build does: it checks that
 # each source includes what it uses). Call once, after every target is defined.
 function(foresight_unity_torch_free_libraries)
   if(NOT FORESIGHT_UNITY_BUILD)

@@ -6,7 +6,7 @@
 # 1-batch solve needs, so the setting with more reaching candidates over the six thesis families
 # is the better fabric. Writes runs/fabric_select/ and results/fabric_select.md.
 #   experiments/fabric_select.sh "fabric.self={gain: 10, metric: 5, range: 0.05}" ...
-#     (each argument is one setting: overrides separated by ';')
+#     (each argument is one setting: key.path=value overrides joined by '+', as select_lib.sh)
 #   ENERGY_MODEL=runs/gfcs_all/model.h5 experiments/fabric_select.sh ...
 #     (adds the learned sampler's rows; that model trained on problems 1-50, so those rows compare
 #      fabrics on its own training problems)
@@ -20,6 +20,7 @@ FAMILIES="table_under_pick box bookshelf_tall cage bookshelf_thin bookshelf_smal
 OUT="$ROOT/runs/fabric_select"
 cd "$ROOT"
 mkdir -p "$OUT" results
+source experiments/select_lib.sh
 methods="{name: uniform, kind: gfcs, batches: 1}"
 model_args=()
 if [ -n "${ENERGY_MODEL:-}" ]; then
@@ -31,13 +32,13 @@ fi
 settings=("" "$@")
 index=0
 for setting in "${settings[@]}"; do
-  IFS=';' read -r -a overrides <<< "$setting"
+  mapfile -t setting_overrides < <(overrides "$setting")
   for f in $FAMILIES; do
     run="$OUT/$index/$f"
     rm -rf "$run"
     mkdir -p "$OUT/$index"
     "$BIN" plan "configs/manipulation/$f.yaml" --problems "$FIRST-$LAST" "methods=[$methods]" \
-      plot_problems=0 "${model_args[@]}" "${overrides[@]}" --run-dir "$run" > "$run.out" 2>&1 ||
+      plot_problems=0 "${model_args[@]}" "${setting_overrides[@]}" --run-dir "$run" > "$run.out" 2>&1 ||
       { tail -n 20 "$run.out" >&2; echo "failed: see $run.out" >&2; exit 1; }
   done
   printf '%s\n' "${setting:-shipped fabric (the defaults of this build)}" > "$OUT/$index/setting.txt"

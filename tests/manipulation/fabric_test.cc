@@ -233,7 +233,7 @@ int SelfCollisionsInFreeSpace(const FabricParams& params, int rollouts) {
   KinematicsData data = Panda().MakeData();
   std::mt19937_64 rng(21);
   int done = 0, collisions = 0;
-  while (done < rollouts) {
+  for (int trial = 0; trial < 20 * rollouts && done < rollouts; ++trial) {
     const JointVector start = RandomConfiguration(&rng), goal = RandomConfiguration(&rng);
     if (checker.Check(start, &data) != Validity::kValid ||
         checker.Check(goal, &data) != Validity::kValid)
@@ -242,6 +242,7 @@ int SelfCollisionsInFreeSpace(const FabricParams& params, int rollouts) {
     collisions +=
         fabric.Rollout(start, JointVector::Zero(), goal, &ws).status == RolloutStatus::kCollision;
   }
+  EXPECT_EQ(done, rollouts) << "too few valid random configurations";
   return collisions;
 }
 
