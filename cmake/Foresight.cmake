@@ -77,6 +77,12 @@ function(foresight_add_test name)
   endif()
   add_executable(${name} ${exclude} ${ARG_SOURCES})
   target_compile_options(${name} PRIVATE ${FORESIGHT_WARNINGS})
+  # Test sources at -O1 in optimised builds (the code under test is in the libraries, built as
+  # configured): a LibTorch test source compiles in 49 s instead of 67 s at -O3, and GCC still
+  # accepts the -O3 precompiled <torch/torch.h> (it rejects it only at -O0).
+  if(CMAKE_BUILD_TYPE MATCHES "^(Release|RelWithDebInfo)$")
+    target_compile_options(${name} PRIVATE -O1)
+  endif()
   target_link_libraries(${name} PRIVATE ${ARG_DEPS} GTest::gtest GTest::gtest_main)
   set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
   if(NOT builds)

@@ -4,7 +4,8 @@
 # with the shipped fabric and once per setting given, and counts how every candidate's last
 # rollout ended (summary.json candidate_statuses). A candidate that reaches the goal is what a
 # 1-batch solve needs, so the setting with more reaching candidates over the six thesis families
-# is the better fabric. Writes runs/fabric_select/ and results/fabric_select.md.
+# is the better fabric. Writes runs/fabric_select/ and results/fabric_select.md (RESULT=file.md
+# writes that file instead, e.g. to keep an earlier sweep).
 #   experiments/fabric_select.sh "fabric.self={gain: 10, metric: 5, range: 0.05}" ...
 #     (each argument is one setting: key.path=value overrides joined by '+', as select_lib.sh)
 #   ENERGY_MODEL=runs/gfcs_all/model.h5 experiments/fabric_select.sh ...
@@ -18,6 +19,7 @@ FIRST="${FIRST:-1}"
 LAST="${LAST:-50}"
 FAMILIES="table_under_pick box bookshelf_tall cage bookshelf_thin bookshelf_small"
 OUT="$ROOT/runs/fabric_select"
+RESULT="${RESULT:-results/fabric_select.md}"
 cd "$ROOT"
 mkdir -p "$OUT" results
 source experiments/select_lib.sh
@@ -44,7 +46,7 @@ for setting in "${settings[@]}"; do
   printf '%s\n' "${setting:-shipped fabric (the defaults of this build)}" > "$OUT/$index/setting.txt"
   index=$((index + 1))
 done
-python3 - "$OUT" "$index" "$FIRST" "$LAST" "${ENERGY_MODEL:-}" $FAMILIES > results/fabric_select.md <<'PY'
+python3 - "$OUT" "$index" "$FIRST" "$LAST" "${ENERGY_MODEL:-}" $FAMILIES > "$RESULT" <<'PY'
 import json, sys
 out, count, first, last, model = sys.argv[1], int(sys.argv[2]), sys.argv[3], sys.argv[4], sys.argv[5]
 families = sys.argv[6:]
@@ -75,4 +77,4 @@ for i in range(count):
         print(f"| all | {name} | {t[0]}/{t[1]} | " + " | ".join(str(v) for v in t[2:]) + " |")
     print()
 PY
-cat results/fabric_select.md
+cat "$RESULT"

@@ -96,6 +96,8 @@ Fabric::Fabric(const RobotModel& robot, const World& world, const FabricParams& 
                   params.t_max, ")");
   FS_THROW_UNLESS(params.goal_tolerance > 0, "fabric: goal_tolerance must be positive, got ",
                   params.goal_tolerance);
+  FS_THROW_UNLESS(params.via_tolerance > 0, "fabric: via_tolerance must be positive, got ",
+                  params.via_tolerance);
   FS_THROW_UNLESS(params.base_inertia > 0, "fabric: base_inertia must be positive, got ",
                   params.base_inertia);
 }
@@ -189,8 +191,10 @@ bool Fabric::Acceleration(const JointVector& q, const JointVector& qd, const Joi
 
 RolloutResult Fabric::Rollout(const JointVector& q0, const JointVector& qd0,
                               const JointVector& command, FabricWorkspace* ws,
-                              std::vector<JointVector>* path, double stop_beyond_s) const {
+                              std::vector<JointVector>* path, double stop_beyond_s,
+                              CommandRole role) const {
   const FabricParams& p = params_;
+  const double tolerance = role == CommandRole::kVia ? p.via_tolerance : p.goal_tolerance;
   const JointLimits& limits = robot_.limits();
   const int max_steps = static_cast<int>(std::llround(p.t_max / p.dt));
   RolloutResult result;
@@ -212,7 +216,7 @@ RolloutResult Fabric::Rollout(const JointVector& q0, const JointVector& qd0,
       result.status = RolloutStatus::kCollision;
       return result;
     }
-    if ((result.q - command).norm() < p.goal_tolerance) {
+    if ((result.q - command).norm() < tolerance) {
       result.status = RolloutStatus::kReached;
       return result;
     }

@@ -26,7 +26,8 @@
 /// the motion slows down (the thesis's reason why GFCOP solutions keep clear of obstacles).
 ///
 /// Integration (thesis eq. "integrate"): semi-implicit Euler at `dt`; rollout_t is the first time
-/// |q_t - c|_2 < goal_tolerance, capped at t_max. A rollout also stops when a sphere penetrates an
+/// |q_t - c|_2 < goal_tolerance (via_tolerance towards an intermediate command), capped at t_max.
+/// A rollout also stops when a sphere penetrates an
 /// obstacle or another sphere, a joint leaves its limits, or the state becomes non-finite: these
 /// are statuses, never exceptions, and NaN never propagates.
 ///
@@ -79,6 +80,10 @@ struct FabricParams {
   double dt = 0.01;                            ///< integration step (s), thesis 0.01
   double t_max = 7.0;                          ///< time budget per command (s), thesis 7
   double goal_tolerance = 0.05;                ///< epsilon of rollout_t (rad, 2-norm)
+  /// epsilon of rollout_t towards an intermediate command (Rollout(..., kVia)). The thesis has one
+  /// epsilon for every command, so the default equals goal_tolerance; a larger one hands over to
+  /// the next command while still moving (a departure, chosen on validation when changed).
+  double via_tolerance = 0.05;
 
   template <class A>
   void Serialize(A* a) {
@@ -106,6 +111,9 @@ struct FabricParams {
     a->Visit("t_max", &t_max, config::Range::OpenClosed(0.0, 600.0), "time budget per command (s)");
     a->Visit("goal_tolerance", &goal_tolerance, config::Range::Positive(),
              "rollout_t tolerance on |q - command| (rad)");
+    a->Visit(
+        "via_tolerance", &via_tolerance, config::Range::Positive(),
+        "rollout_t tolerance towards an intermediate command (rad; the thesis: goal_tolerance)");
   }
 };
 
@@ -138,7 +146,7 @@ double BarrierMetric(const BarrierParams& p, double x, double xd);
 
 /// How a rollout towards one command ended.
 enum class RolloutStatus {
-  kReached,     ///< |q - command| < goal_tolerance before t_max
+  kReached,     ///< |q - command| < the tolerance (goal_ or via_tolerance) before t_max
   kTimeout,     ///< t_max elapsed; the state at t_max is returned
   kCollision,   ///< a sphere penetrated an obstacle or another sphere
   kJointLimit,  ///< a joint left its limits
@@ -147,6 +155,9 @@ enum class RolloutStatus {
 };
 inline constexpr int kRolloutStatusCount = static_cast<int>(RolloutStatus::kStopped) + 1;
 const char* ToString(RolloutStatus status);
+
+/// What a rollout's command is: the goal (goal_tolerance) or an intermediate one (via_tolerance).
+enum class CommandRole { kGoal, kVia };
 
 struct RolloutResult {
   RolloutStatus status = RolloutStatus::kTimeout;
@@ -197,10 +208,11 @@ class Fabric {
   /// violation or a non-finite state. When `path` is given, every state's q is appended to it
   /// (this allocates; leave it null in optimisation loops). A caller that only needs to know
   /// whether the rollout lasts longer than `stop_beyond_s` gets kStopped at the first step whose
-  /// time exceeds it (the rollout is identical up to there).
+  /// time exceeds it (the rollout is identical up to there). `role` picks rollout_t's tolerance.
   RolloutResult Rollout(const JointVector& q0, const JointVector& qd0, const JointVector& command,
                         FabricWorkspace* ws, std::vector<JointVector>* path = nullptr,
-                        double stop_beyond_s = std::numeric_limits<double>::infinity()) const;
+                        double stop_beyond_s = std::numeric_limits<double>::infinity(),
+                        CommandRole role = CommandRole::kGoal) const;
 
  private:
   const RobotModel& robot_;

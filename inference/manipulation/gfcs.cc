@@ -103,7 +103,9 @@ GfcsCandidate EvaluateCommandSequence(const Fabric& fabric, const GfcsQuery& que
   for (int i = 0; i <= intermediate; ++i) {
     const JointVector command =
         i < intermediate ? JointVector(commands.segment<kDof>(i * kDof)) : query.goal;
-    const RolloutResult r = fabric.Rollout(q, qd, command, ws, path, prune_above - c.time);
+    const RolloutResult r =
+        fabric.Rollout(q, qd, command, ws, path, prune_above - c.time,
+                       i < intermediate ? CommandRole::kVia : CommandRole::kGoal);
     c.time += r.t;
     c.last_status = r.status;
     if (r.status == RolloutStatus::kStopped) {

@@ -9,6 +9,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <random>
 #include <utility>
@@ -328,6 +329,34 @@ TEST(Gfcs, CostIsTheSumOfRolloutTimesPlusThePenaltyOnTimeout) {
   const GfcsCandidate late = EvaluateCommandSequence(hurried, query, mid, 100.0, &ws2);
   EXPECT_FALSE(late.reached);
   EXPECT_NEAR(late.cost, late.time + 100.0, 1e-12);
+}
+
+TEST(Gfcs, IntermediateCommandsUseTheViaTolerance) {
+  const ManipulationProblem problem = SyntheticProblem(3);
+  FabricParams loose;
+  loose.via_tolerance = 0.4;
+  const Fabric fabric(Panda(), problem.world, loose);
+  FabricWorkspace ws = fabric.MakeWorkspace();
+  const GfcsQuery query = QueryOf(problem);
+  const JointVector mid = 0.5 * (problem.start + problem.goal);
+  const GfcsCandidate c = EvaluateCommandSequence(fabric, query, mid, 100.0, &ws);
+  // By hand: the intermediate rollout hands over within 0.4 rad, the goal's within 0.05 rad.
+  const RolloutResult r1 =
+      fabric.Rollout(problem.start, JointVector::Zero(), mid, &ws, nullptr,
+                     std::numeric_limits<double>::infinity(), CommandRole::kVia);
+  ASSERT_EQ(r1.status, RolloutStatus::kReached);
+  EXPECT_LT((r1.q - mid).norm(), 0.4);
+  EXPECT_GE((r1.q - mid).norm(), 0.05);  // it left while still short of the thesis's epsilon
+  EXPECT_GT(r1.qd.norm(), 0.0);          // and still moving
+  const RolloutResult r2 = fabric.Rollout(r1.q, r1.qd, problem.goal, &ws);
+  EXPECT_NEAR(c.time, r1.t + r2.t, 1e-12);
+  if (r2.status == RolloutStatus::kReached) EXPECT_LT((r2.q - problem.goal).norm(), 0.05);
+  // The goal role keeps goal_tolerance: from the start, the intermediate command takes longer.
+  const RolloutResult strict = fabric.Rollout(problem.start, JointVector::Zero(), mid, &ws);
+  EXPECT_GT(strict.t, r1.t);
+  FabricParams bad;
+  bad.via_tolerance = 0;
+  EXPECT_THROW(Fabric(Panda(), problem.world, bad), Error);
 }
 
 TEST(Gfcs, SolveIsDeterministicSortedAndBeatsOrMatchesItsFirstBatch) {
