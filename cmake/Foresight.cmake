@@ -64,6 +64,25 @@ function(foresight_builds_test out)
   set(${out} ${result} PARENT_SCOPE)
 endfunction()
 
+# foresight_test_compile_options(TARGET): how a test source is compiled (also the tests' precompiled
+# header, cmake/TestPch.cmake, which must match).
+function(foresight_test_compile_options target)
+  target_compile_options(${target} PRIVATE ${FORESIGHT_WARNINGS})
+  # Test sources at -O1 in optimised builds (the code under test is in the libraries, built as
+  # configured): a LibTorch test source compiles in 49 s instead of 67 s at -O3, and GCC still
+  # accepts the -O3 precompiled <torch/torch.h> (it rejects it only at -O0).
+  if(CMAKE_BUILD_TYPE MATCHES "^(Release|RelWithDebInfo)$")
+    target_compile_options(${target} PRIVATE -O1)
+  endif()
+  # Sanitizer builds: UBSan instruments the code under test (libraries, apps, fuzz targets), ASan
+  # everything; test sources skip UBSan's instrumentation, which took 5 of the 12 s a test source
+  # needs under Clang 14 (core/rbf_test.cc: 12.0 s -> 6.9 s; -O0 instead would compile in 7 s but
+  # made the sanitizer tests run 1460 s instead of 433 s).
+  if(FORESIGHT_SANITIZE AND NOT FORESIGHT_FUZZ)
+    target_compile_options(${target} PRIVATE -fno-sanitize=undefined)
+  endif()
+endfunction()
+
 # foresight_add_test(NAME SOURCES a_test.cc DEPS lib [PREFIX p.])
 # PREFIX is prepended to the discovered ctest names (so `ctest -R p` selects the binary's tests).
 # A binary this build leaves to another (foresight_builds_test) is defined but neither built by
@@ -76,20 +95,7 @@ function(foresight_add_test name)
     set(exclude EXCLUDE_FROM_ALL)
   endif()
   add_executable(${name} ${exclude} ${ARG_SOURCES})
-  target_compile_options(${name} PRIVATE ${FORESIGHT_WARNINGS})
-  # Test sources at -O1 in optimised builds (the code under test is in the libraries, built as
-  # configured): a LibTorch test source compiles in 49 s instead of 67 s at -O3, and GCC still
-  # accepts the -O3 precompiled <torch/torch.h> (it rejects it only at -O0).
-  if(CMAKE_BUILD_TYPE MATCHES "^(Release|RelWithDebInfo)$")
-    target_compile_options(${name} PRIVATE -O1)
-  endif()
-  # Sanitizer builds: UBSan instruments the code under test (libraries, apps, fuzz targets), ASan
-  # everything; test sources skip UBSan's instrumentation, which took 5 of the 12 s a test source
-  # needs under Clang 14 (core/rbf_test.cc: 12.0 s -> 6.9 s; -O0 instead would compile in 7 s but
-  # made the sanitizer tests run 1460 s instead of 433 s).
-  if(FORESIGHT_SANITIZE AND NOT FORESIGHT_FUZZ)
-    target_compile_options(${name} PRIVATE -fno-sanitize=undefined)
-  endif()
+  foresight_test_compile_options(${name})
   target_link_libraries(${name} PRIVATE ${ARG_DEPS} GTest::gtest GTest::gtest_main)
   set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
   if(NOT builds)
@@ -97,6 +103,7 @@ function(foresight_add_test name)
     file(APPEND ${CMAKE_BINARY_DIR}/tests_left_to_torch_free_build.txt "${name}\n")
     return()
   endif()
+  set_property(GLOBAL APPEND PROPERTY FORESIGHT_BUILT_TESTS ${name})
   gtest_discover_tests(${name}
     WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}
     TEST_PREFIX "${ARG_PREFIX}"
