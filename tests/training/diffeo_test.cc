@@ -6,12 +6,14 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <vector>
 
 #include "core/config.h"
 #include "inference/imitation/eflow.h"
 #include "inference/imitation/template_artifact.h"
 #include "tests/test_util.h"
 #include "training/diffeo/config.h"
+#include "training/diffeo/demos.h"
 #include "training/diffeo/pipeline.h"
 #include "training/run_dir.h"
 
@@ -62,7 +64,28 @@ TEST(DiffeoRun, AnObstacleOnTheGoalIsRefused) {
                                {"s_curve", "covers the goal", "obstacle.fraction"});
 }
 
+TEST(DiffeoDemos, ExcludedDemosAreDroppedAndHeldOutIsRenumbered) {
+  // Both train on demo 1 alone, so they share the normalisation: A's demos are B's 1 and 2.
+  const auto a = imitation::LoadDemos(Tiny({"data.excluded=[0]"}));
+  const auto b = imitation::LoadDemos(Tiny({"data.held_out=[0, 2]"}));
+  ASSERT_EQ(a.size(), 1u);
+  ASSERT_EQ(a[0].demos.demos.size(), 2u);
+  EXPECT_EQ(a[0].train, std::vector<int>{0});
+  EXPECT_EQ(a[0].held_out, std::vector<int>{1});
+  for (std::size_t k = 0; k < 2; ++k) {
+    EXPECT_EQ(a[0].demos.demos[k].position, b[0].demos.demos[k + 1].position) << k;
+    EXPECT_EQ(a[0].demos.demos[k].velocity, b[0].demos.demos[k + 1].velocity) << k;
+  }
+  testing::ExpectErrorContains([] { imitation::LoadDemos(Tiny({"data.excluded=[3]"})); },
+                               {"s_curve", "data.excluded", "demo 3", "3 demos"});
+  testing::ExpectErrorContains([] { imitation::LoadDemos(Tiny({"data.excluded=[0, 1]"})); },
+                               {"s_curve", "no demo left to train on"});
+}
+
 TEST(DiffeoConfig, RulesAcrossKeysNameTheKey) {
+  testing::ExpectErrorContains([] { Tiny({"data.excluded=[2]"}); },
+                               {"demo 2", "data.held_out", "data.excluded"});
+  testing::ExpectErrorContains([] { Tiny({"data.excluded=[-1]"}); }, {"data.excluded", "negative"});
   testing::ExpectErrorContains([] { Tiny({"data.held_out=[1, 1]"}); }, {"data.held_out", "twice"});
   testing::ExpectErrorContains([] { Tiny({"obstacle.times=[0.004, 0.002]"}); },
                                {"obstacle.times", "not increasing"});

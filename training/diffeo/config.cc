@@ -16,6 +16,13 @@ void ExperimentConfig::Validate(const std::string& source) const {
     FS_THROW_UNLESS(i >= 0, source, ": data.held_out: ", i, " is negative");
     FS_THROW_UNLESS(held.insert(i).second, source, ": data.held_out: ", i, " listed twice");
   }
+  std::set<int> excluded;
+  for (int i : data.excluded) {
+    FS_THROW_UNLESS(i >= 0, source, ": data.excluded: ", i, " is negative");
+    FS_THROW_UNLESS(excluded.insert(i).second, source, ": data.excluded: ", i, " listed twice");
+    FS_THROW_UNLESS(held.count(i) == 0, source, ": demo ", i,
+                    " is in both data.held_out and data.excluded");
+  }
   const auto check_list = [&](const std::vector<double>& v, const char* key) {
     FS_THROW_UNLESS(!v.empty(), source, ": ", key, ": empty list");
     for (std::size_t i = 0; i < v.size(); ++i) {

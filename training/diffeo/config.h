@@ -29,6 +29,9 @@ struct DataConfig {
   int task_demos = 7;               ///< thesis: 7 (push box), 8 (lift box)
   int downsample = 4;               ///< keep every n-th sample (LASA has 1000 per demo)
   std::vector<int> held_out{5, 6};  ///< demo indices not trained on (evaluated from their starts)
+  /// Demo indices dropped before anything reads them: a validation run leaves the test demos
+  /// (held_out of the report run) out entirely and holds out one of the rest instead.
+  std::vector<int> excluded;
   double goal_tolerance = 0.02;  ///< refuse demos whose final points spread more than this x extent
   double half_range = 0.5;       ///< positions normalised into [-half_range, half_range]
 
@@ -53,6 +56,8 @@ struct DataConfig {
     a->Visit("task_demos", &task_demos, Range::Closed(2, 1000), "task-space demos");
     a->Visit("downsample", &downsample, Range::Closed(1, 1000), "keep every n-th sample");
     a->Visit("held_out", &held_out, Range::Any(), "demo indices held out of training");
+    a->Visit("excluded", &excluded, Range::Any(),
+             "demo indices never read (validation runs exclude the test demos)");
     a->Visit("goal_tolerance", &goal_tolerance, Range::Closed(0, 1),
              "largest spread of the demos' final points, as a share of their extent");
     a->Visit("half_range", &half_range, Range::Positive(),

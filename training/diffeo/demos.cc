@@ -10,21 +10,41 @@
 namespace foresight::imitation {
 namespace {
 
-PreparedDemos Prepare(const ExperimentConfig& c, const DemoSet& raw) {
+bool Contains(const std::vector<int>& v, int i) {
+  return std::find(v.begin(), v.end(), i) != v.end();
+}
+
+/// `all` without the demos of data.excluded (dropped before anything reads them), and data.held_out
+/// renumbered into the kept demos.
+DemoSet WithoutExcluded(const ExperimentConfig& c, const DemoSet& all, std::vector<int>* held_out) {
+  const int n = static_cast<int>(all.demos.size());
+  for (const auto& [key, ids] :
+       {std::pair{"data.held_out", &c.data.held_out}, std::pair{"data.excluded", &c.data.excluded}})
+    for (int i : *ids)
+      FS_THROW_UNLESS(i < n, all.name, ": ", key, ": demo ", i, " does not exist (", n, " demos)");
+  DemoSet kept{all.name, all.dimension, {}};
+  held_out->clear();
+  for (int i = 0; i < n; ++i) {
+    if (Contains(c.data.excluded, i)) continue;
+    if (Contains(c.data.held_out, i)) held_out->push_back(static_cast<int>(kept.demos.size()));
+    kept.demos.push_back(all.demos[static_cast<std::size_t>(i)]);
+  }
+  FS_THROW_UNLESS(kept.demos.size() > held_out->size(), all.name,
+                  ": no demo left to train on after data.excluded and data.held_out (", n,
+                  " demos)");
+  return kept;
+}
+
+PreparedDemos Prepare(const ExperimentConfig& c, const DemoSet& all) {
+  std::vector<int> held_out;
+  const DemoSet raw = WithoutExcluded(c, all, &held_out);
   PreparedDemos p;
   p.name = raw.name;
   p.spread = CheckDemonstrations(raw, c.data.goal_tolerance);
   const int n = static_cast<int>(raw.demos.size());
-  for (int i : c.data.held_out)
-    FS_THROW_UNLESS(i < n, raw.name, ": data.held_out: demo ", i, " does not exist (", n,
-                    " demos)");
-  const auto [train_set, held_set] = SplitByDemo(raw, c.data.held_out);
+  const auto [train_set, held_set] = SplitByDemo(raw, held_out);
   (void)held_set;
-  for (int i = 0; i < n; ++i)
-    (std::find(c.data.held_out.begin(), c.data.held_out.end(), i) == c.data.held_out.end()
-         ? p.train
-         : p.held_out)
-        .push_back(i);
+  for (int i = 0; i < n; ++i) (Contains(held_out, i) ? p.held_out : p.train).push_back(i);
   p.norm = FitNormalisation(train_set, c.data.half_range);
   p.demos = ApplyNormalisation(Downsample(raw, c.data.downsample), p.norm);
   return p;

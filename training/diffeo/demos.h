@@ -13,10 +13,10 @@ namespace foresight::imitation {
 /// One shape (or task) ready to train on: every demo normalised by the training demos' goal and
 /// extent (x_n = (x - offset) * scale, goal at the origin), downsampled as configured.
 struct PreparedDemos {
-  std::string name;                  ///< shape or task name (also the file stem of its artifacts)
-  DemoSet demos;                     ///< normalised, all demos in their original order
-  DemoNormalisation norm;            ///< fitted on the training demos
-  std::vector<int> train, held_out;  ///< demo indices
+  std::string name;        ///< shape or task name (also the file stem of its artifacts)
+  DemoSet demos;           ///< normalised; every demo not in data.excluded, in their original order
+  DemoNormalisation norm;  ///< fitted on the training demos
+  std::vector<int> train, held_out;  ///< indices into `demos`
   GoalSpread spread;                 ///< of the raw demos
 };
 
