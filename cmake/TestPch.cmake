@@ -1,7 +1,8 @@
 # One precompiled header of what the LibTorch-free tests share: GoogleTest, Eigen and the standard
 # headers they include most (cmake/test_pch.h). Parsing those is most of a test source's compile.
-# Tests that link LibTorch keep what cmake/TorchPch.cmake gives them. -DFORESIGHT_UNITY_BUILD=OFF (the fuzz build) turns
-# it off with the unity build, so that build still checks each test source includes what it uses.
+# Tests that link LibTorch keep what cmake/TorchPch.cmake gives them. The header is included into
+# every test source, so a test that forgets a standard include still compiles here; a build with
+# # -DFORESIGHT_UNITY_BUILD=OFF compiles the tests without it (no CI build does that today).
 #
 # The header's target is compiled exactly as foresight_add_test compiles a test source (warnings,
 # -O1, the sanitizer build's -fno-sanitize=undefined), so GCC and Clang accept it in every test.
@@ -23,7 +24,7 @@ function(foresight_use_test_pch)
     get_target_property(reuses ${test} PRECOMPILE_HEADERS_REUSE_FROM)
     if(NOT reuses AND NOT links_torch)
       target_precompile_headers(${test} REUSE_FROM foresight_test_pch)
-      target_compile_options(${test} PRIVATE -Winvalid-pch)  # a rejected header becomes a warning
+      target_compile_options(${test} PRIVATE -Winvalid-pch)  # GCC: say when it rejects the header
     endif()
   endforeach()
 endfunction()

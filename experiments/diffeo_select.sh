@@ -56,7 +56,7 @@ for setting in "${settings[@]}"; do
   index=$((index + 1))
 done
 [ ${#pids[@]} = 0 ] || wait_all "${pids[@]}"
-python3 - "$OUT" "$index" > "$RESULT" <<'PY'
+python3 - "$OUT" "$index" > "$RESULT.tmp" <<'PY'
 import json, sys
 out, count = sys.argv[1], int(sys.argv[2])
 rows = []
@@ -76,7 +76,7 @@ print("# Imitation flow settings chosen on validation demonstrations "
 print(f"{len(shapes)} LASA shapes, trained on demos 0-3, scored from demo 4's start (validation) and from "
       "the training starts; demos 5 and 6 (the report's test) excluded. Rule fixed in advance: the lowest "
       "mean validation Frechet distance, a setting within 0.002 with fewer Euler steps preferred.\n")
-print("| setting | Euler steps | validation F.D. (demo 4) | F.D. from the training starts | grid reach | worst shape (val) | run time (s) |")
+print("| setting | Euler steps | validation F.D. (demo 4) | F.D. from the training starts | grid reach | worst shape (val) | run time (s; the first row includes EFlow) |")
 print("|---|---|---|---|---|---|---|")
 for setting, seconds, steps, ev in rows:
     m = ev["mean"]
@@ -96,4 +96,5 @@ for s in shapes:
     ef = rows[0][3]["shapes"][s].get("eflow_frechet_heldout")
     print(f"| {s} | " + " | ".join(cells) + f" | {'' if ef is None else f'{ef:.3f}'} |")
 PY
+mv "$RESULT.tmp" "$RESULT"
 cat "$RESULT"

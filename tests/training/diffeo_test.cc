@@ -72,6 +72,7 @@ TEST(DiffeoDemos, ExcludedDemosAreDroppedAndHeldOutIsRenumbered) {
   ASSERT_EQ(a[0].demos.demos.size(), 2u);
   EXPECT_EQ(a[0].train, std::vector<int>{0});
   EXPECT_EQ(a[0].held_out, std::vector<int>{1});
+  EXPECT_EQ(a[0].original, (std::vector<int>{1, 2}));
   for (std::size_t k = 0; k < 2; ++k) {
     EXPECT_EQ(a[0].demos.demos[k].position, b[0].demos.demos[k + 1].position) << k;
     EXPECT_EQ(a[0].demos.demos[k].velocity, b[0].demos.demos[k + 1].velocity) << k;

@@ -1,6 +1,7 @@
 #include "training/diffeo/demos.h"
 
 #include <algorithm>
+#include <string>
 
 #include "core/error.h"
 #include "datasets/data_root.h"
@@ -14,9 +15,10 @@ bool Contains(const std::vector<int>& v, int i) {
   return std::find(v.begin(), v.end(), i) != v.end();
 }
 
-/// `all` without the demos of data.excluded (dropped before anything reads them), and data.held_out
-/// renumbered into the kept demos.
-DemoSet WithoutExcluded(const ExperimentConfig& c, const DemoSet& all, std::vector<int>* held_out) {
+/// `all` without the demos of data.excluded (dropped before anything reads them), data.held_out
+/// renumbered into the kept demos, and each kept demo's index in `all`.
+DemoSet WithoutExcluded(const ExperimentConfig& c, const DemoSet& all, std::vector<int>* held_out,
+                        std::vector<int>* original) {
   const int n = static_cast<int>(all.demos.size());
   for (const auto& [key, ids] :
        {std::pair{"data.held_out", &c.data.held_out}, std::pair{"data.excluded", &c.data.excluded}})
@@ -24,10 +26,12 @@ DemoSet WithoutExcluded(const ExperimentConfig& c, const DemoSet& all, std::vect
       FS_THROW_UNLESS(i < n, all.name, ": ", key, ": demo ", i, " does not exist (", n, " demos)");
   DemoSet kept{all.name, all.dimension, {}};
   held_out->clear();
+  original->clear();
   for (int i = 0; i < n; ++i) {
     if (Contains(c.data.excluded, i)) continue;
     if (Contains(c.data.held_out, i)) held_out->push_back(static_cast<int>(kept.demos.size()));
     kept.demos.push_back(all.demos[static_cast<std::size_t>(i)]);
+    original->push_back(i);
   }
   FS_THROW_UNLESS(kept.demos.size() > held_out->size(), all.name,
                   ": no demo left to train on after data.excluded and data.held_out (", n,
@@ -37,10 +41,18 @@ DemoSet WithoutExcluded(const ExperimentConfig& c, const DemoSet& all, std::vect
 
 PreparedDemos Prepare(const ExperimentConfig& c, const DemoSet& all) {
   std::vector<int> held_out;
-  const DemoSet raw = WithoutExcluded(c, all, &held_out);
   PreparedDemos p;
+  const DemoSet raw = WithoutExcluded(c, all, &held_out, &p.original);
   p.name = raw.name;
-  p.spread = CheckDemonstrations(raw, c.data.goal_tolerance);
+  try {
+    p.spread = CheckDemonstrations(raw, c.data.goal_tolerance);
+  } catch (const Error& e) {
+    if (c.data.excluded.empty()) throw;
+    std::string kept;
+    for (int i : p.original) kept += (kept.empty() ? "" : ", ") + std::to_string(i);
+    Fail(e.what(), " (demo numbers count the demos kept after data.excluded: the data's [", kept,
+         "])");
+  }
   const int n = static_cast<int>(raw.demos.size());
   const auto [train_set, held_set] = SplitByDemo(raw, held_out);
   (void)held_set;

@@ -17,7 +17,8 @@ struct PreparedDemos {
   DemoSet demos;           ///< normalised; every demo not in data.excluded, in their original order
   DemoNormalisation norm;  ///< fitted on the training demos
   std::vector<int> train, held_out;  ///< indices into `demos`
-  GoalSpread spread;                 ///< of the raw demos
+  std::vector<int> original;  ///< each demo's index in the data (differs after data.excluded)
+  GoalSpread spread;          ///< of the raw demos
 };
 
 /// Reads the demonstrations the config names (every LASA shape asked for, one synthetic family,

@@ -147,8 +147,9 @@ Scores EvaluateTaskSpaceShape(const ExperimentConfig& c, const PreparedDemos& de
     const Eigen::Vector3d x0 =
         tn.ToWorld(demos.demos.demos[static_cast<std::size_t>(i)].position.col(0));
     ArmVector q;
-    FS_THROW_UNLESS(InverseKinematics(chain, x0, seed_q, &q, 1e-6, 500), demos.name, ": demo ", i,
-                    " starts at ", x0.transpose(), " m, which the arm does not reach");
+    FS_THROW_UNLESS(InverseKinematics(chain, x0, seed_q, &q, 1e-6, 500), demos.name, ": demo ",
+                    demos.original[static_cast<std::size_t>(i)], " starts at ", x0.transpose(),
+                    " m, which the arm does not reach");
     starts.push_back(q);
   }
   Scores s;
