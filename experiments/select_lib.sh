@@ -5,7 +5,11 @@ wait_all() {  # waits for every given process; when one failed, stops the others
   local pid
   for pid in "$@"; do
     wait "$pid" || {
-      kill "$@" 2> /dev/null || true
+      local other
+      for other in "$@"; do  # the runs' own processes too (children of background subshells)
+        pkill -P "$other" 2> /dev/null || true
+        kill "$other" 2> /dev/null || true
+      done
       echo "a run failed (see $OUT/*.out)" >&2
       exit 1
     }
