@@ -2,7 +2,7 @@
 # headers they include most (cmake/test_pch.h). Parsing those is most of a test source's compile.
 # Tests that link LibTorch keep what cmake/TorchPch.cmake gives them. The header is included into
 # every test source, so a test that forgets a standard include still compiles here; a build with
-# # -DFORESIGHT_UNITY_BUILD=OFF compiles the tests without it (no CI build does that today).
+# -DFORESIGHT_UNITY_BUILD=OFF compiles the tests without it (no CI build does that today).
 #
 # The header's target is compiled exactly as foresight_add_test compiles a test source (warnings,
 # -O1, the sanitizer build's -fno-sanitize=undefined), so GCC and Clang accept it in every test.

@@ -29,9 +29,9 @@ settings=("" "$@")
 threads=()
 [ "${PARALLEL:-0}" != 1 ] || threads=(train.threads=1 eflow.train.threads=1)
 run_setting() {  # INDEX SETTING
-  local run="$OUT/$1" eflow=eflow.enabled=false start
+  local run="$OUT/$1" label="${2:-shipped settings (configs/diffeo/lasa.yaml)}" eflow=eflow.enabled=false start
   if [ "${RESUME:-0}" = 1 ] && [ -f "$run/setting.txt" ] &&
-    [ "$(sed -n '1p;3p' "$run/setting.txt")" = "$(printf '%s\n%s' "${2:-shipped settings (configs/diffeo/lasa.yaml)}" "$SHAPES")" ]; then
+    [ "$(sed -n '1p;3p' "$run/setting.txt")" = "$(printf '%s\n%s' "$label" "$SHAPES")" ]; then
     return 0  # finished before with this setting and these shapes
   fi
   mapfile -t setting_overrides < <(overrides "$2")
@@ -41,8 +41,7 @@ run_setting() {  # INDEX SETTING
   "$BIN" train configs/diffeo/lasa.yaml "${validation[@]}" "$eflow" "${threads[@]}" \
     "${setting_overrides[@]}" --run-dir "$run" > "$run.out" 2>&1 ||
     { tail -n 20 "$run.out" >&2; echo "failed: see $run.out" >&2; return 1; }
-  printf '%s\n%s\n%s\n' "${2:-shipped settings (configs/diffeo/lasa.yaml)}" "$(($(date +%s) - start))" \
-    "$SHAPES" > "$run/setting.txt"
+  printf '%s\n%s\n%s\n' "$label" "$(($(date +%s) - start))" "$SHAPES" > "$run/setting.txt"
 }
 pids=()
 index=0
@@ -78,10 +77,11 @@ print(f"{len(shapes)} LASA shapes, trained on demos 0-3, scored from demo 4's st
       "mean validation Frechet distance, a setting within 0.002 with fewer Euler steps preferred.\n")
 print("| setting | Euler steps | validation F.D. (demo 4) | F.D. from the training starts | grid reach | worst shape (val) | run time (s; the first row includes EFlow) |")
 print("|---|---|---|---|---|---|---|")
-for setting, seconds, steps, ev in rows:
+for row in rows:
+    setting, seconds, steps, ev = row
     m = ev["mean"]
     worst = max(shapes, key=lambda s: ev["shapes"][s]["frechet_heldout"])
-    mark = " **chosen**" if (setting, seconds) == (chosen[0], chosen[1]) else ""
+    mark = " **chosen**" if row is chosen else ""
     print(f"| {setting}{mark} | {steps} | {m['frechet_heldout']:.4f} | {m['frechet']:.4f} | "
           f"{m['grid_reach_rate']:.3f} | {worst} {ev['shapes'][worst]['frechet_heldout']:.3f} | {seconds} |")
 m = rows[0][3]["mean"]

@@ -15,34 +15,31 @@ bool Contains(const std::vector<int>& v, int i) {
   return std::find(v.begin(), v.end(), i) != v.end();
 }
 
-/// `all` without the demos of data.excluded (dropped before anything reads them), data.held_out
-/// renumbered into the kept demos, and each kept demo's index in `all`.
-DemoSet WithoutExcluded(const ExperimentConfig& c, const DemoSet& all, std::vector<int>* held_out,
-                        std::vector<int>* original) {
+/// `all` without the demos of data.excluded (dropped before anything reads them); fills p's train,
+/// held_out (indices into the kept demos) and original (each kept demo's index in `all`).
+DemoSet WithoutExcluded(const ExperimentConfig& c, const DemoSet& all, PreparedDemos* p) {
   const int n = static_cast<int>(all.demos.size());
   for (const auto& [key, ids] :
        {std::pair{"data.held_out", &c.data.held_out}, std::pair{"data.excluded", &c.data.excluded}})
     for (int i : *ids)
       FS_THROW_UNLESS(i < n, all.name, ": ", key, ": demo ", i, " does not exist (", n, " demos)");
   DemoSet kept{all.name, all.dimension, {}};
-  held_out->clear();
-  original->clear();
   for (int i = 0; i < n; ++i) {
     if (Contains(c.data.excluded, i)) continue;
-    if (Contains(c.data.held_out, i)) held_out->push_back(static_cast<int>(kept.demos.size()));
+    const int k = static_cast<int>(kept.demos.size());
+    (Contains(c.data.held_out, i) ? p->held_out : p->train).push_back(k);
     kept.demos.push_back(all.demos[static_cast<std::size_t>(i)]);
-    original->push_back(i);
+    p->original.push_back(i);
   }
-  FS_THROW_UNLESS(kept.demos.size() > held_out->size(), all.name,
+  FS_THROW_UNLESS(!p->train.empty(), all.name,
                   ": no demo left to train on after data.excluded and data.held_out (", n,
                   " demos)");
   return kept;
 }
 
 PreparedDemos Prepare(const ExperimentConfig& c, const DemoSet& all) {
-  std::vector<int> held_out;
   PreparedDemos p;
-  const DemoSet raw = WithoutExcluded(c, all, &held_out, &p.original);
+  const DemoSet raw = WithoutExcluded(c, all, &p);
   p.name = raw.name;
   try {
     p.spread = CheckDemonstrations(raw, c.data.goal_tolerance);
@@ -53,10 +50,8 @@ PreparedDemos Prepare(const ExperimentConfig& c, const DemoSet& all) {
     Fail(e.what(), " (demo numbers count the demos kept after data.excluded: the data's [", kept,
          "])");
   }
-  const int n = static_cast<int>(raw.demos.size());
-  const auto [train_set, held_set] = SplitByDemo(raw, held_out);
+  const auto [train_set, held_set] = SplitByDemo(raw, p.held_out);
   (void)held_set;
-  for (int i = 0; i < n; ++i) (Contains(held_out, i) ? p.held_out : p.train).push_back(i);
   p.norm = FitNormalisation(train_set, c.data.half_range);
   p.demos = ApplyNormalisation(Downsample(raw, c.data.downsample), p.norm);
   return p;
