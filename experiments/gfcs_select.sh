@@ -10,27 +10,45 @@
 #   SHARES="0.25 0.5" experiments/gfcs_select.sh
 #   RUN=runs/gfcs_all FIRST=1 LAST=50 experiments/gfcs_select.sh   (another model, other problems;
 #     on the model's own training problems the comparison favours share 0)
-# About 20 minutes on 2 cores (the loop 15, the comparison 3).
+#   SHARES= RESULT=results/gfcs_select_loop.md experiments/gfcs_select.sh "loop.batches=30+loop.adam_steps=800"
+#     (each argument is a setting of the loop's training, key.path=value overrides joined by '+' as
+#      select_lib.sh: a loop per setting is trained on the same problems (RUN_<n>, reused when it
+#      was trained with that setting) and its learned sampler compared beside the shipped loop's)
+# About 20 minutes on 2 cores (the loop 15, the comparison 3), plus a loop per setting.
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BIN="${FORESIGHT_BIN:-$ROOT/build/bin/foresight}"
-SHARES="${SHARES:-0.25 0.5}"
+SHARES="${SHARES-0.25 0.5}"
 FIRST="${FIRST:-41}"
 LAST="${LAST:-50}"
 RUN="${RUN:-$ROOT/runs/gfcs_select_loop_1-$((FIRST - 1))}"
+RESULT="${RESULT:-results/gfcs_select.md}"
 FAMILIES="table_under_pick box bookshelf_tall cage bookshelf_thin bookshelf_small"
 OUT="$ROOT/runs/gfcs_select"
 cd "$ROOT"
 mkdir -p "$OUT" results runs "$(dirname "$RUN")"
 fail() { tail -n 30 "$1" >&2; echo "failed: see $1" >&2; exit 1; }
-if [ ! -f "$RUN/model.h5" ]; then
+source experiments/select_lib.sh
+train_loop() {  # RUN_DIR SETTING: trains the loop on problems 1..FIRST-1 unless RUN_DIR has it
+  local run="$1" setting="$2"
+  local stamp="problems 1-$((FIRST - 1)): $setting"
+  if [ -f "$run/model.h5" ] && [ "$(cat "$run/setting.txt" 2> /dev/null)" = "$stamp" ]; then return; fi
   [ "$FIRST" -gt 1 ] || { echo "FIRST=$FIRST: no problems before it to train the loop on" >&2; exit 1; }
-  train=""
+  local train="" f
   for f in $FAMILIES; do train+="${train:+, }{family: ${f}_panda, first: 1, last: $((FIRST - 1))}"; done
-  rm -rf "$RUN"
-  "$BIN" train configs/gfcs/all_families.yaml --run-dir "$RUN" --no-eval "train_problems=[$train]" \
-    > "$RUN.out" 2>&1 || fail "$RUN.out"
-fi
+  local setting_overrides
+  mapfile -t setting_overrides < <(overrides "$setting")
+  rm -rf "$run"
+  "$BIN" train configs/gfcs/all_families.yaml --run-dir "$run" --no-eval "train_problems=[$train]" \
+    "${setting_overrides[@]}" > "$run.out" 2>&1 || fail "$run.out"
+  printf '%s' "$stamp" > "$run/setting.txt"
+}
+# The shipped loop (unless RUN has a model) and a loop per setting, side by side.
+pids=()
+if [ ! -f "$RUN/model.h5" ]; then train_loop "$RUN" "" & pids+=($!); fi
+settings=("$@")
+for i in "${!settings[@]}"; do train_loop "${RUN}_$((i + 1))" "${settings[$i]}" & pids+=($!); done
+[ ${#pids[@]} -eq 0 ] || wait_all "${pids[@]}"
 # A reused model must not have trained on the problems compared here.
 python3 - "$RUN/config.yaml" "$FIRST" <<'PY' || exit 1
 import sys, yaml
@@ -54,14 +72,27 @@ for f in $FAMILIES; do
   "$BIN" plan "configs/manipulation/$f.yaml" --problems "$FIRST-$LAST" "methods=[$methods]" \
     "energy_model=$RUN/model.h5" "sgld.particles=$PARTICLES" "sgld.steps=$STEPS" "sgld.step_scale=$SCALE" \
     plot_problems=0 --run-dir "$OUT/$f" > "$OUT/$f.out" 2>&1 || fail "$OUT/$f.out"
+  for i in "${!settings[@]}"; do  # each setting's learned sampler, same problems and seeds
+    run="$OUT/loop_$((i + 1))/$f"
+    mkdir -p "$(dirname "$run")"
+    rm -rf "$run"
+    "$BIN" plan "configs/manipulation/$f.yaml" --problems "$FIRST-$LAST" \
+      "methods=[{name: \"learned [loop $((i + 1))]\", kind: gfcs, batches: 1, sampler: learned}]" \
+      "energy_model=${RUN}_$((i + 1))/model.h5" "sgld.particles=$PARTICLES" "sgld.steps=$STEPS" \
+      "sgld.step_scale=$SCALE" plot_problems=0 --run-dir "$run" > "$run.out" 2>&1 || fail "$run.out"
+  done
 done
-python3 - "$OUT" "$FIRST" "$LAST" "$RUN" $FAMILIES > results/gfcs_select.md <<'PY'
-import csv, sys
-out, first, last, run, families = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4], sys.argv[5:]
+SETTINGS="$(printf '%s\n' "${settings[@]}")" \
+  python3 - "$OUT" "$FIRST" "$LAST" "$RUN" "${#settings[@]}" $FAMILIES > "$RESULT.tmp" <<'PY'
+import csv, os, sys
+out, first, last, run = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4]
+n_settings, families = int(sys.argv[5]), sys.argv[6:]
+settings = os.environ["SETTINGS"].splitlines()[:n_settings]
 rows, totals = [], {}
 for fam in families:
     per = {}
-    for r in csv.DictReader(open(f"{out}/{fam}/problems.csv")):
+    dirs = [f"{out}/{fam}"] + [f"{out}/loop_{i}/{fam}" for i in range(1, n_settings + 1)]
+    for r in (r for d in dirs for r in csv.DictReader(open(f"{d}/problems.csv"))):
         m = per.setdefault(r["method"], {"n": 0, "ok": 0, "cost": 0.0, "errors": 0})
         m["n"] += 1
         m["ok"] += int(r["success"])
@@ -74,13 +105,19 @@ for fam in families:
             t[k] += m[k]
     rows.append((fam, per))
 names = list(totals)
-print("# Learned sampler: share of its first batch drawn uniformly, chosen on development problems "
-      "(generated by experiments/gfcs_select.sh)\n")
+print("# Learned sampler: its first batch's uniform share and the loop's training settings, chosen "
+      "on development problems (generated by experiments/gfcs_select.sh)\n")
 print(f"Problems {first}-{last} of each family, GFCS with 1 batch of 20, energy model "
       f"`{run}/model.h5` (by default a loop on problems 1-{int(first) - 1}: these are new to it). "
       "Success = solved problems; cost = mean GFCOP cost of the best candidate (s; an unsolved "
-      "problem carries the penalty M = 100 s). Rule: the share with the most successes over all "
-      "families, ties to the lower mean cost; the held-out problems 51-75 are not read.\n")
+      "problem carries the penalty M = 100 s). Rule: the share (or loop setting) with the most "
+      "successes over all families, ties to the lower mean cost; the held-out problems 51-75 are "
+      "not read.\n")
+for i, setting in enumerate(settings, 1):
+    print(f"- `learned [loop {i}]`: the same loop trained with `{setting}` "
+          f"(`{run}_{i}/model.h5`), sampled with the shipped loop's SGLD settings")
+if settings:
+    print()
 print("| family | " + " | ".join(f"{n}: success / cost" for n in names) + " |")
 print("|---|" + "---|" * len(names))
 for fam, per in rows:
@@ -92,9 +129,16 @@ print("| all | " + " | ".join(cells) + " |")
 errors = {n: t["errors"] for n, t in totals.items() if t["errors"]}
 if errors:
     print(f"\nErrored attempts (counted as unsolved, cost M): {errors}.")
-learned = [n for n in names if n.startswith("learned")]
-best = max(learned, key=lambda n: (totals[n]["ok"], -totals[n]["cost"]))
-share = best.split("+")[1] if "+" in best else "0"
-print(f"\nChosen: `eval.uniform_share: {share}` ({best}).")
+key = lambda n: (totals[n]["ok"], -totals[n]["cost"])
+shares = [n for n in names if n == "learned" or n.startswith("learned+")]
+if len(shares) > 1:
+    best = max(shares, key=key)
+    share = best.split("+")[1] if "+" in best else "0"
+    print(f"\nChosen: `eval.uniform_share: {share}` ({best}).")
+loops = [n for n in names if n == "learned" or n.startswith("learned [")]
+if len(loops) > 1:  # the shipped loop wins ties (listed first; max keeps the first maximum)
+    best = max(loops, key=key)
+    print(f"\nLoop setting chosen by the same rule (the shipped loop's `learned` wins ties): {best}.")
 PY
-cat results/gfcs_select.md
+mv "$RESULT.tmp" "$RESULT"
+cat "$RESULT"

@@ -26,8 +26,9 @@ run() {  # run DIR CONFIG [key=value ...]
 
 # 1. The validation sweep (eval.plots off), fixed in advance: the thesis's settings (M = 15, Q = 4,
 #    l_H = 50, Normal), the Laplace family, narrower and fewer basis functions (less independent
-#    per-weight noise in the samples), more components, dropout and other l_H. The choice reads
-#    only the val_* figures (experiments/otnet_select.py: the lowest val_frechet).
+#    per-weight noise in the samples), more components, dropout and other l_H; added after that
+#    sweep: its choice trained on the training maps' 8 orientations (data.augment, ~8x the time).
+#    The choice reads only the val_* figures (experiments/otnet_select.py: the lowest val_frechet).
 while read -r name overrides; do
   [[ -z "$name" || "$name" == \#* ]] && continue
   dir="runs/otnet_sweep/$name"
@@ -46,6 +47,7 @@ m10_g150_q16_drop      otnet.basis=10 otnet.basis_gamma=150 otnet.components=16 
 m10_g150_q32           otnet.basis=10 otnet.basis_gamma=150 otnet.components=32
 m10_g150_q16_lh200     otnet.basis=10 otnet.basis_gamma=150 otnet.components=16 otnet.length_scale=200
 m8_g100_q16            otnet.basis=8 otnet.basis_gamma=100 otnet.components=16
+m8_g100_q16_dihedral   otnet.basis=8 otnet.basis_gamma=100 otnet.components=16 data.augment=dihedral
 SWEEP
 chosen=$(python3 experiments/otnet_select.py runs/otnet_sweep)
 echo "chosen on validation: $chosen"

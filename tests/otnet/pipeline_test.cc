@@ -1,8 +1,10 @@
 // OTNet's pipeline pieces against independent computations: the pruned MTD equals the brute-force
-// mean minimum distance; the greedy farthest-point database; and the pipeline on synthetic data.
+// mean minimum distance; the greedy farthest-point database; the symmetric copies of the training
+// maps; and the pipeline on synthetic data.
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 
 #include "datasets/synthetic_rooms.h"
@@ -93,6 +95,114 @@ TEST(OtnetPipeline, BorderOpeningsAreTheLongestFreeRunsOfTheBorder) {
   BinaryGrid closed(6, 6);
   for (auto& v : closed.cells) v = 1;
   EXPECT_TRUE(BorderOpenings(closed, 2).empty());
+}
+
+// A 6 x 6 map with no symmetry of its own (an L of walls and one pillar off the diagonals) and a
+// trajectory through free cells at cell centres and off-centre points.
+MapTrajectories AsymmetricMap() {
+  MapTrajectories m;
+  m.id = "asym";
+  m.map = BinaryGrid(6, 6);
+  for (int c = 0; c < 6; ++c) m.map.at(0, c) = 1;
+  for (int r = 0; r < 6; ++r) m.map.at(r, 0) = 1;
+  m.map.at(3, 4) = 1;
+  Eigen::MatrixX2d t(4, 2);
+  t << 1.5, 1.5, 2.25, 3.75, 3.1, 4.9, 5.6, 2.2;
+  m.trajectories = {t};
+  return m;
+}
+
+TEST(OtnetAugment, EverySymmetryKeepsEachWaypointInTheImageOfItsCell) {
+  const MapTrajectories m = AsymmetricMap();
+  std::vector<std::vector<std::uint8_t>> seen;
+  for (int s = 0; s < 8; ++s) {
+    int dropped = 0;
+    const MapTrajectories t = TransformMap(m, s, &dropped);
+    EXPECT_EQ(dropped, 0);
+    EXPECT_EQ(t.map.CountOccupied(), m.map.CountOccupied());
+    ASSERT_EQ(t.trajectories.size(), 1u);
+    // By hand: the cell of (x, y) after the swap (y, x) and the reflections n - x, n - y.
+    const Eigen::MatrixX2d& a = m.trajectories[0];
+    const Eigen::MatrixX2d& b = t.trajectories[0];
+    for (Eigen::Index k = 0; k < a.rows(); ++k) {
+      double x = a(k, 0), y = a(k, 1);
+      if (s & 4) std::swap(x, y);
+      if (s & 1) x = 6 - x;
+      if (s & 2) y = 6 - y;
+      EXPECT_DOUBLE_EQ(b(k, 0), x);
+      EXPECT_DOUBLE_EQ(b(k, 1), y);
+      EXPECT_FALSE(t.map.OccupiedAt(x, y));
+    }
+    // Every cell of the copy holds the value of its preimage.
+    for (int r = 0; r < 6; ++r)
+      for (int c = 0; c < 6; ++c) {
+        int x = s & 4 ? r : c, y = s & 4 ? c : r;
+        if (s & 1) x = 5 - x;
+        if (s & 2) y = 5 - y;
+        EXPECT_EQ(t.map.at(y, x), m.map.at(r, c)) << "s " << s << " cell " << r << ", " << c;
+      }
+    seen.push_back(t.map.cells);
+  }
+  // The 8 copies of a map without symmetry are distinct, and a reflection twice is the identity.
+  std::sort(seen.begin(), seen.end());
+  EXPECT_EQ(std::unique(seen.begin(), seen.end()), seen.end());
+  int dropped = 0;
+  const MapTrajectories twice = TransformMap(TransformMap(m, 1, &dropped), 1, &dropped);
+  EXPECT_EQ(twice.map.cells, m.map.cells);
+  EXPECT_TRUE(twice.trajectories[0].isApprox(m.trajectories[0], 1e-15));
+}
+
+TEST(OtnetAugment, AveragedHausdorffIsInvariantUnderTheSameSymmetry) {
+  // The encoder's similarity is a distance between edge sets: moving both maps by one symmetry
+  // keeps it (an independent check that maps are transformed as rigid motions of the grid).
+  SyntheticRoomsOptions o;
+  o.maps = 2;
+  o.trajectories_per_map = 1;
+  const std::vector<MapTrajectories> maps = GenerateRoomsAndCorridors(o);
+  const double d0 = AveragedHausdorffBruteForce(EdgeCells(maps[0].map), EdgeCells(maps[1].map));
+  ASSERT_GT(d0, 0);
+  for (int s = 1; s < 8; ++s) {
+    int dropped = 0;
+    const BinaryGrid a = TransformMap(maps[0], s, &dropped).map;
+    const BinaryGrid b = TransformMap(maps[1], s, &dropped).map;
+    EXPECT_NEAR(AveragedHausdorffBruteForce(EdgeCells(a), EdgeCells(b)), d0, 1e-12) << s;
+  }
+}
+
+TEST(OtnetAugment, BoundaryWaypointsNextToAWallAreDroppedAndCounted) {
+  MapTrajectories m = AsymmetricMap();
+  // x = 1.0 lies on the boundary between the wall column 0 and the free column 1: free as read,
+  // inside the reflected wall after x -> 6 - x (5.0 is column 5, the image of column 0).
+  Eigen::MatrixX2d on_edge(2, 2);
+  on_edge << 1.0, 2.5, 2.5, 2.5;
+  m.trajectories.push_back(on_edge);
+  int dropped = 0;
+  EXPECT_EQ(TransformMap(m, 1, &dropped).trajectories.size(), 1u);
+  EXPECT_EQ(dropped, 1);
+  MapTrajectories wide = m;
+  wide.map = BinaryGrid(6, 5);
+  testing::ExpectErrorContains([&] { TransformMap(wide, 1, &dropped); },
+                               {"asym", "6 x 5", "square"});
+}
+
+TEST(OtnetAugment, OnlyTheTrainingMapsAreCopiedAndTheDatabaseKeepsTheMapsAsRead) {
+  ExperimentConfig c;
+  c.data.source = Source::kSynthetic;
+  c.data.synthetic_maps = 24;
+  c.data.synthetic_trajectories = 3;
+  c.data.synthetic_layouts = 12;
+  const OtnetData plain = LoadOtnetData(c);
+  c.data.augment = Augment::kDihedral;
+  const OtnetData aug = LoadOtnetData(c);
+  const std::size_t n = plain.train.maps.size();
+  ASSERT_EQ(aug.train.maps.size(), 8 * n);
+  EXPECT_EQ(aug.train.copies, static_cast<int>(7 * n));
+  EXPECT_EQ(aug.val.maps.size(), plain.val.maps.size());
+  EXPECT_EQ(aug.test.maps.size(), plain.test.maps.size());
+  EXPECT_EQ(aug.val.copies + aug.test.copies, 0);
+  for (std::size_t i = 0; i < n; ++i) EXPECT_EQ(aug.train.maps[i].id, plain.train.maps[i].id);
+  EXPECT_EQ(aug.train.maps[n].id, plain.train.maps[0].id + "@s1");
+  EXPECT_EQ(MakeEncoder(c, aug.train).size(), static_cast<int>(n));
 }
 
 }  // namespace

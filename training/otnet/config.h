@@ -17,6 +17,8 @@ namespace foresight::otnet {
 enum class Source { kOccTraj, kSynthetic };
 enum class Family { kNormal, kLaplace };
 enum class BadWaypoints { kDrop, kError };
+/// Symmetric copies of the training maps: none, or the 8 symmetries of the square (dihedral).
+enum class Augment { kNone, kDihedral };
 
 struct DataConfig {
   Source source = Source::kSynthetic;
@@ -31,6 +33,9 @@ struct DataConfig {
   int synthetic_trajectories = 50;
   int synthetic_layouts =
       12;  ///< layout families (SyntheticRoomsOptions::layouts); 0: all distinct
+  /// Training maps only: each map and its trajectories also in its 7 other orientations (rotations
+  /// by multiples of 90 degrees and reflections). Validation and test maps are never transformed.
+  Augment augment = Augment::kNone;
 
   template <class A>
   void Serialize(A* a) {
@@ -58,6 +63,12 @@ struct DataConfig {
     a->Visit(
         "synthetic_layouts", &synthetic_layouts, Range::Closed(0, 100000),
         "synthetic layout families (maps of a family differ by a few pillars); 0: all distinct");
+    a->VisitEnum(
+        "augment", &augment,
+        config::EnumNames<Augment>{{Augment::kNone, "none"}, {Augment::kDihedral, "dihedral"}},
+        "training maps only: none, or dihedral (each map and its trajectories also "
+        "rotated by 90/180/270 degrees and reflected: 8 copies; the encoder's database "
+        "keeps the maps as read)");
   }
 };
 

@@ -18,6 +18,58 @@ int OtnetSplit::trajectories() const {
   return n;
 }
 
+std::vector<MapTrajectories> OtnetSplit::OriginalMaps() const {
+  return {maps.begin(), maps.end() - copies};
+}
+
+MapTrajectories TransformMap(const MapTrajectories& m, int s, int* dropped) {
+  FS_THROW_UNLESS(s >= 0 && s < 8, "otnet: symmetry ", s, " is not in [0, 8)");
+  const int n = m.map.width;
+  FS_THROW_UNLESS(m.map.height == n, "otnet: map ", m.id, " is ", m.map.width, " x ", m.map.height,
+                  "; symmetric copies need a square map");
+  const bool swap = (s & 4) != 0, flip_x = (s & 1) != 0, flip_y = (s & 2) != 0;
+  MapTrajectories out;
+  out.id = s == 0 ? m.id : m.id + "@s" + std::to_string(s);
+  out.map = BinaryGrid(n, n);
+  for (int r = 0; r < n; ++r)
+    for (int c = 0; c < n; ++c) {
+      int x = swap ? r : c, y = swap ? c : r;  // the source cell's column and row after the swap
+      if (flip_x) x = n - 1 - x;
+      if (flip_y) y = n - 1 - y;
+      out.map.at(y, x) = m.map.at(r, c);
+    }
+  for (const Eigen::MatrixX2d& t : m.trajectories) {
+    Eigen::MatrixX2d u(t.rows(), 2);
+    u.col(0) = swap ? t.col(1) : t.col(0);
+    u.col(1) = swap ? t.col(0) : t.col(1);
+    if (flip_x) u.col(0) = (n - u.col(0).array()).matrix();
+    if (flip_y) u.col(1) = (n - u.col(1).array()).matrix();
+    bool free = true;
+    for (Eigen::Index k = 0; k < u.rows() && free; ++k)
+      free = !out.map.OccupiedAt(u(k, 0), u(k, 1));
+    if (free)
+      out.trajectories.push_back(std::move(u));
+    else
+      ++*dropped;
+  }
+  return out;
+}
+
+void AugmentDihedral(OtnetSplit* split) {
+  const std::size_t originals = split->maps.size() - split->copies;
+  split->maps.reserve(8 * originals);
+  int dropped = 0;
+  for (int s = 1; s < 8; ++s)
+    for (std::size_t i = 0; i < originals; ++i) {
+      split->maps.push_back(TransformMap(split->maps[i], s, &dropped));
+      ++split->copies;
+    }
+  if (dropped > 0)
+    log::Warn("otnet data: ", dropped,
+              " trajectories of the symmetric copies dropped (a waypoint "
+              "on a cell boundary next to an occupied cell lands in it when reflected)");
+}
+
 namespace {
 
 void Truncate(MapTrajectories* m, int max_trajectories) {
@@ -28,7 +80,8 @@ void Truncate(MapTrajectories* m, int max_trajectories) {
 void LogSplit(const char* name, const OtnetSplit& s) {
   const ReadReport& r = s.report;
   log::Info("otnet data: ", name, ": ", s.maps.size(), " maps, ", s.trajectories(), " trajectories",
-            r.trajectories > 0 ? "" : " (synthetic)");
+            r.trajectories > 0 ? "" : " (synthetic)",
+            s.copies > 0 ? " (" + std::to_string(s.copies) + " maps are symmetric copies)" : "");
   if (r.dropped_outside + r.dropped_occupied + r.dropped_too_short > 0)
     log::Warn("otnet data: ", name, ": dropped ", r.dropped_outside,
               " trajectories with a waypoint outside the map, ", r.dropped_occupied,
@@ -92,6 +145,7 @@ OtnetData LoadOtnetData(const ExperimentConfig& c) {
     read(split.val, &d.val);
     read(split.test, &d.test);
   }
+  if (c.data.augment == Augment::kDihedral) AugmentDihedral(&d.train);
   LogSplit("train", d.train);
   LogSplit("val", d.val);
   LogSplit("test", d.test);
@@ -149,9 +203,10 @@ std::vector<int> ChooseDatabase(const std::vector<MapTrajectories>& maps, int da
   return chosen;
 }
 
-MapEncoder MakeEncoder(const ExperimentConfig& c, const std::vector<MapTrajectories>& train) {
+MapEncoder MakeEncoder(const ExperimentConfig& c, const OtnetSplit& train) {
+  const std::vector<MapTrajectories> read = train.OriginalMaps();
   std::vector<BinaryGrid> database;
-  for (int i : ChooseDatabase(train, c.otnet.database_size)) database.push_back(train[i].map);
+  for (int i : ChooseDatabase(read, c.otnet.database_size)) database.push_back(read[i].map);
   return MapEncoder(std::move(database), c.otnet.length_scale);
 }
 

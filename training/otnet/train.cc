@@ -60,7 +60,7 @@ OtnetPrepared PrepareOtnet(const ExperimentConfig& c) {
   p.basis = MakeBasis(c);
   log::Info("otnet: basis M = ", p.basis.size(), ", reconstruction RMSE ",
             ReconstructionRmse(p.basis, p.data.train), " cells on the training trajectories");
-  p.encoder = MakeEncoder(c, p.data.train.maps);
+  p.encoder = MakeEncoder(c, p.data.train);
   log::Info("otnet: database of ", p.encoder.size(), " representative maps, l_H ",
             c.otnet.length_scale);
   p.train = EncodeSplit(p.encoder, p.basis, p.data.train);
