@@ -350,7 +350,9 @@ TEST(Gfcs, IntermediateCommandsUseTheViaTolerance) {
   EXPECT_GT(r1.qd.norm(), 0.0);          // and still moving
   const RolloutResult r2 = fabric.Rollout(r1.q, r1.qd, problem.goal, &ws);
   EXPECT_NEAR(c.time, r1.t + r2.t, 1e-12);
-  if (r2.status == RolloutStatus::kReached) EXPECT_LT((r2.q - problem.goal).norm(), 0.05);
+  if (r2.status == RolloutStatus::kReached) {
+    EXPECT_LT((r2.q - problem.goal).norm(), 0.05);
+  }
   // The goal role keeps goal_tolerance: from the start, the intermediate command takes longer.
   const RolloutResult strict = fabric.Rollout(problem.start, JointVector::Zero(), mid, &ws);
   EXPECT_GT(strict.t, r1.t);
