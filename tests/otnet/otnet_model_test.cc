@@ -317,7 +317,9 @@ void ThesisConditional(const Eigen::MatrixXd& k_full, const Eigen::VectorXd& mu_
 }
 
 TEST(OtnetModel, ConditionedMarginalsAreTheThesisSchurComplement) {
-  const Eigen::VectorXd taus = (Eigen::VectorXd(6) << 0.1, 0.25, 0.5, 0.6, 0.9, 1.0).finished();
+  // Filled in place: GCC 12 warns (-Wmaybe-uninitialized) on a copied .finished().
+  Eigen::VectorXd taus(6);
+  taus << 0.1, 0.25, 0.5, 0.6, 0.9, 1.0;
   Eigen::VectorXd taus_full(7);
   taus_full << 0.0, taus;
   const Eigen::Vector2d start(17.3, 22.9);
