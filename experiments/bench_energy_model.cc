@@ -1,6 +1,8 @@
-// Google Benchmark of the learned GFCS sampler's energy engine at production size: encoding 64
-// (any k; it only enters the per-call context GEMV), energy MLP [21 + k + 7n] -> 800 -> 800 -> 800
-// -> 1, n = 1 (7 command inputs). Random weights: latency does not depend on their values.
+// Google Benchmark of the learned GFCS sampler's energy engine: encoding 64 (any k; it only enters
+// the per-call context GEMV), energy MLP [21 + k + 7n] -> W -> W -> W -> 1, n = 1 (7 command
+// inputs), at the thesis's width W = 800 and the shipped 256 (configs/gfcs/all_families.yaml).
+// SGLD at the thesis's 20 and 200 particles x 50 steps, and the shipped sampler's 40 x 30.
+// Random weights: latency does not depend on their values.
 //   build/bin/bench_energy_model [--benchmark_repetitions=3]
 // Counters: GFLOP/s of the multiply-adds (2 flops each) of the forward and backward GEMMs.
 
@@ -13,7 +15,7 @@
 namespace foresight::manipulation {
 namespace {
 
-constexpr int kEncoding = 64, kCommands = 1, kWidth = 800;
+constexpr int kEncoding = 64, kCommands = 1;
 
 Mlp RandomMlp(const std::vector<int>& sizes, std::mt19937_64* rng) {
   std::vector<DenseLayer> layers;
@@ -29,72 +31,90 @@ Mlp RandomMlp(const std::vector<int>& sizes, std::mt19937_64* rng) {
   return Mlp(std::move(layers));
 }
 
-const EnergyModel& Model() {
-  static const EnergyModel model = [] {
-    std::mt19937_64 rng(1);
-    EnergyModelParts p;
-    p.lattice.lower = Eigen::Vector3d::Zero();
-    p.lattice.upper = Eigen::Vector3d::Constant(0.3);
-    p.lattice.spacing = 0.3;
-    p.bps_mean = Eigen::VectorXf::Zero(8);
-    p.bps_std = Eigen::VectorXf::Ones(8);
-    p.encoder = RandomMlp({8, kEncoding}, &rng);
-    const int in = EnergyModel::kStateContext + kEncoding + 7 * kCommands;
-    p.energy = RandomMlp({in, kWidth, kWidth, kWidth, 1}, &rng);
-    p.intermediate_commands = kCommands;
-    return EnergyModel(std::move(p));
-  }();
-  return model;
+EnergyModel MakeModel(int width) {
+  std::mt19937_64 rng(1);
+  EnergyModelParts p;
+  p.lattice.lower = Eigen::Vector3d::Zero();
+  p.lattice.upper = Eigen::Vector3d::Constant(0.3);
+  p.lattice.spacing = 0.3;
+  p.bps_mean = Eigen::VectorXf::Zero(8);
+  p.bps_std = Eigen::VectorXf::Ones(8);
+  p.encoder = RandomMlp({8, kEncoding}, &rng);
+  const int in = EnergyModel::kStateContext + kEncoding + 7 * kCommands;
+  p.energy = RandomMlp({in, width, width, width, 1}, &rng);
+  p.intermediate_commands = kCommands;
+  return EnergyModel(std::move(p));
+}
+
+/// The model of width 800 (thesis) or 256 (shipped), built once.
+const EnergyModel& Model(int width) {
+  static const EnergyModel thesis = MakeModel(800), shipped = MakeModel(256);
+  return width == 800 ? thesis : shipped;
 }
 
 /// Multiply-adds x 2 of one EnergyAndGradient call over P particles (the context GEMV once).
-double Flops(int P, bool with_gradient) {
-  const double du = 7 * kCommands, w = kWidth;
+double Flops(int P, int width, bool with_gradient) {
+  const double du = 7 * kCommands, w = width;
   const double forward = P * (w * du + 2 * w * w + w);
   const double backward = with_gradient ? P * (2 * w * w + du * w) : 0;
   return 2 * (forward + backward) + 2 * w * (EnergyModel::kStateContext + kEncoding);
 }
 
-Eigen::VectorXf Context() { return Eigen::VectorXf::Constant(Model().context_size(), 0.1f); }
+Eigen::VectorXf Context(const EnergyModel& m) {
+  return Eigen::VectorXf::Constant(m.context_size(), 0.1f);
+}
 
+// Args: particles P, width W.
 void BM_EnergyAndGradient(benchmark::State& state) {
-  const EnergyModel& m = Model();
-  const int P = static_cast<int>(state.range(0));
+  const int P = static_cast<int>(state.range(0)), width = static_cast<int>(state.range(1));
+  const EnergyModel& m = Model(width);
   auto ws = m.MakeWorkspace(P);
   std::mt19937_64 rng(2);
   std::uniform_real_distribution<float> u11(-1, 1);
   const Eigen::MatrixXf u =
       Eigen::MatrixXf::NullaryExpr(m.command_size(), P, [&] { return u11(rng); });
-  const Eigen::VectorXf ctx = Context();
+  const Eigen::VectorXf ctx = Context(m);
   Eigen::VectorXf E(P);
   Eigen::MatrixXf G(m.command_size(), P);
   for (auto _ : state) {
     m.EnergyAndGradient(ctx, u, &E, &G, &ws);
     benchmark::DoNotOptimize(E.data());
   }
-  state.counters["GFLOP/s"] =
-      benchmark::Counter(Flops(P, true) * 1e-9, benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["GFLOP/s"] = benchmark::Counter(Flops(P, width, true) * 1e-9,
+                                                 benchmark::Counter::kIsIterationInvariantRate);
 }
-BENCHMARK(BM_EnergyAndGradient)->Arg(20)->Arg(200)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_EnergyAndGradient)
+    ->ArgNames({"particles", "width"})
+    ->Args({20, 800})
+    ->Args({200, 800})
+    ->Args({40, 256})
+    ->Unit(benchmark::kMillisecond);
 
+// Args: particles, steps, width. The shipped sampler is 40 x 30 at width 256.
 void BM_RunSgld(benchmark::State& state) {
-  const EnergyModel& m = Model();
+  const int width = static_cast<int>(state.range(2));
+  const EnergyModel& m = Model(width);
   SgldParams p;
   p.particles = static_cast<int>(state.range(0));
-  p.steps = 50;
+  p.steps = static_cast<int>(state.range(1));
   auto ws = m.MakeWorkspace(p.particles);
-  const Eigen::VectorXf ctx = Context();
+  const Eigen::VectorXf ctx = Context(m);
   std::mt19937_64 rng(3);
   for (auto _ : state) {
     const SgldResult r = RunSgld(m, ctx, p, &rng, &ws);
     benchmark::DoNotOptimize(r.energy.data());
   }
-  // 50 steps with the gradient plus one final energy-only evaluation
-  state.counters["GFLOP/s"] =
-      benchmark::Counter((50 * Flops(p.particles, true) + Flops(p.particles, false)) * 1e-9,
-                         benchmark::Counter::kIsIterationInvariantRate);
+  // the steps with the gradient plus one final energy-only evaluation
+  state.counters["GFLOP/s"] = benchmark::Counter(
+      (p.steps * Flops(p.particles, width, true) + Flops(p.particles, width, false)) * 1e-9,
+      benchmark::Counter::kIsIterationInvariantRate);
 }
-BENCHMARK(BM_RunSgld)->Arg(20)->Arg(200)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_RunSgld)
+    ->ArgNames({"particles", "steps", "width"})
+    ->Args({20, 50, 800})
+    ->Args({200, 50, 800})
+    ->Args({40, 30, 256})
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace foresight::manipulation
