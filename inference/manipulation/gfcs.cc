@@ -158,7 +158,10 @@ GfcsSolution SolveGfcop(const Fabric& fabric, const GfcsQuery& query, CommandSam
     EvaluateBatch(fabric, query, candidates, params.penalty, /*prune_m=*/0, &workspaces, &batch);
     all = batch;
   } else {
+    const auto sample_started = std::chrono::steady_clock::now();
     sampler->Sample(query, intermediate, params.batch_size, &rng, &candidates);
+    solution.sample_time_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - sample_started).count();
     optim::CmaEsOptions options;
     options.population = params.batch_size;
     options.sigma0 = params.sigma0;

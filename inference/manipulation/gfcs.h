@@ -132,6 +132,8 @@ struct GfcsSolution {
   /// solved iff the kReached count is positive.
   RolloutStatusCounts candidate_statuses{};
   double solve_time_s = 0;  ///< wall time of SolveGfcop
+  /// Of solve_time_s, the sampler's first batch (SGLD for the learned sampler; 0 without one).
+  double sample_time_s = 0;
   bool solved() const { return status == GfcsStatus::kSolved; }
 };
 

@@ -392,6 +392,9 @@ TEST(Gfcs, SolveIsDeterministicSortedAndBeatsOrMatchesItsFirstBatch) {
   EXPECT_EQ(a.solved(), a.candidate_statuses[static_cast<int>(RolloutStatus::kReached)] > 0);
   EXPECT_EQ(a.candidate_statuses[static_cast<int>(RolloutStatus::kStopped)], a.pruned);
   EXPECT_EQ(a.candidate_statuses, b.candidate_statuses);
+  // The first batch's sampling is timed inside the solve.
+  EXPECT_GE(a.sample_time_s, 0.0);
+  EXPECT_LE(a.sample_time_s, a.solve_time_s);
 }
 
 TEST(Gfcs, APrunedCandidateCostsMoreThanItsBound) {

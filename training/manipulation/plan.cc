@@ -1,5 +1,6 @@
 #include "training/manipulation/plan.h"
 
+#include <array>
 #include <chrono>
 #include <filesystem>
 #include <iomanip>
@@ -7,6 +8,7 @@
 #include <random>
 #include <sstream>
 
+#include "core/bench.h"
 #include "core/error.h"
 #include "core/file_io.h"
 #include "core/log.h"
@@ -36,7 +38,8 @@ struct Trajectory {
   std::string status;
   TimedPath joints;
   double generation_time_s = 0;
-  RolloutStatusCounts candidates{};  ///< GFCS: how its evaluated candidates ended
+  RolloutStatusCounts candidates{};   ///< GFCS: how its evaluated candidates ended
+  double encode_s = 0, sample_s = 0;  ///< GFCS: of generation_time_s, encoding and first batch
 };
 
 TimedPath ToTimedPath(const std::vector<JointVector>& states, double dt) {
@@ -62,6 +65,7 @@ Trajectory RunGfcs(const Fabric& fabric, const ManipulationProblem& problem,
   const GfcsSolution solution = SolveGfcop(fabric, query, sampler, params);
   Trajectory t;
   t.generation_time_s = Seconds(started);
+  t.sample_s = solution.sample_time_s;
   t.candidates = solution.candidate_statuses;
   if (solution.status == GfcsStatus::kError) {
     t.status = "error: " + solution.message;
@@ -198,7 +202,9 @@ void WriteSummaryJson(const std::string& path, const ExperimentConfig& c,
       for (int k = 0; k < kRolloutStatusCount; ++k)
         os << (k ? ", " : "") << "\"" << ToString(static_cast<RolloutStatus>(k))
            << "\": " << report.methods[i].candidate_statuses[k];
-      os << "}";
+      os << "}, \"time_median_s\": {\"total\": " << report.methods[i].median_total_s
+         << ", \"encode\": " << report.methods[i].median_encode_s
+         << ", \"first_batch_sampling\": " << report.methods[i].median_sample_s << "}";
     }
     os << "}" << (i + 1 < report.methods.size() ? "," : "") << "\n";
   }
@@ -249,6 +255,8 @@ PlanReport RunPlanExperiment(const ExperimentConfig& c, const std::string& run_d
   report.problems = static_cast<int>(problems.size());
   std::vector<std::vector<PathMetrics>> per_method(c.methods.size());
   std::vector<RolloutStatusCounts> candidate_statuses(c.methods.size(), RolloutStatusCounts{});
+  // GFCS time split per method: total, encoding, first batch's sampling (one entry per problem).
+  std::vector<std::array<std::vector<double>, 3>> times(c.methods.size());
   std::vector<PlanProblemPicture> pictures;
   KinematicsData ee_data = robot.MakeData();
   const EndEffectorFn ee = [&](const JointVector& q) {
@@ -315,6 +323,7 @@ PlanReport RunPlanExperiment(const ExperimentConfig& c, const std::string& run_d
             }
             t = RunGfcs(fabric, problem, c, method, sampler, seed, &best);
             t.generation_time_s += encode_s;
+            t.encode_s = encode_s;
             attempt_cost = best.commands.size() ? best.cost : std::optional<double>();
             break;
           }
@@ -358,6 +367,11 @@ PlanReport RunPlanExperiment(const ExperimentConfig& c, const std::string& run_d
       line << " " << method.name << "=" << attempt.status;
       per_method[m].push_back(attempt.metrics);
       for (int k = 0; k < kRolloutStatusCount; ++k) candidate_statuses[m][k] += t.candidates[k];
+      if (method.kind == PlanMethodKind::kGfcs) {
+        times[m][0].push_back(t.generation_time_s);
+        times[m][1].push_back(t.encode_s);
+        times[m][2].push_back(t.sample_s);
+      }
 
       // Reactivity: GFCS's commands re-run by the fabric with obstacles on the solved path.
       if (c.reactivity.enabled && static_cast<int>(m) == reactive_method &&
@@ -384,8 +398,15 @@ PlanReport RunPlanExperiment(const ExperimentConfig& c, const std::string& run_d
     log::Info(line.str());
     if (static_cast<int>(pictures.size()) < c.plot_problems) pictures.push_back(picture);
   }
-  for (std::size_t m = 0; m < c.methods.size(); ++m)
-    report.methods.push_back({c.methods[m].name, Summarise(per_method[m]), candidate_statuses[m]});
+  for (std::size_t m = 0; m < c.methods.size(); ++m) {
+    PlanMethodResult result{c.methods[m].name, Summarise(per_method[m]), candidate_statuses[m]};
+    if (!times[m][0].empty()) {
+      result.median_total_s = bench::Median(times[m][0]);
+      result.median_encode_s = bench::Median(times[m][1]);
+      result.median_sample_s = bench::Median(times[m][2]);
+    }
+    report.methods.push_back(std::move(result));
+  }
 
   WriteSummaryJson((fs::path(run_dir) / "summary.json").string(), c, report);
   WriteProblemsCsv((fs::path(run_dir) / "problems.csv").string(), report);

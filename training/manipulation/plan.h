@@ -45,6 +45,10 @@ struct PlanMethodResult {
   /// GFCS: how every evaluated candidate ended, summed over problems (summary.json
   /// "candidate_statuses").
   manipulation::RolloutStatusCounts candidate_statuses{};
+  /// GFCS: medians over the problems of the whole method time, the world's encoding (learned
+  /// sampler) and the sampler's first batch (SGLD for the learned sampler), in s (summary.json
+  /// "time_median_s"; medians, so the parts need not add up to the total).
+  double median_total_s = 0, median_encode_s = 0, median_sample_s = 0;
 };
 
 struct PlanReport {
