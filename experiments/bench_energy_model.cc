@@ -8,6 +8,7 @@
 
 #include <benchmark/benchmark.h>
 
+#include <map>
 #include <random>
 
 #include "inference/manipulation/energy_model.h"
@@ -46,10 +47,12 @@ EnergyModel MakeModel(int width) {
   return EnergyModel(std::move(p));
 }
 
-/// The model of width 800 (thesis) or 256 (shipped), built once.
+/// The model of a width, built once per width.
 const EnergyModel& Model(int width) {
-  static const EnergyModel thesis = MakeModel(800), shipped = MakeModel(256);
-  return width == 800 ? thesis : shipped;
+  static std::map<int, EnergyModel> models;
+  auto it = models.find(width);
+  if (it == models.end()) it = models.emplace(width, MakeModel(width)).first;
+  return it->second;
 }
 
 /// Multiply-adds x 2 of one EnergyAndGradient call over P particles (the context GEMV once).

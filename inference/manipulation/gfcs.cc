@@ -2,11 +2,11 @@
 
 #include <algorithm>
 #include <atomic>
-#include <chrono>
 #include <limits>
 #include <mutex>
 #include <thread>
 
+#include "core/bench.h"
 #include "core/error.h"
 #include "inference/optim/cmaes.h"
 
@@ -128,7 +128,7 @@ GfcsCandidate EvaluateCommandSequence(const Fabric& fabric, const GfcsQuery& que
 
 GfcsSolution SolveGfcop(const Fabric& fabric, const GfcsQuery& query, CommandSampler* sampler,
                         const GfcsParams& params) {
-  const auto started = std::chrono::steady_clock::now();
+  const auto started = bench::Clock::now();
   GfcsSolution solution;
   const JointLimits& limits = fabric.robot().limits();
   const int intermediate = params.commands - 1;
@@ -158,10 +158,9 @@ GfcsSolution SolveGfcop(const Fabric& fabric, const GfcsQuery& query, CommandSam
     EvaluateBatch(fabric, query, candidates, params.penalty, /*prune_m=*/0, &workspaces, &batch);
     all = batch;
   } else {
-    const auto sample_started = std::chrono::steady_clock::now();
+    const auto sample_started = bench::Clock::now();
     sampler->Sample(query, intermediate, params.batch_size, &rng, &candidates);
-    solution.sample_time_s =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - sample_started).count();
+    solution.sample_time_s = bench::SecondsSince(sample_started);
     optim::CmaEsOptions options;
     options.population = params.batch_size;
     options.sigma0 = params.sigma0;
@@ -199,8 +198,7 @@ GfcsSolution SolveGfcop(const Fabric& fabric, const GfcsQuery& query, CommandSam
   solution.top = std::move(all);
   solution.status = !solution.top.empty() && solution.top.front().reached ? GfcsStatus::kSolved
                                                                           : GfcsStatus::kNotSolved;
-  solution.solve_time_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  solution.solve_time_s = bench::SecondsSince(started);
   return solution;
 }
 

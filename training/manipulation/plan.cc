@@ -1,7 +1,5 @@
 #include "training/manipulation/plan.h"
 
-#include <array>
-#include <chrono>
 #include <filesystem>
 #include <iomanip>
 #include <optional>
@@ -27,10 +25,6 @@ namespace fs = std::filesystem;
 using namespace manipulation;  // NOLINT: this file is the manipulation harness
 
 namespace {
-
-double Seconds(std::chrono::steady_clock::time_point since) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
-}
 
 /// A method's trajectory before judging: joint states at a fixed step, or nothing.
 struct Trajectory {
@@ -61,10 +55,10 @@ Trajectory RunGfcs(const Fabric& fabric, const ManipulationProblem& problem,
   GfcsQuery query;
   query.start = problem.start;
   query.goal = problem.goal;
-  const auto started = std::chrono::steady_clock::now();
+  const auto started = bench::Clock::now();
   const GfcsSolution solution = SolveGfcop(fabric, query, sampler, params);
   Trajectory t;
-  t.generation_time_s = Seconds(started);
+  t.generation_time_s = bench::SecondsSince(started);
   t.sample_s = solution.sample_time_s;
   t.candidates = solution.candidate_statuses;
   if (solution.status == GfcsStatus::kError) {
@@ -90,11 +84,11 @@ Trajectory RunGfcs(const Fabric& fabric, const ManipulationProblem& problem,
 Trajectory RunFabric(const Fabric& fabric, const ManipulationProblem& problem) {
   FabricWorkspace ws = fabric.MakeWorkspace();
   std::vector<JointVector> states{problem.start};
-  const auto started = std::chrono::steady_clock::now();
+  const auto started = bench::Clock::now();
   const RolloutResult r =
       fabric.Rollout(problem.start, JointVector::Zero(), problem.goal, &ws, &states);
   Trajectory t;
-  t.generation_time_s = Seconds(started);
+  t.generation_time_s = bench::SecondsSince(started);
   t.reached = r.status == RolloutStatus::kReached;
   t.status = t.reached ? "solved" : ToString(r.status);
   t.joints = ToTimedPath(states, fabric.params().dt);
@@ -255,8 +249,11 @@ PlanReport RunPlanExperiment(const ExperimentConfig& c, const std::string& run_d
   report.problems = static_cast<int>(problems.size());
   std::vector<std::vector<PathMetrics>> per_method(c.methods.size());
   std::vector<RolloutStatusCounts> candidate_statuses(c.methods.size(), RolloutStatusCounts{});
-  // GFCS time split per method: total, encoding, first batch's sampling (one entry per problem).
-  std::vector<std::array<std::vector<double>, 3>> times(c.methods.size());
+  // GFCS time split per method, one entry per problem.
+  struct Times {
+    std::vector<double> total, encode, sample;
+  };
+  std::vector<Times> times(c.methods.size());
   std::vector<PlanProblemPicture> pictures;
   KinematicsData ee_data = robot.MakeData();
   const EndEffectorFn ee = [&](const JointVector& q) {
@@ -316,9 +313,9 @@ PlanReport RunPlanExperiment(const ExperimentConfig& c, const std::string& run_d
             CommandSampler* sampler = &uniform;
             double encode_s = 0;  // the world's encoding is part of the learned method's time
             if (learned[m]) {
-              const auto started = std::chrono::steady_clock::now();
+              const auto started = bench::Clock::now();
               learned[m]->SetWorld(problem.world);
-              encode_s = Seconds(started);
+              encode_s = bench::SecondsSince(started);
               sampler = &*learned[m];
             }
             t = RunGfcs(fabric, problem, c, method, sampler, seed, &best);
@@ -368,9 +365,9 @@ PlanReport RunPlanExperiment(const ExperimentConfig& c, const std::string& run_d
       per_method[m].push_back(attempt.metrics);
       for (int k = 0; k < kRolloutStatusCount; ++k) candidate_statuses[m][k] += t.candidates[k];
       if (method.kind == PlanMethodKind::kGfcs) {
-        times[m][0].push_back(t.generation_time_s);
-        times[m][1].push_back(t.encode_s);
-        times[m][2].push_back(t.sample_s);
+        times[m].total.push_back(t.generation_time_s);
+        times[m].encode.push_back(t.encode_s);
+        times[m].sample.push_back(t.sample_s);
       }
 
       // Reactivity: GFCS's commands re-run by the fabric with obstacles on the solved path.
@@ -400,10 +397,10 @@ PlanReport RunPlanExperiment(const ExperimentConfig& c, const std::string& run_d
   }
   for (std::size_t m = 0; m < c.methods.size(); ++m) {
     PlanMethodResult result{c.methods[m].name, Summarise(per_method[m]), candidate_statuses[m]};
-    if (!times[m][0].empty()) {
-      result.median_total_s = bench::Median(times[m][0]);
-      result.median_encode_s = bench::Median(times[m][1]);
-      result.median_sample_s = bench::Median(times[m][2]);
+    if (!times[m].total.empty()) {
+      result.median_total_s = bench::Median(times[m].total);
+      result.median_encode_s = bench::Median(times[m].encode);
+      result.median_sample_s = bench::Median(times[m].sample);
     }
     report.methods.push_back(std::move(result));
   }
