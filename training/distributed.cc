@@ -13,6 +13,7 @@
 #include <map>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <torch/csrc/distributed/c10d/FileStore.hpp>
 #include <torch/csrc/distributed/c10d/ProcessGroupGloo.hpp>
@@ -51,6 +52,9 @@ std::string Seconds(std::chrono::milliseconds t) {
   os << static_cast<double>(t.count()) / 1000.0 << " s";
   return os.str();
 }
+
+/// Store key of a flag; the prefix keeps it apart from Gloo's own keys in the same store.
+std::string FlagKey(const std::string& name) { return "foresight/flag/" + name; }
 
 }  // namespace
 
@@ -100,8 +104,9 @@ struct Group::Impl {
   std::chrono::milliseconds timeout{60000};
   c10::intrusive_ptr<c10d::Store> store;
   c10::intrusive_ptr<c10d::ProcessGroupGloo> pg;
-  std::string broken;       ///< the failure that broke the group (later collectives refuse)
-  torch::Tensor grad_flat;  ///< reused buffer of AllReduceGradients
+  std::string broken;  ///< the failure that broke the group (later collectives refuse)
+  std::set<std::string> local_flags;  ///< RaiseFlag() of a Local() group
+  torch::Tensor grad_flat;            ///< reused buffer of AllReduceGradients
 
   /// Runs one collective and waits for it; any failure becomes an Error naming the rank, the
   /// collective and the cause, and breaks the group (its peers are gone or out of step).
@@ -327,6 +332,30 @@ std::vector<std::string> Group::AllGatherBytes(const std::string& mine) {
 void Group::Barrier() {
   if (!distributed()) return;
   impl_->Run("barrier", [&] { return impl_->pg->barrier(); });
+}
+
+void Group::RaiseFlag(const std::string& name) {
+  if (!distributed()) {
+    impl_->local_flags.insert(name);
+    return;
+  }
+  try {
+    impl_->store->set(FlagKey(name), std::vector<std::uint8_t>{1});
+  } catch (const std::exception& e) {
+    Fail("rank ", rank(), " of ", size(), ": cannot raise the flag '", name,
+         "' in the rendezvous store: ", Brief(e));
+  }
+}
+
+bool Group::FlagRaised(const std::string& name) {
+  if (!distributed()) return impl_->local_flags.count(name) > 0;
+  try {
+    return impl_->store->check({FlagKey(name)});
+  } catch (const std::exception& e) {
+    Fail("rank ", rank(), " of ", size(), ": cannot read the flag '", name,
+         "' from the rendezvous store (rank 0, which holds a TCPStore, may have exited): ",
+         Brief(e));
+  }
 }
 
 std::shared_ptr<Group> DefaultGroup() {

@@ -70,6 +70,14 @@ class Group {
   std::vector<std::string> AllGatherBytes(const std::string& mine);
   void Barrier();
 
+  /// Raises the job-wide flag `name` in the rendezvous store: every rank sees it at its next
+  /// FlagRaised(), and no rank waits for another (unlike a collective). A Local() group keeps it
+  /// in the process.
+  void RaiseFlag(const std::string& name);
+  /// Whether some rank raised `name`: one look-up in the store (a file read or a round trip to
+  /// rank 0's TCPStore), so cheap enough between two solves, not inside a step.
+  bool FlagRaised(const std::string& name);
+
  private:
   struct Impl;
   explicit Group(std::unique_ptr<Impl> impl);

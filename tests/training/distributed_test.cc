@@ -152,6 +152,10 @@ TEST(DistributedGroup, LocalCollectivesAreNoOps) {
   group->AllReduceGradients(task.module());
   group->BroadcastParameters(task.module());
   group->Barrier();
+  EXPECT_FALSE(group->FlagRaised("stop"));
+  group->RaiseFlag("stop");
+  EXPECT_TRUE(group->FlagRaised("stop"));
+  EXPECT_FALSE(group->FlagRaised("other"));
   const auto params = task.module().parameters();
   for (std::size_t i = 0; i < params.size(); ++i)
     EXPECT_TRUE(torch::equal(params[i].grad(), grads[i]));
@@ -288,7 +292,8 @@ TEST(DistributedGroup, CollectivesAcrossTwoProcesses) {
                {{"FORESIGHT_STORE_FILE", dir.File("store")}, {"FORESIGHT_DIST_TIMEOUT_S", "20"}});
   ASSERT_EQ(status, (std::vector<int>{0, 0}))
       << ReadText(dir.File("error0.txt")) << ReadText(dir.File("error1.txt"));
-  const std::string expected = "rank;rankx;\n" + std::string("from\0zero", 9) + "\n9.000000 6";
+  const std::string expected =
+      "rank;rankx;\n" + std::string("from\0zero", 9) + "\n9.000000 6\nlowered raised";
   EXPECT_EQ(ReadText(dir.File("rank0.txt")), expected);
   EXPECT_EQ(ReadText(dir.File("rank1.txt")), expected);
 }

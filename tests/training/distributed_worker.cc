@@ -7,7 +7,8 @@
 ///     matters); writes OUT_DIR/rank<r>.pt (final parameters) and OUT_DIR/rank<r>.txt (summary).
 ///     With EXIT_AT_BATCH, the process exits (status 3) inside that BatchLoss call (1-based).
 ///   distributed_worker collectives OUT_DIR
-///     checks AllGatherBytes, BroadcastBytes, AllReduceSum, Barrier; writes OUT_DIR/rank<r>.txt.
+///     checks AllGatherBytes, BroadcastBytes, AllReduceSum, Barrier, RaiseFlag/FlagRaised; writes
+///     OUT_DIR/rank<r>.txt.
 /// A foresight::Error goes to OUT_DIR/error<r>.txt and the status is 2.
 
 #include <unistd.h>
@@ -78,6 +79,13 @@ int Collectives(const std::string& out) {
   report += "\n" + std::to_string(t[0].sum().item<double>()) + " " +
             std::to_string(t[1].sum().item<std::int64_t>());
   group->Barrier();
+  // A flag raised by rank 1 is seen by rank 0 after a barrier, without a collective of its own.
+  report += std::string("\n") + (group->FlagRaised("f") ? "raised" : "lowered");
+  group->Barrier();  // both have read before rank 1 raises it
+  if (rank == 1) group->RaiseFlag("f");
+  group->Barrier();
+  report += std::string(" ") + (group->FlagRaised("f") ? "raised" : "lowered") +
+            (group->FlagRaised("g") ? " g" : "");
   WriteText(out + "/rank" + std::to_string(rank) + ".txt", report);
   return 0;
 }

@@ -142,6 +142,7 @@ TEST(GfcsLoop, TwoRanksShareTheSolvesAndEndWithTheModelOfOne) {
   gfcs::ExperimentConfig c = TinyConfig();
   c.loop.threads = 1;
   c.autoencoder.train.threads = 1;
+  c.loop.gradient_shards = 2;  // the training rounds data-parallel too: one shard per rank
   testing::TempDir dir;
   const std::string config = dir.File("tiny.yaml");
   testing::WriteText(config, config::ToYaml(c));
@@ -157,8 +158,17 @@ TEST(GfcsLoop, TwoRanksShareTheSolvesAndEndWithTheModelOfOne) {
                   " > r1.out 2>&1 & p1=$!; wait $p0; a=$?; wait $p1; b=$?; exit $((a | b)))"),
             0)
       << testing::ReadText(d + "/r0.out") << testing::ReadText(d + "/r1.out");
-  // Rank 1 solved its share (every other solve of a block) and kept its own checkpoint.
-  EXPECT_NE(testing::ReadText(d + "/two/log.rank1.txt").find("solve 2/6"), std::string::npos);
+  // Rank 1 solved its share (every other solve of a block) and kept its own checkpoint; the
+  // rounds' losses are the same float sums as on one rank.
+  const std::string log1 = testing::ReadText(d + "/two/log.rank1.txt");
+  EXPECT_NE(log1.find("solve 2/6"), std::string::npos);
+  const std::string round = "training round 3: ";
+  const auto Round3 = [&](const std::string& log) {
+    const auto at = log.find(round);
+    return at == std::string::npos ? std::string() : log.substr(at, log.find('\n', at) - at);
+  };
+  EXPECT_FALSE(Round3(log1).empty()) << log1;
+  EXPECT_EQ(Round3(log1), Round3(testing::ReadText(d + "/one/log.txt")));
   EXPECT_TRUE(fs::exists(gfcs::LoopCheckpointPath(d + "/two", 1)));
   const auto a = EnergyWeights(d + "/one/model.h5"), b = EnergyWeights(d + "/two/model.h5");
   ASSERT_EQ(a.size(), b.size());
@@ -195,6 +205,44 @@ TEST(GfcsLoop, TwoRanksKilledMidRunResumeToTheModelOfOne) {
       " --resume > q1.out 2>&1 & p1=$!; wait $p0; a=$?; wait $p1; b=$?; exit $((a | b)))");
   ASSERT_EQ(resumed, 0) << testing::ReadText(d + "/r0.out") << testing::ReadText(d + "/q0.out")
                         << testing::ReadText(d + "/q1.out");
+  const auto a = EnergyWeights(d + "/one/model.h5"), b = EnergyWeights(d + "/two/model.h5");
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i)
+    EXPECT_EQ((a[i] - b[i]).cwiseAbs().maxCoeff(), 0.0f) << "layer " << i;
+}
+
+TEST(GfcsLoop, ASignalToOneRankStopsBothAndTheyResumeToTheModelOfOne) {
+  gfcs::ExperimentConfig c = TinyConfig();
+  c.loop.threads = 1;
+  c.autoencoder.train.threads = 1;
+  c.loop.passes = 4;       // 12 solves
+  c.loop.train_every = 6;  // blocks of 3 solves per rank: the stop flag, not the block end, stops
+  testing::TempDir dir;
+  testing::WriteText(dir.File("tiny.yaml"), config::ToYaml(c));
+  const std::string cli = FORESIGHT_CLI, d = dir.path();
+  ASSERT_EQ(Shell("cd " + d + " && timeout 120 " + cli +
+                  " train tiny.yaml --run-dir one --no-eval > one.out 2>&1"),
+            0);
+  // SIGTERM to rank 0 only, once its log shows a few solves; rank 1 must stop too (the flag in
+  // the store), not fail on a lost peer and not run on to the end.
+  const std::string env = "FORESIGHT_DIST_TIMEOUT_S=60 WORLD_SIZE=2 ";
+  const std::string run = " timeout 120 " + cli + " train tiny.yaml --run-dir two --no-eval";
+  const std::string bare = " " + cli + " train tiny.yaml --run-dir two --no-eval";  // signalled
+  Shell("cd " + d + " && (FORESIGHT_STORE_FILE=" + d + "/s1 RANK=0 " + env + bare +
+        " > r0.out 2>&1 & p0=$!; FORESIGHT_STORE_FILE=" + d + "/s1 RANK=1 " + env + run +
+        " > r1.out 2>&1 & for i in $(seq 2000); do grep -q \"solve 3/\" two/log.txt "
+        "2>/dev/null && break; sleep 0.005; done; kill -TERM $p0; wait)");
+  const std::string r0 = testing::ReadText(d + "/r0.out"), r1 = testing::ReadText(d + "/r1.out");
+  if (r0.find("interrupted") == std::string::npos)
+    GTEST_SKIP() << "rank 0 finished before the signal reached it (a loaded machine)";
+  EXPECT_NE(r1.find("interrupted; continue with --resume"), std::string::npos) << r1;
+  EXPECT_EQ(r1.find("failed"), std::string::npos) << r1;
+  EXPECT_FALSE(fs::exists(d + "/two/model.h5"));
+  const int resumed = Shell(
+      "cd " + d + " && (FORESIGHT_STORE_FILE=" + d + "/s2 RANK=0 " + env + run +
+      " --resume > q0.out 2>&1 & p0=$!; FORESIGHT_STORE_FILE=" + d + "/s2 RANK=1 " + env + run +
+      " --resume > q1.out 2>&1 & p1=$!; wait $p0; a=$?; wait $p1; b=$?; exit $((a | b)))");
+  ASSERT_EQ(resumed, 0) << testing::ReadText(d + "/q0.out") << testing::ReadText(d + "/q1.out");
   const auto a = EnergyWeights(d + "/one/model.h5"), b = EnergyWeights(d + "/two/model.h5");
   ASSERT_EQ(a.size(), b.size());
   for (std::size_t i = 0; i < a.size(); ++i)

@@ -71,6 +71,11 @@ struct LoopConfig {
   bool shuffle = true;                     ///< solve the training problems in a seeded random order
   int checkpoint_every = 1;                ///< solves between loop checkpoints
   int threads = 2;                         ///< LibTorch intra-op threads
+  /// Each Adam step's batch is split into this many fixed shards whose gradients are summed; over
+  /// R ranks the shards are dealt round-robin, so training rounds run data-parallel. 1 or 2 shards
+  /// give bit-identical models for 1 and 2 ranks (same threads); more shards over more ranks agree
+  /// to float rounding only (docs/distributed.md).
+  int gradient_shards = 1;
 
   template <class A>
   void Serialize(A* a) {
@@ -96,6 +101,8 @@ struct LoopConfig {
     a->Visit("checkpoint_every", &checkpoint_every, Range::Closed(1, 1000000),
              "solves between loop checkpoints");
     a->Visit("threads", &threads, Range::Closed(1, 256), "LibTorch intra-op threads");
+    a->Visit("gradient_shards", &gradient_shards, Range::Closed(1, 1024),
+             "fixed shards of each Adam step's batch, dealt over the ranks (data-parallel rounds)");
   }
 };
 

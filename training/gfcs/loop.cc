@@ -40,6 +40,8 @@ std::uint64_t StreamSeed(std::int64_t seed, std::uint64_t what, std::uint64_t k,
   return z ^ (z >> 31);
 }
 constexpr std::uint64_t kNegativeStream = 1, kBatchStream = 2;
+/// The rendezvous store's flag by which an interrupted rank stops the others between solves.
+constexpr const char* kStopFlag = "gfcs_loop_stop";
 
 // --- Byte packing of positives (the rank gather and nothing else) ---------------------------
 
@@ -606,6 +608,7 @@ void Loop::TrainRound() {
   }
   std::mt19937_64 rng(StreamSeed(c_.seed, kBatchStream, round));
   const int batch = std::min(c_.loop.batch_positives, b_total);
+  const int shards = c_.loop.gradient_shards, size = group_->size(), rank = group_->rank();
   std::vector<std::int64_t> order(static_cast<std::size_t>(b_total));
   net_->train();
   double loss_sum = 0;
@@ -617,15 +620,29 @@ void Loop::TrainRound() {
       std::swap(order[static_cast<std::size_t>(i)], order[static_cast<std::size_t>(pick(rng))]);
     }
     adam_.zero_grad();
-    const torch::Tensor idx = torch::tensor(
-        std::vector<std::int64_t>(order.begin(), order.begin() + batch), torch::kInt64);
-    const torch::Tensor e = net_->forward(ctx.index_select(0, idx), u_all.index_select(0, idx));
-    const torch::Tensor local = InfoNceLoss(e.select(1, 0), e.slice(1, 1));
-    local.backward();
-    const double value = local.item<double>();
-    FS_THROW_UNLESS(std::isfinite(value), "gfcs loop: training round ", round + 1, ", step ",
+    // The batch's mean loss as a weighted sum over fixed shards (shard s: positives [batch s / K,
+    // batch (s + 1) / K) of this step's draw), each with its own backward; over several ranks,
+    // rank r takes shards r, r + R, ... and the gradients (and the loss, both float32) are summed
+    // over the ranks. With K <= 2 that is the same float additions on one rank as on two, so the
+    // model does not depend on the rank count. With K = 1 every rank computes the one shard.
+    const bool exchange = shards > 1 && size > 1;
+    float local_loss = 0;
+    for (int shard = exchange ? rank : 0; shard < shards; shard += exchange ? size : 1) {
+      const int from = batch * shard / shards, to = batch * (shard + 1) / shards;
+      if (to == from) continue;
+      const torch::Tensor idx = torch::tensor(
+          std::vector<std::int64_t>(order.begin() + from, order.begin() + to), torch::kInt64);
+      const torch::Tensor e = net_->forward(ctx.index_select(0, idx), u_all.index_select(0, idx));
+      const double weight = static_cast<double>(to - from) / batch;
+      const torch::Tensor part = InfoNceLoss(e.select(1, 0), e.slice(1, 1)) * weight;
+      part.backward();
+      local_loss += part.item<float>();
+    }
+    std::vector<double> loss{local_loss};
+    if (exchange) group_->AllReduceGradients(*net_, 1.0, &loss);
+    FS_THROW_UNLESS(std::isfinite(loss[0]), "gfcs loop: training round ", round + 1, ", step ",
                     step + 1, ": the InfoNCE loss is not finite");
-    loss_sum += value;
+    loss_sum += loss[0];
     adam_.step();
   }
   net_->eval();
@@ -646,18 +663,18 @@ LoopStats Loop::Run(bool resume, const std::atomic<bool>* interrupt) {
   int since_save = 0;
   int s = walk_from_;        // start of the next chunk: `size` solves, one per rank
   int done = st_.rank_next;  // this rank's solves before `done` are in its pending results
+  const auto loop_started = std::chrono::steady_clock::now();
   while (st_.block_start < total) {
     const int block_end =
         std::min(total, (st_.block_start / c_.loop.train_every + 1) * c_.loop.train_every);
+    // The ranks meet once per block (the gather before training), not after every solve: a rank
+    // whose solves were quick goes on with its next ones instead of waiting for the slowest rank.
+    // A stop reaches the others through a flag in the rendezvous store, read between solves.
+    bool stopping = false;
     for (; s < block_end; s += size) {
-      // Every rank stops at the same chunk: the flag is agreed on (one small all-reduce).
-      std::vector<torch::Tensor> stop{
-          torch::full({1}, interrupt && interrupt->load() ? 1.0 : 0.0, torch::kFloat64)};
-      group_->AllReduceSum(stop);
-      if (stop[0].item<double>() > 0) {
-        Save();
-        stats_.interrupted = true;
-        log::Info("interrupted before solve ", s + 1, "; continue with train --resume");
+      if (interrupt && interrupt->load() && !stopping) group_->RaiseFlag(kStopFlag);
+      if (group_->FlagRaised(kStopFlag)) {
+        stopping = true;
         break;
       }
       const int mine = s + rank;
@@ -671,12 +688,23 @@ LoopStats Loop::Run(bool resume, const std::atomic<bool>* interrupt) {
         since_save = 0;
       }
     }
-    if (stats_.interrupted) break;
+    // Every rank stops at this block or none does: the flag is agreed on (one small all-reduce).
+    if (interrupt && interrupt->load()) stopping = true;
+    std::vector<torch::Tensor> stop{torch::full({1}, stopping ? 1.0 : 0.0, torch::kFloat64)};
+    group_->AllReduceSum(stop);
+    if (stop[0].item<double>() > 0) {
+      Save();
+      stats_.interrupted = true;
+      log::Info("interrupted before solve ", std::min(s, block_end) + 1,
+                "; continue with train --resume");
+      break;
+    }
     FinishBlock(block_end);
     Save();
     since_save = 0;
     s = done = st_.block_start;
   }
+  stats_.loop_seconds = Seconds(loop_started);
   stats_.solves = st_.solves;
   stats_.solved = st_.solved;
   stats_.rounds = st_.rounds;
@@ -696,6 +724,7 @@ std::string LoopStats::ToJson() const {
      << ", \"dropped_particles\": " << dropped_particles
      << ", \"sampler_failures\": " << sampler_failures << ", \"solve_seconds\": " << solve_seconds
      << ", \"negative_seconds\": " << negative_seconds << ", \"train_seconds\": " << train_seconds
+     << ", \"loop_seconds\": " << loop_seconds
      << ", \"interrupted\": " << (interrupted ? "true" : "false") << "}";
   return os.str();
 }

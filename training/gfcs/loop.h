@@ -56,6 +56,9 @@ struct LoopStats {
   int solves = 0, solved = 0, rounds = 0;
   double last_loss = 0;
   double solve_seconds = 0, negative_seconds = 0, train_seconds = 0;  ///< this invocation
+  /// wall time of this invocation's loop (solves, waits for other ranks, training rounds,
+  /// checkpoints), without the set-up before it (problems, encoding, autoencoder)
+  double loop_seconds = 0;
   int dropped_particles = 0;  ///< non-finite SGLD particles (sampler and negatives)
   int sampler_failures = 0;   ///< solves where the learned sampler failed (uniform instead)
   bool interrupted = false;

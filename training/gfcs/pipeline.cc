@@ -312,7 +312,8 @@ bool TrainRun(const ExperimentConfig& c, const std::string& run_dir, bool resume
   if (stats.interrupted) return false;
   log::Info("loop: ", stats.solved, "/", stats.solves, " solved, ", stats.rounds,
             " training rounds; solving ", stats.solve_seconds, " s, negatives ",
-            stats.negative_seconds, " s, training ", stats.train_seconds, " s (this invocation)");
+            stats.negative_seconds, " s, training ", stats.train_seconds, " s, the whole loop ",
+            stats.loop_seconds, " s (this invocation)");
   if (group->rank() == 0) WriteArtifact(c, robot, enc, energy, yaml, run_dir + "/" + kGfcsArtifact);
   return true;
 }
