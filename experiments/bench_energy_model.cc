@@ -1,7 +1,8 @@
 // Google Benchmark of the learned GFCS sampler's energy engine: encoding 64 (any k; it only enters
 // the per-call context GEMV), energy MLP [21 + k + 7n] -> W -> W -> W -> 1, n = 1 (7 command
 // inputs), at the thesis's width W = 800 and the shipped 256 (configs/gfcs/all_families.yaml).
-// SGLD at the thesis's 20 and 200 particles x 50 steps, and the shipped sampler's 40 x 30.
+// SGLD at the thesis's 20 and 200 particles x 50 steps, and the shipped sampler's 40 x 30, on
+// one thread and on two (SgldParams::threads).
 // Random weights: latency does not depend on their values.
 //   build/bin/bench_energy_model [--benchmark_repetitions=3]
 // Counters: GFLOP/s of the multiply-adds (2 flops each) of the forward and backward GEMMs.
@@ -93,18 +94,23 @@ BENCHMARK(BM_EnergyAndGradient)
     ->Args({40, 256})
     ->Unit(benchmark::kMillisecond);
 
-// Args: particles, steps, width. The shipped sampler is 40 x 30 at width 256.
+// Args: particles, steps, width, threads. The shipped sampler is 40 x 30 at width 256. Wall
+// time (several threads): SgldParams::threads splits each step's evaluation.
 void BM_RunSgld(benchmark::State& state) {
   const int width = static_cast<int>(state.range(2));
+  const int threads = static_cast<int>(state.range(3));
   const EnergyModel& m = Model(width);
   SgldParams p;
   p.particles = static_cast<int>(state.range(0));
   p.steps = static_cast<int>(state.range(1));
-  auto ws = m.MakeWorkspace(p.particles);
+  std::vector<EnergyModel::Workspace> ws;
+  for (int t = 0; t < threads; ++t)
+    ws.push_back(m.MakeWorkspace(SgldBlockCapacity(p.particles, threads)));
   const Eigen::VectorXf ctx = Context(m);
   std::mt19937_64 rng(3);
   for (auto _ : state) {
-    const SgldResult r = RunSgld(m, ctx, p, &rng, &ws);
+    const SgldResult r =
+        threads == 1 ? RunSgld(m, ctx, p, &rng, &ws.front()) : RunSgld(m, ctx, p, &rng, &ws);
     benchmark::DoNotOptimize(r.energy.data());
   }
   // the steps with the gradient plus one final energy-only evaluation
@@ -113,10 +119,13 @@ void BM_RunSgld(benchmark::State& state) {
       benchmark::Counter::kIsIterationInvariantRate);
 }
 BENCHMARK(BM_RunSgld)
-    ->ArgNames({"particles", "steps", "width"})
-    ->Args({20, 50, 800})
-    ->Args({200, 50, 800})
-    ->Args({40, 30, 256})
+    ->ArgNames({"particles", "steps", "width", "threads"})
+    ->Args({20, 50, 800, 1})
+    ->Args({200, 50, 800, 1})
+    ->Args({40, 30, 256, 1})
+    ->Args({40, 30, 256, 2})
+    ->Args({200, 50, 800, 2})
+    ->UseRealTime()
     ->Unit(benchmark::kMillisecond);
 
 }  // namespace

@@ -125,7 +125,8 @@ for f in summary.json problems.csv ee_paths.png config.yaml log.txt; do
 done
 check_json "$PLAN/summary.json"
 for k in '"GFCS (1 batch)"' '"GF"' '"RRT-Connect"' success_rate ee_length cspace_length time_s ee_ldj cspace_ldj \
-         candidate_statuses '"reached"' '"timeout"' '"collision"' time_median_s first_batch_sampling; do
+         candidate_statuses '"reached"' '"timeout"' '"collision"' time_median_s first_batch_sampling \
+         integration_steps stalled_rollouts; do
   grep -q "$k" "$PLAN/summary.json" || fail "plan summary.json lacks $k"
 done
 [ "$(wc -l < "$PLAN/problems.csv")" -eq 4 ] || fail "plan problems.csv: expected a header and 3 rows"

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <numeric>
+#include <thread>
 
 #include "core/error.h"
 #include "inference/engine/artifact.h"
@@ -281,16 +283,77 @@ double SgldStepVariance(const SgldParams& params, int k) {
   return params.step_scale / std::sqrt(1.0 + k);
 }
 
-SgldResult RunSgld(const EnergyModel& model, const Eigen::VectorXf& context,
-                   const SgldParams& params, std::mt19937_64* rng, EnergyModel::Workspace* ws) {
+namespace {
+
+/// Columns per alignment unit of the threads' blocks: Eigen's GEMM kernels take the columns of
+/// a product in groups (4 for float below AVX-512) and the leftover ones by another path, so a
+/// column's rounding depends on its position in its block modulo the group. Blocks that start at
+/// multiples of 8 give every column the position it has in one undivided product.
+constexpr int kBlockAlign = 4;
+
+/// E and dE/du (or E alone) of u's columns, split into contiguous blocks over the workspaces'
+/// threads (the calling thread takes the first). Each block writes its own columns.
+void EvaluateBlocks(const EnergyModel& model, const Eigen::VectorXf& context,
+                    const Eigen::MatrixXf& u, int active, bool with_grad,
+                    EnergyModel::Workspace* const* ws, int threads, Eigen::VectorXf* E,
+                    Eigen::MatrixXf* G) {
+  const int units = (active + kBlockAlign - 1) / kBlockAlign;
+  if (threads <= 1 || units < 2) {
+    model.EnergyAndGradient(context, u.leftCols(active), E, with_grad ? G : nullptr, ws[0]);
+    return;
+  }
+  const int blocks = std::min(threads, units);
+  if (E->size() != active) E->resize(active);
+  if (with_grad && (G->rows() != u.rows() || G->cols() != active)) G->resize(u.rows(), active);
+  std::vector<Eigen::VectorXf> e(static_cast<std::size_t>(blocks));
+  std::vector<Eigen::MatrixXf> g(static_cast<std::size_t>(blocks));
+  std::vector<std::exception_ptr> errors(static_cast<std::size_t>(blocks));
+  const auto run = [&](int b) {
+    const auto B = static_cast<std::size_t>(b);
+    try {
+      const int from = kBlockAlign * (units * b / blocks);
+      const int to = std::min(active, kBlockAlign * (units * (b + 1) / blocks));
+      model.EnergyAndGradient(context, u.middleCols(from, to - from), &e[B],
+                              with_grad ? &g[B] : nullptr, ws[b]);
+      E->segment(from, to - from) = e[B];
+      if (with_grad) G->middleCols(from, to - from) = g[B];
+    } catch (...) {
+      errors[B] = std::current_exception();
+    }
+  };
+  std::vector<std::thread> pool;
+  pool.reserve(static_cast<std::size_t>(blocks - 1));
+  for (int b = 1; b < blocks; ++b) pool.emplace_back(run, b);
+  run(0);
+  for (std::thread& t : pool) t.join();
+  for (const std::exception_ptr& e_ptr : errors)
+    if (e_ptr) std::rethrow_exception(e_ptr);
+}
+
+}  // namespace
+
+int SgldBlockCapacity(int particles, int threads) {
+  const int units = (particles + kBlockAlign - 1) / kBlockAlign;
+  if (threads <= 1 || units < 2) return particles;
+  return std::min(particles, kBlockAlign * ((units + threads - 1) / threads));
+}
+
+namespace {
+
+SgldResult RunSgldOn(const EnergyModel& model, const Eigen::VectorXf& context,
+                     const SgldParams& params, std::mt19937_64* rng,
+                     EnergyModel::Workspace* const* ws, int threads) {
   const int P = params.particles, D = model.command_size();
   FS_THROW_UNLESS(
       P >= 1 && params.steps >= 0 && std::isfinite(params.step_scale) && params.step_scale > 0 &&
           params.max_dropped_share >= 0 && params.max_dropped_share <= 1,
       "RunSgld: bad parameters (particles ", P, ", steps ", params.steps, ", step_scale ",
       params.step_scale, ", max_dropped_share ", params.max_dropped_share, ")");
-  FS_THROW_UNLESS(ws->max_particles >= P, "RunSgld: ", P, " particles for a workspace made for ",
-                  ws->max_particles);
+  FS_THROW_UNLESS(threads >= 1, "RunSgld: no workspace given");
+  const int per_thread = SgldBlockCapacity(P, threads);
+  for (int t = 0; t < threads; ++t)
+    FS_THROW_UNLESS(ws[t]->max_particles >= per_thread, "RunSgld: ", per_thread,
+                    " particles per thread for a workspace made for ", ws[t]->max_particles);
   Eigen::MatrixXf u(D, P);
   std::uniform_real_distribution<double> uniform(-1.0, 1.0);
   for (Eigen::Index i = 0; i < u.size(); ++i) u.data()[i] = static_cast<float>(uniform(*rng));
@@ -318,7 +381,7 @@ SgldResult RunSgld(const EnergyModel& model, const Eigen::VectorXf& context,
                     "), above max_dropped_share ", params.max_dropped_share);
   };
   for (int k = 0; k < params.steps && active > 0; ++k) {
-    model.EnergyAndGradient(context, u.leftCols(active), &E, &G, ws);
+    EvaluateBlocks(model, context, u, active, true, ws, threads, &E, &G);
     drop(true);
     const double s2 = SgldStepVariance(params, k);
     const double half = 0.5 * s2, noise = std::sqrt(s2);
@@ -330,7 +393,7 @@ SgldResult RunSgld(const EnergyModel& model, const Eigen::VectorXf& context,
   }
   SgldResult result;
   if (active > 0) {
-    model.EnergyAndGradient(context, u.leftCols(active), &E, nullptr, ws);
+    EvaluateBlocks(model, context, u, active, false, ws, threads, &E, &G);
     drop(false);
   }
   std::vector<int> order(static_cast<std::size_t>(active));
@@ -346,9 +409,27 @@ SgldResult RunSgld(const EnergyModel& model, const Eigen::VectorXf& context,
   return result;
 }
 
+}  // namespace
+
+SgldResult RunSgld(const EnergyModel& model, const Eigen::VectorXf& context,
+                   const SgldParams& params, std::mt19937_64* rng, EnergyModel::Workspace* ws) {
+  return RunSgldOn(model, context, params, rng, &ws, 1);
+}
+
+SgldResult RunSgld(const EnergyModel& model, const Eigen::VectorXf& context,
+                   const SgldParams& params, std::mt19937_64* rng,
+                   std::vector<EnergyModel::Workspace>* workspaces) {
+  std::vector<EnergyModel::Workspace*> ws;
+  for (EnergyModel::Workspace& w : *workspaces) ws.push_back(&w);
+  return RunSgldOn(model, context, params, rng, ws.data(), static_cast<int>(ws.size()));
+}
+
 // ---------------------------------------------------------------------------------------------
 LearnedSampler::LearnedSampler(const EnergyModel& model, SgldParams params)
-    : model_(model), params_(params), ws_(model.MakeWorkspace(std::max(1, params.particles))) {}
+    : model_(model), params_(params) {
+  FS_THROW_UNLESS(params.threads >= 1, "LearnedSampler: threads must be >= 1, got ",
+                  params.threads);
+}
 
 void LearnedSampler::SetWorld(const World& world) {
   encoding_ = model_.EncodeWorld(world);
@@ -375,7 +456,12 @@ void LearnedSampler::Sample(const GfcsQuery& query, int intermediate_commands, i
   if (learned > 0) {
     SgldParams p = params_;
     p.particles = std::max(p.particles, learned);
-    if (ws_.max_particles < p.particles) ws_ = model_.MakeWorkspace(p.particles);
+    const int threads = std::max(1, p.threads);
+    const int per_thread = SgldBlockCapacity(p.particles, threads);
+    if (static_cast<int>(ws_.size()) != threads || ws_.front().max_particles < per_thread) {
+      ws_.clear();
+      for (int t = 0; t < threads; ++t) ws_.push_back(model_.MakeWorkspace(per_thread));
+    }
     model_.Context(query, encoding_, &context_);
     last_ = RunSgld(model_, context_, p, rng, &ws_);
     kept = std::min<int>(learned, static_cast<int>(last_.u.cols()));

@@ -124,6 +124,11 @@ struct SgldParams {
   int steps = 50;                  ///< Langevin steps
   double step_scale = 0.01;        ///< sigma2_k = step_scale (1 + k)^-0.5
   double max_dropped_share = 0.5;  ///< more non-finite particles than this share: Error
+  /// Threads sharing each step's energy and gradient evaluation (the particles split into
+  /// contiguous blocks). The noise is drawn on the calling thread in the same order, and each
+  /// particle's evaluation does not depend on its block (tested), so the result is the same for
+  /// any count. Used by LearnedSampler; RunSgld with one workspace runs on the calling thread.
+  int threads = 1;
   /// LearnedSampler only (RunSgld ignores it; not a config key here: the plan harness sets it per
   /// method, methods[].uniform_share): the share of each requested batch drawn uniformly
   /// in the joint limits instead of from SGLD, rounded to the nearest count. 0 is the thesis (the
@@ -140,6 +145,8 @@ struct SgldParams {
              "sigma2_k = step_scale (1 + k)^-0.5 (normalised command units^2)");
     a->Visit("max_dropped_share", &max_dropped_share, config::Range::Closed(0, 1),
              "largest share of particles that may become non-finite");
+    a->Visit("threads", &threads, config::Range::Closed(1, 256),
+             "threads sharing each SGLD step's evaluation (the same result for any count)");
   }
 };
 
@@ -159,10 +166,20 @@ struct SgldResult {
 /// for a given rng state. `ws` must hold at least params.particles particles (else Error).
 SgldResult RunSgld(const EnergyModel& model, const Eigen::VectorXf& context,
                    const SgldParams& params, std::mt19937_64* rng, EnergyModel::Workspace* ws);
+/// The same on `workspaces->size()` threads (the calling one and size - 1 started per step), each
+/// workspace holding at least SgldBlockCapacity(particles, size) particles; params.threads is not
+/// read. The particles are split into blocks that start at multiples of 8, so that every
+/// particle's evaluation is the one it gets undivided: the result equals RunSgld's on one thread.
+SgldResult RunSgld(const EnergyModel& model, const Eigen::VectorXf& context,
+                   const SgldParams& params, std::mt19937_64* rng,
+                   std::vector<EnergyModel::Workspace>* workspaces);
+/// The most particles one of `threads` workspaces receives from RunSgld.
+int SgldBlockCapacity(int particles, int threads);
 
 // ---------------------------------------------------------------------------------------------
-/// The learned GFCS sampler: SGLD on the energy model, the lowest-energy particles in radians.
-/// Call SetWorld once per problem before Sample. Not thread-safe (one per caller).
+/// The learned GFCS sampler: SGLD on the energy model, the lowest-energy particles in radians,
+/// on params.threads threads. Call SetWorld once per problem before Sample. Not thread-safe (one
+/// per caller).
 class LearnedSampler : public CommandSampler {
  public:
   /// `model` must outlive the sampler.
@@ -189,7 +206,7 @@ class LearnedSampler : public CommandSampler {
   SgldParams params_;
   Eigen::VectorXf encoding_, context_;
   bool has_world_ = false;
-  EnergyModel::Workspace ws_;
+  std::vector<EnergyModel::Workspace> ws_;  ///< one per SGLD thread
   SgldResult last_;
   int last_filled_ = 0;
   double last_seconds_ = 0;

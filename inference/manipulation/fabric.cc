@@ -1,7 +1,9 @@
 #include "inference/manipulation/fabric.h"
 
 #include <Eigen/Cholesky>
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "core/error.h"
 
@@ -98,6 +100,11 @@ Fabric::Fabric(const RobotModel& robot, const World& world, const FabricParams& 
                   params.goal_tolerance);
   FS_THROW_UNLESS(params.via_tolerance > 0, "fabric: via_tolerance must be positive, got ",
                   params.via_tolerance);
+  FS_THROW_UNLESS(params.stall_window >= 0 && params.stall_progress > 0 &&
+                      params.stall_fraction > 0 && params.stall_fraction <= 1,
+                  "fabric: stall_window must be >= 0, stall_progress positive and stall_fraction "
+                  "in (0, 1], got ",
+                  params.stall_window, ", ", params.stall_progress, " and ", params.stall_fraction);
   FS_THROW_UNLESS(params.base_inertia > 0, "fabric: base_inertia must be positive, got ",
                   params.base_inertia);
 }
@@ -204,6 +211,13 @@ RolloutResult Fabric::Rollout(const JointVector& q0, const JointVector& qd0,
     result.status = RolloutStatus::kNonFinite;
     return result;
   }
+  // Stall test, towards the goal only: an intermediate rollout's end state starts the next one,
+  // so ending it early would change what follows. The step of the last progress and its distance.
+  const int stall_steps = p.stall_window > 0 && role == CommandRole::kGoal
+                              ? std::max(1, static_cast<int>(std::llround(p.stall_window / p.dt)))
+                              : 0;
+  double anchor = std::numeric_limits<double>::infinity();
+  int anchor_step = 0;
   JointVector qdd;
   for (int step = 0;; ++step) {
     result.steps = step;
@@ -216,7 +230,8 @@ RolloutResult Fabric::Rollout(const JointVector& q0, const JointVector& qd0,
       result.status = RolloutStatus::kCollision;
       return result;
     }
-    if ((result.q - command).norm() < tolerance) {
+    const double distance = (result.q - command).norm();
+    if (distance < tolerance) {
       result.status = RolloutStatus::kReached;
       return result;
     }
@@ -227,6 +242,20 @@ RolloutResult Fabric::Rollout(const JointVector& q0, const JointVector& qd0,
     if (result.t > stop_beyond_s) {
       result.status = RolloutStatus::kStopped;
       return result;
+    }
+    if (stall_steps > 0) {
+      const double needed = std::min(p.stall_progress, p.stall_fraction * (anchor - tolerance));
+      if (distance < anchor - needed) {
+        anchor = distance;
+        anchor_step = step;
+      } else if (step - anchor_step >= stall_steps) {
+        // Charged as the timeout it is taken for; a caller's time limit still comes first.
+        result.t = max_steps * p.dt;
+        result.stalled = true;
+        result.status =
+            result.t > stop_beyond_s ? RolloutStatus::kStopped : RolloutStatus::kTimeout;
+        return result;
+      }
     }
     result.qd += p.dt * qdd;
     result.q += p.dt * result.qd;

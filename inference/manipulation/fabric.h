@@ -84,6 +84,17 @@ struct FabricParams {
   /// epsilon for every command, so the default equals goal_tolerance; a larger one hands over to
   /// the next command while still moving (a departure, chosen on validation when changed).
   double via_tolerance = 0.05;
+  /// Stall test (0 = off, the thesis): a rollout towards the goal (CommandRole::kGoal; an
+  /// intermediate rollout's end state starts the next one, so those always run on) whose distance
+  /// d to its command has not made progress within the last `stall_window` seconds ends as a
+  /// timeout at once, charged t_max as if it had run on (Rollout's `stalled`). Progress from the
+  /// last anchor distance d_a means d < d_a - min(stall_progress, stall_fraction (d_a -
+  /// tolerance)): a fixed step far from the command, a share of what is left near it (a slow final
+  /// approach still progresses). Not in the thesis: it only saves the steps of rollouts held in a
+  /// local minimum, and is adopted only where validation shows the same outcomes (docs/gfcs.md).
+  double stall_window = 0.0;
+  double stall_progress = 0.01;  ///< rad (2-norm of q - command)
+  double stall_fraction = 0.2;   ///< of the distance left beyond the tolerance
 
   template <class A>
   void Serialize(A* a) {
@@ -114,6 +125,14 @@ struct FabricParams {
     a->Visit(
         "via_tolerance", &via_tolerance, config::Range::Positive(),
         "rollout_t tolerance towards an intermediate command (rad; the thesis: goal_tolerance)");
+    a->Visit("stall_window", &stall_window, config::Range::Closed(0.0, 600.0),
+             "end a rollout towards the goal as a timeout (charged t_max) when it has made no "
+             "progress (stall_progress, stall_fraction) for this long (s); 0 = off (the thesis)");
+    a->Visit("stall_progress", &stall_progress, config::Range::Positive(),
+             "progress towards the command that resets the stall window, far from it (rad)");
+    a->Visit("stall_fraction", &stall_fraction, config::Range::OpenClosed(0.0, 1.0),
+             "progress that resets the stall window near the command: this share of the "
+             "distance left beyond the tolerance");
   }
 };
 
@@ -164,7 +183,8 @@ struct RolloutResult {
   double t = 0;                          ///< integration time used (s); t_max on timeout
   JointVector q = JointVector::Zero();   ///< terminal configuration
   JointVector qd = JointVector::Zero();  ///< terminal velocity
-  int steps = 0;
+  int steps = 0;         ///< integration steps taken (fewer than t / dt when stalled)
+  bool stalled = false;  ///< a timeout declared by the stall test (t is t_max)
   bool ok() const { return status == RolloutStatus::kReached || status == RolloutStatus::kTimeout; }
 };
 
@@ -209,6 +229,8 @@ class Fabric {
   /// (this allocates; leave it null in optimisation loops). A caller that only needs to know
   /// whether the rollout lasts longer than `stop_beyond_s` gets kStopped at the first step whose
   /// time exceeds it (the rollout is identical up to there). `role` picks rollout_t's tolerance.
+  /// With params().stall_window > 0 a goal rollout that stops approaching the goal ends early as
+  /// a timeout (see FabricParams::stall_window).
   RolloutResult Rollout(const JointVector& q0, const JointVector& qd0, const JointVector& command,
                         FabricWorkspace* ws, std::vector<JointVector>* path = nullptr,
                         double stop_beyond_s = std::numeric_limits<double>::infinity(),

@@ -107,6 +107,8 @@ GfcsCandidate EvaluateCommandSequence(const Fabric& fabric, const GfcsQuery& que
         fabric.Rollout(q, qd, command, ws, path, prune_above - c.time,
                        i < intermediate ? CommandRole::kVia : CommandRole::kGoal);
     c.time += r.t;
+    c.steps += r.steps;
+    c.stalled += r.stalled;
     c.last_status = r.status;
     if (r.status == RolloutStatus::kStopped) {
       c.pruned = true;
@@ -186,7 +188,11 @@ GfcsSolution SolveGfcop(const Fabric& fabric, const GfcsQuery& query, CommandSam
   solution.evaluations = static_cast<int>(all.size());
   solution.pruned = static_cast<int>(
       std::count_if(all.begin(), all.end(), [](const GfcsCandidate& c) { return c.pruned; }));
-  for (const GfcsCandidate& c : all) ++solution.candidate_statuses[static_cast<int>(c.last_status)];
+  for (const GfcsCandidate& c : all) {
+    ++solution.candidate_statuses[static_cast<int>(c.last_status)];
+    solution.integration_steps += c.steps;
+    solution.stalled_rollouts += c.stalled;
+  }
   // Pruned candidates cost more than the top_m-th exact cost of their batch: they sort last, so the
   // top m are those of an unpruned solve.
   std::stable_sort(all.begin(), all.end(), [](const GfcsCandidate& a, const GfcsCandidate& b) {

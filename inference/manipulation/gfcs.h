@@ -99,6 +99,8 @@ struct GfcsCandidate {
   /// Stopped once `time` exceeded the caller's bound: `cost` (= time) is a lower bound, and
   /// reached/feasible are unknown (false/true).
   bool pruned = false;
+  int steps = 0;    ///< integration steps of its rollouts (the work it cost)
+  int stalled = 0;  ///< of its rollouts, ended by the fabric's stall test (FabricParams)
 };
 
 /// Rolls out `commands` [7n] (then the goal) from the query's start state and prices the sequence
@@ -131,7 +133,9 @@ struct GfcsSolution {
   /// kReached; intermediate timeouts are allowed). With penalty >= commands t_max, the solve is
   /// solved iff the kReached count is positive.
   RolloutStatusCounts candidate_statuses{};
-  double solve_time_s = 0;  ///< wall time of SolveGfcop
+  long long integration_steps = 0;  ///< fabric steps over every evaluated candidate
+  int stalled_rollouts = 0;         ///< rollouts ended by the fabric's stall test
+  double solve_time_s = 0;          ///< wall time of SolveGfcop
   /// Of solve_time_s, the sampler's first batch (SGLD for the learned sampler; 0 without one).
   double sample_time_s = 0;
   bool solved() const { return status == GfcsStatus::kSolved; }

@@ -284,6 +284,13 @@ TEST(Fabric, RejectsInvalidParams) {
   p = FabricParams{};
   p.t_max = 0.001;
   EXPECT_THROW(Fabric(Panda(), world, p), Error);
+  p = FabricParams{};
+  p.stall_window = -1;
+  EXPECT_THROW(Fabric(Panda(), world, p), Error);
+  p = FabricParams{};
+  p.stall_window = 1;
+  p.stall_progress = 0;
+  EXPECT_THROW(Fabric(Panda(), world, p), Error);
 }
 
 /// A synthetic problem of the generator with the built-in Panda.
@@ -303,6 +310,72 @@ GfcsQuery QueryOf(const ManipulationProblem& problem) {
   query.start = problem.start;
   query.goal = problem.goal;
   return query;
+}
+
+/// Rollouts of the default fabric in generated scenes (tables, shelves) from each problem's start
+/// towards its goal and towards random configurations (seeded), without and with the stall test.
+struct StallComparison {
+  int reached = 0, timeouts = 0, stalled = 0, changed = 0;
+  long long steps_without = 0, steps_with = 0;
+};
+
+StallComparison CompareStallTest(double window, int problems, int per_problem) {
+  FabricParams with;
+  with.stall_window = window;
+  std::mt19937_64 rng(33);
+  StallComparison out;
+  for (int seed = 1; seed <= problems; ++seed) {
+    const ManipulationProblem problem = SyntheticProblem(static_cast<std::uint64_t>(seed));
+    const Fabric plain(Panda(), problem.world, FabricParams{});
+    const Fabric stalling(Panda(), problem.world, with);
+    FabricWorkspace ws = plain.MakeWorkspace();
+    for (int k = 0; k < per_problem; ++k) {
+      const JointVector start = problem.start;
+      const JointVector goal = k == 0 ? problem.goal : RandomConfiguration(&rng);
+      const int trial = seed * 100 + k;
+      std::vector<JointVector> full_path, path;
+      const RolloutResult a = plain.Rollout(start, JointVector::Zero(), goal, &ws, &full_path);
+      const RolloutResult b = stalling.Rollout(start, JointVector::Zero(), goal, &ws, &path);
+      out.steps_without += a.steps;
+      out.steps_with += b.steps;
+      out.reached += a.status == RolloutStatus::kReached;
+      out.timeouts += a.status == RolloutStatus::kTimeout;
+      out.stalled += b.stalled;
+      EXPECT_FALSE(a.stalled);
+      // Up to where the stall test ends it, the rollout is the plain one.
+      EXPECT_LE(path.size(), full_path.size());
+      for (std::size_t i = 0; i < path.size() && i < full_path.size(); ++i)
+        EXPECT_EQ(path[i], full_path[i]) << "trial " << trial << ", state " << i;
+      if (b.stalled) {
+        EXPECT_EQ(b.status, RolloutStatus::kTimeout);
+        EXPECT_EQ(b.t, plain.params().t_max);  // charged as the timeout it is taken for
+        EXPECT_LT(b.steps, a.steps);
+        EXPECT_EQ(b.q, path.back());
+        // Inside a caller's time limit below t_max it is pruned instead: the limit comes first.
+        const double limit = 0.5 * (b.steps * plain.params().dt + plain.params().t_max);
+        const RolloutResult cut =
+            stalling.Rollout(start, JointVector::Zero(), goal, &ws, nullptr, limit);
+        EXPECT_EQ(cut.status, RolloutStatus::kStopped);
+      } else {
+        EXPECT_EQ(b.status, a.status);
+        EXPECT_EQ(b.steps, a.steps);
+      }
+      out.changed += b.status != a.status;
+    }
+  }
+  EXPECT_GT(out.reached + out.timeouts, 0);
+  return out;
+}
+
+TEST(Fabric, TheStallTestEndsOnlyRolloutsThatTimeOut) {
+  // 1 s without 0.01 rad of progress: every stalled rollout is one that timed out (held in a
+  // local minimum), none that would have reached; the work saved is a large part of the whole.
+  const StallComparison c = CompareStallTest(1.0, 8, 6);
+  EXPECT_EQ(c.changed, 0);
+  EXPECT_GT(c.timeouts, 0) << "no rollout was held in a local minimum: the scene needs changing";
+  EXPECT_GT(c.stalled, 0);
+  EXPECT_LE(c.stalled, c.timeouts);
+  EXPECT_LT(c.steps_with, c.steps_without);
 }
 
 TEST(Gfcs, CostIsTheSumOfRolloutTimesPlusThePenaltyOnTimeout) {
@@ -392,6 +465,10 @@ TEST(Gfcs, SolveIsDeterministicSortedAndBeatsOrMatchesItsFirstBatch) {
   EXPECT_EQ(a.solved(), a.candidate_statuses[static_cast<int>(RolloutStatus::kReached)] > 0);
   EXPECT_EQ(a.candidate_statuses[static_cast<int>(RolloutStatus::kStopped)], a.pruned);
   EXPECT_EQ(a.candidate_statuses, b.candidate_statuses);
+  // The work is counted: at least one step per evaluated candidate, no stall test by default.
+  EXPECT_GE(a.integration_steps, a.evaluations);
+  EXPECT_EQ(a.integration_steps, b.integration_steps);
+  EXPECT_EQ(a.stalled_rollouts, 0);
   // The first batch's sampling is timed inside the solve.
   EXPECT_GE(a.sample_time_s, 0.0);
   EXPECT_LE(a.sample_time_s, a.solve_time_s);

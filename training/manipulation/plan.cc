@@ -34,6 +34,8 @@ struct Trajectory {
   double generation_time_s = 0;
   RolloutStatusCounts candidates{};   ///< GFCS: how its evaluated candidates ended
   double encode_s = 0, sample_s = 0;  ///< GFCS: of generation_time_s, encoding and first batch
+  long long steps = 0;                ///< GFCS: fabric integration steps of the solve
+  int stalled = 0;                    ///< GFCS: rollouts ended by the stall test
 };
 
 TimedPath ToTimedPath(const std::vector<JointVector>& states, double dt) {
@@ -61,6 +63,8 @@ Trajectory RunGfcs(const Fabric& fabric, const ManipulationProblem& problem,
   t.generation_time_s = bench::SecondsSince(started);
   t.sample_s = solution.sample_time_s;
   t.candidates = solution.candidate_statuses;
+  t.steps = solution.integration_steps;
+  t.stalled = solution.stalled_rollouts;
   if (solution.status == GfcsStatus::kError) {
     t.status = "error: " + solution.message;
     return t;
@@ -196,7 +200,9 @@ void WriteSummaryJson(const std::string& path, const ExperimentConfig& c,
       for (int k = 0; k < kRolloutStatusCount; ++k)
         os << (k ? ", " : "") << "\"" << ToString(static_cast<RolloutStatus>(k))
            << "\": " << report.methods[i].candidate_statuses[k];
-      os << "}, \"time_median_s\": {\"total\": " << report.methods[i].median_total_s
+      os << "}, \"integration_steps\": " << report.methods[i].work.steps
+         << ", \"stalled_rollouts\": " << report.methods[i].work.stalled
+         << ", \"time_median_s\": {\"total\": " << report.methods[i].median_total_s
          << ", \"encode\": " << report.methods[i].median_encode_s
          << ", \"first_batch_sampling\": " << report.methods[i].median_sample_s << "}";
     }
@@ -249,6 +255,7 @@ PlanReport RunPlanExperiment(const ExperimentConfig& c, const std::string& run_d
   report.problems = static_cast<int>(problems.size());
   std::vector<std::vector<PathMetrics>> per_method(c.methods.size());
   std::vector<RolloutStatusCounts> candidate_statuses(c.methods.size(), RolloutStatusCounts{});
+  std::vector<GfcsWork> work(c.methods.size());
   // GFCS time split per method, one entry per problem.
   struct Times {
     std::vector<double> total, encode, sample;
@@ -364,6 +371,8 @@ PlanReport RunPlanExperiment(const ExperimentConfig& c, const std::string& run_d
       line << " " << method.name << "=" << attempt.status;
       per_method[m].push_back(attempt.metrics);
       for (int k = 0; k < kRolloutStatusCount; ++k) candidate_statuses[m][k] += t.candidates[k];
+      work[m].steps += t.steps;
+      work[m].stalled += t.stalled;
       if (method.kind == PlanMethodKind::kGfcs) {
         times[m].total.push_back(t.generation_time_s);
         times[m].encode.push_back(t.encode_s);
@@ -396,7 +405,11 @@ PlanReport RunPlanExperiment(const ExperimentConfig& c, const std::string& run_d
     if (static_cast<int>(pictures.size()) < c.plot_problems) pictures.push_back(picture);
   }
   for (std::size_t m = 0; m < c.methods.size(); ++m) {
-    PlanMethodResult result{c.methods[m].name, Summarise(per_method[m]), candidate_statuses[m]};
+    PlanMethodResult result;
+    result.method = c.methods[m].name;
+    result.summary = Summarise(per_method[m]);
+    result.candidate_statuses = candidate_statuses[m];
+    result.work = work[m];
     if (!times[m].total.empty()) {
       result.median_total_s = bench::Median(times[m].total);
       result.median_encode_s = bench::Median(times[m].encode);

@@ -39,6 +39,12 @@ struct PlanAttempt {
   std::optional<double> gfcs_cost;  ///< GFCS: the best candidate's GFCOP cost (s), solved or not
 };
 
+/// GFCS: the fabric work of a method, summed over problems.
+struct GfcsWork {
+  long long steps = 0;  ///< integration steps of every evaluated candidate
+  int stalled = 0;      ///< rollouts ended by the fabric's stall test (fabric.stall_window)
+};
+
 struct PlanMethodResult {
   std::string method;
   manipulation::MetricSummary summary;
@@ -49,6 +55,7 @@ struct PlanMethodResult {
   /// sampler) and the sampler's first batch (SGLD for the learned sampler), in s (summary.json
   /// "time_median_s"; medians, so the parts need not add up to the total).
   double median_total_s = 0, median_encode_s = 0, median_sample_s = 0;
+  GfcsWork work;  ///< summary.json "integration_steps", "stalled_rollouts"
 };
 
 struct PlanReport {
