@@ -45,7 +45,9 @@ def main():
         print(f"Loop: {loop['solved']}/{loop['solves']} training solves succeeded, "
               f"{loop['training_rounds']} training rounds, last InfoNCE {loop['last_loss']:.3f}; "
               f"solving {loop['solve_seconds']:.0f} s, negatives {loop['negative_seconds']:.0f} s, "
-              f"training {loop['train_seconds']:.0f} s (last invocation; 2 cores).\n")
+              f"training {loop['train_seconds']:.0f} s"
+              + (f", the whole loop {loop['loop_seconds']:.0f} s" if "loop_seconds" in loop else "")
+              + " (last invocation; 2 cores).\n")
     print("| family | method | success | EE length (m) | C-space length (rad) | time (s) | "
           "median time (s) | EE-LDJ | C-space LDJ |")
     print("|---|---|---|---|---|---|---|---|---|")
@@ -82,6 +84,36 @@ def main():
                       f"{ci(d['cost_both_solved_s'])} | {ci(d['solve_time_s'])} | "
                       f"{ci(d['success'])} | {d['success']['only_learned']} / "
                       f"{d['success']['only_uniform']} |")
+
+    split = time_split(run_dir, j["sets"])
+    if split:
+        print("\nWhere a GFCS solve's time goes (medians over the set's problems, s, 2 threads; "
+              "medians do not add up): the whole solve, the world's basis-point encoding and the "
+              "first batch's sampling (SGLD for the learned sampler); the rest is rollouts and "
+              "CMA-ES. Fabric steps: integration steps over every candidate of the set.\n")
+        print("| family | method | solve | encoding | first batch sampling | fabric steps (M) |")
+        print("|---|---|---|---|---|---|")
+        for row in split:
+            print("| " + " | ".join(row) + " |")
+
+
+def time_split(run_dir, sets):
+    """Per set and GFCS method: the medians of eval/<i>_<set>/summary.json's time_median_s."""
+    rows = []
+    for i, s in enumerate(sets):
+        path = os.path.join(run_dir, "eval", f"{i}_{s['set']}", "summary.json")
+        if not os.path.exists(path):
+            continue
+        for m in json.load(open(path))["methods"]:
+            t = m.get("time_median_s")
+            if not t:
+                continue
+            steps = m.get("integration_steps")
+            rows.append([s["set"], m["name"], f"{t['total']:.3f}", f"{t['encode']:.4f}",
+                         f"{t['first_batch_sampling']:.4f}",
+                         f"{steps / 1e6:.2f}" if steps is not None else "-"])
+    return rows
+
 
 if __name__ == "__main__":
     main()

@@ -138,19 +138,43 @@ int Shell(const std::string& command) {
   return WIFEXITED(s) ? WEXITSTATUS(s) : 128;
 }
 
+/// The energy layers of two artifacts are equal, bit for bit.
+void ExpectTheSameEnergyNet(const std::string& artifact_a, const std::string& artifact_b) {
+  const auto a = EnergyWeights(artifact_a), b = EnergyWeights(artifact_b);
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i)
+    EXPECT_EQ((a[i] - b[i]).cwiseAbs().maxCoeff(), 0.0f) << "layer " << i;
+}
+
+/// Relaunches both ranks of `command` (env + CLI call) in `d` with --resume through a fresh
+/// FileStore; the OR of their exit statuses (outputs in d/q0.out, d/q1.out).
+int ResumeTwoRanks(const std::string& d, const std::string& command) {
+  return Shell("cd " + d + " && (FORESIGHT_STORE_FILE=" + d + "/s2 RANK=0 " + command +
+               " --resume > q0.out 2>&1 & p0=$!; FORESIGHT_STORE_FILE=" + d + "/s2 RANK=1 " +
+               command +
+               " --resume > q1.out 2>&1 & p1=$!; wait $p0; a=$?; wait $p1; b=$?; exit $((a | b)))");
+}
+
+/// Writes `c` to d/tiny.yaml and trains it on one rank into d/one (the reference model);
+/// whether that run succeeded (its output in d/one.out).
+::testing::AssertionResult TrainTheReferenceOnOneRank(const gfcs::ExperimentConfig& c,
+                                                      const std::string& d) {
+  testing::WriteText(d + "/tiny.yaml", config::ToYaml(c));
+  const std::string cli = FORESIGHT_CLI;
+  if (Shell("cd " + d + " && timeout 120 " + cli +
+            " train tiny.yaml --run-dir one --no-eval > one.out 2>&1") == 0)
+    return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << testing::ReadText(d + "/one.out");
+}
+
 TEST(GfcsLoop, TwoRanksShareTheSolvesAndEndWithTheModelOfOne) {
   gfcs::ExperimentConfig c = TinyConfig();
   c.loop.threads = 1;
   c.autoencoder.train.threads = 1;
   c.loop.gradient_shards = 2;  // the training rounds data-parallel too: one shard per rank
   testing::TempDir dir;
-  const std::string config = dir.File("tiny.yaml");
-  testing::WriteText(config, config::ToYaml(c));
   const std::string cli = FORESIGHT_CLI, d = dir.path();
-  ASSERT_EQ(Shell("cd " + d + " && timeout 120 " + cli +
-                  " train tiny.yaml --run-dir one --no-eval > one.out 2>&1"),
-            0)
-      << testing::ReadText(d + "/one.out");
+  ASSERT_TRUE(TrainTheReferenceOnOneRank(c, d));
   const std::string rank = "FORESIGHT_STORE_FILE=" + d +
                            "/store FORESIGHT_DIST_TIMEOUT_S=60 WORLD_SIZE=2 timeout 120 " + cli +
                            " train tiny.yaml --run-dir two --no-eval";
@@ -170,10 +194,7 @@ TEST(GfcsLoop, TwoRanksShareTheSolvesAndEndWithTheModelOfOne) {
   EXPECT_FALSE(Round3(log1).empty()) << log1;
   EXPECT_EQ(Round3(log1), Round3(testing::ReadText(d + "/one/log.txt")));
   EXPECT_TRUE(fs::exists(gfcs::LoopCheckpointPath(d + "/two", 1)));
-  const auto a = EnergyWeights(d + "/one/model.h5"), b = EnergyWeights(d + "/two/model.h5");
-  ASSERT_EQ(a.size(), b.size());
-  for (std::size_t i = 0; i < a.size(); ++i)
-    EXPECT_EQ((a[i] - b[i]).cwiseAbs().maxCoeff(), 0.0f) << "layer " << i;
+  ExpectTheSameEnergyNet(d + "/one/model.h5", d + "/two/model.h5");
 }
 
 TEST(GfcsLoop, TwoRanksKilledMidRunResumeToTheModelOfOne) {
@@ -182,11 +203,8 @@ TEST(GfcsLoop, TwoRanksKilledMidRunResumeToTheModelOfOne) {
   c.autoencoder.train.threads = 1;
   c.loop.passes = 4;  // 12 solves, 6 blocks
   testing::TempDir dir;
-  testing::WriteText(dir.File("tiny.yaml"), config::ToYaml(c));
   const std::string cli = FORESIGHT_CLI, d = dir.path();
-  ASSERT_EQ(Shell("cd " + d + " && timeout 120 " + cli +
-                  " train tiny.yaml --run-dir one --no-eval > one.out 2>&1"),
-            0);
+  ASSERT_TRUE(TrainTheReferenceOnOneRank(c, d));
   // Rank 1 is killed as soon as its loop checkpoint shows a few solves; rank 0 then fails (a short
   // collective timeout) wherever it was. Both are relaunched with --resume.
   const std::string env = "FORESIGHT_DIST_TIMEOUT_S=5 WORLD_SIZE=2 ";
@@ -199,16 +217,10 @@ TEST(GfcsLoop, TwoRanksKilledMidRunResumeToTheModelOfOne) {
   if (testing::ReadText(d + "/r0.out").find("error: rank 0 of 2") == std::string::npos)
     GTEST_SKIP()
         << "rank 1 finished before the kill reached it (a loaded machine): nothing to resume";
-  const int resumed = Shell(
-      "cd " + d + " && (FORESIGHT_STORE_FILE=" + d + "/s2 RANK=0 " + env + run +
-      " --resume > q0.out 2>&1 & p0=$!; FORESIGHT_STORE_FILE=" + d + "/s2 RANK=1 " + env + run +
-      " --resume > q1.out 2>&1 & p1=$!; wait $p0; a=$?; wait $p1; b=$?; exit $((a | b)))");
+  const int resumed = ResumeTwoRanks(d, env + run);
   ASSERT_EQ(resumed, 0) << testing::ReadText(d + "/r0.out") << testing::ReadText(d + "/q0.out")
                         << testing::ReadText(d + "/q1.out");
-  const auto a = EnergyWeights(d + "/one/model.h5"), b = EnergyWeights(d + "/two/model.h5");
-  ASSERT_EQ(a.size(), b.size());
-  for (std::size_t i = 0; i < a.size(); ++i)
-    EXPECT_EQ((a[i] - b[i]).cwiseAbs().maxCoeff(), 0.0f) << "layer " << i;
+  ExpectTheSameEnergyNet(d + "/one/model.h5", d + "/two/model.h5");
 }
 
 TEST(GfcsLoop, ASignalToOneRankStopsBothAndTheyResumeToTheModelOfOne) {
@@ -218,11 +230,8 @@ TEST(GfcsLoop, ASignalToOneRankStopsBothAndTheyResumeToTheModelOfOne) {
   c.loop.passes = 4;       // 12 solves
   c.loop.train_every = 6;  // blocks of 3 solves per rank: the stop flag, not the block end, stops
   testing::TempDir dir;
-  testing::WriteText(dir.File("tiny.yaml"), config::ToYaml(c));
   const std::string cli = FORESIGHT_CLI, d = dir.path();
-  ASSERT_EQ(Shell("cd " + d + " && timeout 120 " + cli +
-                  " train tiny.yaml --run-dir one --no-eval > one.out 2>&1"),
-            0);
+  ASSERT_TRUE(TrainTheReferenceOnOneRank(c, d));
   // SIGTERM to rank 0 only, once its log shows a few solves; rank 1 must stop too (the flag in
   // the store), not fail on a lost peer and not run on to the end.
   const std::string env = "FORESIGHT_DIST_TIMEOUT_S=60 WORLD_SIZE=2 ";
@@ -238,15 +247,9 @@ TEST(GfcsLoop, ASignalToOneRankStopsBothAndTheyResumeToTheModelOfOne) {
   EXPECT_NE(r1.find("interrupted; continue with --resume"), std::string::npos) << r1;
   EXPECT_EQ(r1.find("failed"), std::string::npos) << r1;
   EXPECT_FALSE(fs::exists(d + "/two/model.h5"));
-  const int resumed = Shell(
-      "cd " + d + " && (FORESIGHT_STORE_FILE=" + d + "/s2 RANK=0 " + env + run +
-      " --resume > q0.out 2>&1 & p0=$!; FORESIGHT_STORE_FILE=" + d + "/s2 RANK=1 " + env + run +
-      " --resume > q1.out 2>&1 & p1=$!; wait $p0; a=$?; wait $p1; b=$?; exit $((a | b)))");
+  const int resumed = ResumeTwoRanks(d, env + run);
   ASSERT_EQ(resumed, 0) << testing::ReadText(d + "/q0.out") << testing::ReadText(d + "/q1.out");
-  const auto a = EnergyWeights(d + "/one/model.h5"), b = EnergyWeights(d + "/two/model.h5");
-  ASSERT_EQ(a.size(), b.size());
-  for (std::size_t i = 0; i < a.size(); ++i)
-    EXPECT_EQ((a[i] - b[i]).cwiseAbs().maxCoeff(), 0.0f) << "layer " << i;
+  ExpectTheSameEnergyNet(d + "/one/model.h5", d + "/two/model.h5");
 }
 
 TEST(GfcsConfig, HeldOutProblemsMayNotOverlapTheTrainingOnes) {

@@ -64,7 +64,7 @@ struct LoopConfig {
   double learning_rate = 1e-4;
   int batch_positives = 64;  ///< positives per Adam step (each with its negatives)
   int negatives = 16;        ///< N_neg SGLD negatives per positive, drawn before each round
-  manipulation::SgldParams negative_sgld;  ///< SGLD of the negatives (particles: unused)
+  manipulation::SgldParams negative_sgld;  ///< SGLD of the negatives (particles, threads: unused)
   bool reached_only = true;                ///< only candidates that reach the goal become positives
   int batches = 30;                        ///< GFCS while training: batches ...
   int batch_size = 30;                     ///< ... of this many candidates (thesis 30 x 30)
@@ -90,7 +90,8 @@ struct LoopConfig {
              "positives per Adam step");
     a->Visit("negatives", &negatives, Range::Closed(1, 100000), "SGLD negatives per positive");
     a->Visit("negative_sgld", &negative_sgld, Range::Any(),
-             "SGLD drawing the negatives (its particles key is unused)");
+             "SGLD drawing the negatives (its particles and threads keys are unused: loop.threads "
+             "share the buffer entries)");
     a->Visit("reached_only", &reached_only, Range::Any(),
              "only candidates reaching the goal become positives");
     a->Visit("batches", &batches, Range::Closed(1, 1000), "GFCS batches while training");
