@@ -2,6 +2,7 @@
 
 #include <Eigen/Cholesky>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -55,6 +56,29 @@ ScalarTask SphereObstacleTask(const World& world, const Eigen::Vector3d& p_W, do
   return t;
 }
 
+ScalarTask SphereObstacleTask(const World& world, double signed_distance, int closest,
+                              const Eigen::Vector3d& p_W, double radius, const PointJacobian& J_p,
+                              const Eigen::Vector3d& jdq_p, const JointVector& qd) {
+  ScalarTask t;
+  Eigen::Vector3d n;
+  world.ObstacleSignedDistance(closest, p_W, &n);
+  t.x = signed_distance - radius;
+  t.J = n.transpose() * J_p;
+  const Eigen::Vector3d v = J_p * qd;
+  t.xd = n.dot(v);
+  double curvature = 0;
+  const double speed = v.norm();
+  if (speed > 0) {
+    const Eigen::Vector3d u = v / speed;
+    Eigen::Vector3d n_plus, n_minus;
+    world.ObstacleSignedDistance(closest, p_W + kCurvatureStep * u, &n_plus);
+    world.ObstacleSignedDistance(closest, p_W - kCurvatureStep * u, &n_minus);
+    curvature = speed * speed * u.dot(n_plus - n_minus) / (2 * kCurvatureStep);
+  }
+  t.jdq = n.dot(jdq_p) + curvature;
+  return t;
+}
+
 ScalarTask SpherePairTask(const Eigen::Vector3d& p_a, double r_a, const PointJacobian& J_a,
                           const Eigen::Vector3d& jdq_a, const Eigen::Vector3d& p_b, double r_b,
                           const PointJacobian& J_b, const Eigen::Vector3d& jdq_b,
@@ -93,6 +117,7 @@ const char* ToString(RolloutStatus status) {
 
 Fabric::Fabric(const RobotModel& robot, const World& world, const FabricParams& params)
     : robot_(robot), world_(world), params_(params) {
+  BuildBroadPhase();
   FS_THROW_UNLESS(params.dt > 0 && params.t_max >= params.dt,
                   "fabric: dt must be positive and at most t_max (dt ", params.dt, ", t_max ",
                   params.t_max, ")");
@@ -107,6 +132,52 @@ Fabric::Fabric(const RobotModel& robot, const World& world, const FabricParams& 
                   params.stall_window, ", ", params.stall_progress, " and ", params.stall_fraction);
   FS_THROW_UNLESS(params.base_inertia > 0, "fabric: base_inertia must be positive, got ",
                   params.base_inertia);
+}
+
+void Fabric::BuildBroadPhase() {
+  const auto& spheres = robot_.spheres();
+  const int num_spheres = static_cast<int>(spheres.size());
+  KinematicsData kin = robot_.MakeData();
+  ForwardKinematics(robot_, JointVector::Zero(), &kin);
+  // Sphere centres in their body frames, grouped by body.
+  std::array<std::vector<int>, kDof + 1> on_body;
+  std::vector<Eigen::Vector3d> p_BS(static_cast<std::size_t>(num_spheres));
+  for (int s = 0; s < num_spheres; ++s) {
+    const int body = robot_.num_supporting_joints(spheres[static_cast<std::size_t>(s)].link);
+    on_body[static_cast<std::size_t>(body)].push_back(s);
+    p_BS[static_cast<std::size_t>(s)] =
+        kin.X_WB[static_cast<std::size_t>(body)].inverse() * Eigen::Vector3d(kin.p_WS.col(s));
+  }
+  sphere_bound_.assign(static_cast<std::size_t>(num_spheres), -1);
+  for (int body = 0; body <= kDof; ++body) {
+    const std::vector<int>& members = on_body[static_cast<std::size_t>(body)];
+    if (members.empty()) continue;
+    BodyBound bound;
+    bound.body = body;
+    for (int s : members) bound.p_BC += p_BS[static_cast<std::size_t>(s)];
+    bound.p_BC /= static_cast<double>(members.size());
+    for (int s : members) {
+      bound.radius =
+          std::max(bound.radius, (p_BS[static_cast<std::size_t>(s)] - bound.p_BC).norm() +
+                                     spheres[static_cast<std::size_t>(s)].radius);
+      sphere_bound_[static_cast<std::size_t>(s)] = static_cast<int>(body_bounds_.size());
+    }
+    // Rounding of the centre's transform and of the distances (m): a bound never skips a sphere
+    // it should have kept.
+    bound.radius += 1e-9;
+    body_bounds_.push_back(bound);
+  }
+  const int num_bounds = static_cast<int>(body_bounds_.size());
+  pair_runs_.clear();
+  const auto& pairs = robot_.self_collision_pairs();
+  for (std::size_t i = 0; i < pairs.size(); ++i) {
+    const auto [a, b] = pairs[i];
+    const int other = sphere_bound_[static_cast<std::size_t>(b)];
+    const int group = sphere_bound_[static_cast<std::size_t>(a)] * num_bounds + other;
+    if (pair_runs_.empty() || pair_runs_.back().sphere != a || pair_runs_.back().group != group)
+      pair_runs_.push_back({static_cast<int>(i), static_cast<int>(i), a, group, other});
+    ++pair_runs_.back().end;
+  }
 }
 
 FabricWorkspace Fabric::MakeWorkspace() const { return FabricWorkspace{robot_.MakeData(), {}}; }
@@ -141,35 +212,80 @@ bool Fabric::Acceleration(const JointVector& q, const JointVector& qd, const Joi
     }
   }
 
-  // Body spheres vs the world (closest obstacle) and checked sphere pairs. The cheap distance
-  // test comes first; the pull-back only for terms within range.
+  // Body spheres vs the world (closest obstacle) and checked sphere pairs. The broad phase
+  // first (FabricProbe): bodies whose bounding sphere is out of range skip their spheres; then
+  // the cheap distance test; the pull-back only for terms within range. Spheres and pairs keep
+  // their order, so the sums are those of the full loops.
   const auto& spheres = robot_.spheres();
   const int num_spheres = static_cast<int>(spheres.size());
-  // A sphere whose centre is farther than range + radius from the box around every obstacle
-  // can neither collide nor have an active term: its exact distance is not needed.
+  const int num_bounds = static_cast<int>(body_bounds_.size());
+  std::array<Eigen::Vector3d, kDof + 1> c_W;  // bounding-sphere centres in W
+  for (int k = 0; k < num_bounds; ++k) {
+    const BodyBound& bound = body_bounds_[static_cast<std::size_t>(k)];
+    c_W[static_cast<std::size_t>(k)] = kin.X_WB[static_cast<std::size_t>(bound.body)] * bound.p_BC;
+  }
+  std::array<bool, kDof + 1> near_world{};
   const Eigen::AlignedBox3d& bounds = world_.bounds();
-  const bool any_obstacle = world_.num_obstacles() > 0;
+  if (!p.broad_phase) {
+    near_world.fill(world_.num_obstacles() > 0);
+  } else if (world_.num_obstacles() > 0) {
+    for (int k = 0; k < num_bounds; ++k) {
+      const double reach = p.obstacles.range + body_bounds_[static_cast<std::size_t>(k)].radius;
+      const Eigen::Vector3d& c = c_W[static_cast<std::size_t>(k)];
+      if (bounds.exteriorDistance(c) > reach) continue;
+      ++probe.obstacle_distances;
+      near_world[static_cast<std::size_t>(k)] = !(world_.SignedDistance(c, nullptr) > reach);
+    }
+  }
   for (int s = 0; s < num_spheres; ++s) {
-    if (!any_obstacle) break;
+    if (!near_world[static_cast<std::size_t>(sphere_bound_[static_cast<std::size_t>(s)])]) continue;
     const double cutoff = p.obstacles.range + spheres[s].radius;
     if (bounds.exteriorDistance(Eigen::Vector3d(kin.p_WS.col(s))) > cutoff) continue;
-    const double x = world_.SignedDistance(kin.p_WS.col(s), nullptr) - spheres[s].radius;
+    int closest = -1;
+    ++probe.obstacle_distances;
+    const double d = world_.SignedDistance(kin.p_WS.col(s), nullptr, &closest);
+    const double x = d - spheres[s].radius;
     probe.min_obstacle_clearance = std::min(probe.min_obstacle_clearance, x);
     if (!(x < p.obstacles.range) || x <= 0) continue;
-    const ScalarTask t = SphereObstacleTask(world_, kin.p_WS.col(s), spheres[s].radius, kin.J_WS[s],
-                                            kin.Jdot_qdot_WS[s], qd);
+    const ScalarTask t = SphereObstacleTask(world_, d, closest, kin.p_WS.col(s), spheres[s].radius,
+                                            kin.J_WS[s], kin.Jdot_qdot_WS[s], qd);
     probe.active_obstacle_terms += AddBarrierTerm(p.obstacles, t, &M, &f);
   }
-  for (const auto& [a, b] : robot_.self_collision_pairs()) {
-    const double reach = spheres[a].radius + spheres[b].radius;
-    const double x = (kin.p_WS.col(a) - kin.p_WS.col(b)).norm() - reach;
-    probe.min_self_clearance = std::min(probe.min_self_clearance, x);
-    if (!(x < p.self.range) || x <= 0) continue;
-    const ScalarTask t =
-        SpherePairTask(kin.p_WS.col(a), spheres[a].radius, kin.J_WS[a], kin.Jdot_qdot_WS[a],
-                       kin.p_WS.col(b), spheres[b].radius, kin.J_WS[b], kin.Jdot_qdot_WS[b], qd);
-    probe.active_self_terms += AddBarrierTerm(p.self, t, &M, &f);
+  std::array<bool, (kDof + 1) * (kDof + 1)> near_pair{};
+  for (int a = 0; a < num_bounds; ++a) {
+    for (int b = 0; b < num_bounds; ++b) {
+      const double reach = p.self.range + body_bounds_[static_cast<std::size_t>(a)].radius +
+                           body_bounds_[static_cast<std::size_t>(b)].radius;
+      near_pair[static_cast<std::size_t>(a * num_bounds + b)] =
+          !p.broad_phase ||
+          !((c_W[static_cast<std::size_t>(a)] - c_W[static_cast<std::size_t>(b)]).norm() > reach);
+    }
   }
+  const auto& pairs = robot_.self_collision_pairs();
+  double min_self_clearance = std::numeric_limits<double>::infinity();
+  for (const PairRun& run : pair_runs_) {
+    if (!near_pair[static_cast<std::size_t>(run.group)]) continue;
+    if (p.broad_phase) {
+      const double reach = p.self.range + spheres[run.sphere].radius +
+                           body_bounds_[static_cast<std::size_t>(run.other_bound)].radius;
+      if ((kin.p_WS.col(run.sphere) - c_W[static_cast<std::size_t>(run.other_bound)]).norm() >
+          reach)
+        continue;
+    }
+    probe.pair_distances += run.end - run.begin;
+    for (int i = run.begin; i < run.end; ++i) {
+      const auto [a, b] = pairs[static_cast<std::size_t>(i)];
+      const double reach = spheres[a].radius + spheres[b].radius;
+      const double x = (kin.p_WS.col(a) - kin.p_WS.col(b)).norm() - reach;
+      min_self_clearance = std::min(min_self_clearance, x);
+      if (!(x < p.self.range) || x <= 0) continue;
+      const ScalarTask t =
+          SpherePairTask(kin.p_WS.col(a), spheres[a].radius, kin.J_WS[a], kin.Jdot_qdot_WS[a],
+                         kin.p_WS.col(b), spheres[b].radius, kin.J_WS[b], kin.Jdot_qdot_WS[b], qd);
+      probe.active_self_terms += AddBarrierTerm(p.self, t, &M, &f);
+    }
+  }
+  probe.min_self_clearance = min_self_clearance;
 
   // Attractor: metric, forcing and damping towards the command.
   const JointVector x_c = q - command;

@@ -95,6 +95,10 @@ struct FabricParams {
   double stall_window = 0.0;
   double stall_progress = 0.01;  ///< rad (2-norm of q - command)
   double stall_fraction = 0.2;   ///< of the distance left beyond the tolerance
+  /// Skip the spheres and pairs of bodies whose bounding spheres are out of range (FabricProbe).
+  /// The same rollouts either way (tested bit for bit); false is the reference the benchmark
+  /// compares against.
+  bool broad_phase = true;
 
   template <class A>
   void Serialize(A* a) {
@@ -133,6 +137,9 @@ struct FabricParams {
     a->Visit("stall_fraction", &stall_fraction, config::Range::OpenClosed(0.0, 1.0),
              "progress that resets the stall window near the command: this share of the "
              "distance left beyond the tolerance");
+    a->Visit("broad_phase", &broad_phase, config::Range::Any(),
+             "skip the spheres and pairs of bodies whose bounding spheres are out of range (the "
+             "same rollouts; false: every distance, the benchmark's reference)");
   }
 };
 
@@ -151,6 +158,16 @@ struct ScalarTask {
 ScalarTask SphereObstacleTask(const World& world, const Eigen::Vector3d& p_W, double radius,
                               const PointJacobian& J_p, const Eigen::Vector3d& jdq_p,
                               const JointVector& qd);
+
+/// The same for a sphere whose centre's world distance `signed_distance` and closest obstacle
+/// `closest` (World::SignedDistance's) are known: the normal and the curvature come from that
+/// obstacle alone (three single-primitive queries instead of three over the world). The result
+/// equals the overload above wherever the closest obstacle is the same within kCurvatureStep
+/// (1e-5 m) of p_W along its velocity; across such a switch the world's minimum has a kink and
+/// this one keeps the one-sided (smooth) curvature.
+ScalarTask SphereObstacleTask(const World& world, double signed_distance, int closest,
+                              const Eigen::Vector3d& p_W, double radius, const PointJacobian& J_p,
+                              const Eigen::Vector3d& jdq_p, const JointVector& qd);
 
 /// Distance between two spheres' surfaces: x = |p_a - p_b| - r_a - r_b, n = (p_a - p_b)/|.|,
 /// J = n'(J_a - J_b), J' q_d = n'(jdq_a - jdq_b) + (|v|^2 - (n'v)^2) / |p_a - p_b|, v = (J_a -
@@ -190,13 +207,25 @@ struct RolloutResult {
 
 /// What the last Acceleration() saw: clearances for the rollout's collision checks, and the fused
 /// metric and energised geometry for tests.
+///
+/// Broad phase: the spheres of one body (those moved by the same arm joints) lie in a bounding
+/// sphere fixed to the body. Since a signed distance is 1-Lipschitz, a body whose bounding sphere
+/// is farther than obstacles.range from the world (or from the box around all obstacles) has no
+/// sphere within range, and two bodies whose bounding spheres are farther apart than self.range
+/// have no pair within range, nor has a sphere farther than that from the other body's bounding
+/// sphere: their distances are not computed. Skipped spheres and
+/// pairs could not add a term or collide, so M and the forces are those of the full sums.
 struct FabricProbe {
   Eigen::Matrix<double, kDof, kDof> metric = Eigen::Matrix<double, kDof, kDof>::Zero();  ///< M
   JointVector energized = JointVector::Zero();  ///< q_dd_e (before forcing and damping)
-  /// min over spheres of d_W(p_s) - r_s (m); spheres farther than obstacles.range from the box
-  /// around all obstacles are left out (+inf when all are)
+  /// min over the spheres the broad phase kept of d_W(p_s) - r_s (m): exact whenever the true
+  /// minimum is below obstacles.range; otherwise at least that (+inf when no sphere was kept)
   double min_obstacle_clearance = 0;
-  double min_self_clearance = 0;  ///< min over checked pairs (m)
+  /// min over the pairs the broad phase kept (m): exact whenever the true minimum over checked
+  /// pairs is below self.range; otherwise at least that
+  double min_self_clearance = 0;
+  int obstacle_distances = 0;  ///< world distance queries made (bodies and spheres)
+  int pair_distances = 0;      ///< sphere-pair distances computed
   int active_obstacle_terms = 0;
   int active_self_terms = 0;
 };
@@ -237,9 +266,29 @@ class Fabric {
                         CommandRole role = CommandRole::kGoal) const;
 
  private:
+  /// The spheres of one body and a sphere around them, fixed to the body (centre p_BC in the body
+  /// frame; every sphere s of the body has |p_s - c| + r_s <= radius).
+  struct BodyBound {
+    int body = 0;
+    Eigen::Vector3d p_BC = Eigen::Vector3d::Zero();
+    double radius = 0;
+  };
+  /// Fills body_bounds_, sphere_bound_ and pair_runs_ from the robot's spheres (FK at q = 0).
+  void BuildBroadPhase();
+
   const RobotModel& robot_;
   const World& world_;
   FabricParams params_;
+  std::vector<BodyBound> body_bounds_;  ///< bodies that carry spheres
+  std::vector<int> sphere_bound_;       ///< [num_spheres] index into body_bounds_
+  /// Maximal runs of consecutive self-collision pairs (in the robot's order) of one sphere a with
+  /// the spheres of one other body: [begin, end), a, the group a_bound * bounds + b_bound and
+  /// b_bound. The broad phase skips whole runs: when the two bodies' bounds are out of range, or
+  /// sphere a is out of range of the other body's bound.
+  struct PairRun {
+    int begin = 0, end = 0, sphere = 0, group = 0, other_bound = 0;
+  };
+  std::vector<PairRun> pair_runs_;
 };
 
 }  // namespace foresight::manipulation

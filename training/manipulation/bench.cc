@@ -2,8 +2,9 @@
 // measured in one run on one thread (except the GFCS solve, which uses the config's threads):
 // forward kinematics of every collision sphere (positions; with Jacobians and J' q_d), one fabric
 // step, a full rollout to the goal, and a GFCS solve (one batch, uniform sampler) with and without
-// pruning (GfcsParams::prune: the same top candidates). Medians of repeated runs over the config's
-// problems. KDL side by side: the bench_kinematics benchmark (experiments/).
+// pruning (GfcsParams::prune: the same top candidates), and the step, rollout and solve again with
+// the fabric's broad phase switched (the rollouts compared bit for bit). Medians of repeated runs
+// over the config's problems. KDL side by side: the bench_kinematics benchmark (experiments/).
 
 #include "core/bench.h"
 
@@ -62,30 +63,44 @@ void RunManipulationBench(const BenchRequest& req, const ManipulationBenchOption
     ForwardKinematicsWithJacobians(robot, qs[k], qds[k], &data);
   });
 
-  // Fabric step and rollout on each problem's world (valid start states).
+  // Fabric step, rollout and GFCS solve on each problem's world (valid start states); each also
+  // with the broad phase switched (FabricParams::broad_phase; false computes every distance), the
+  // rollouts compared bit for bit.
+  FabricParams reference_params = c.fabric;
+  reference_params.broad_phase = !c.fabric.broad_phase;
   std::vector<double> steps, rollouts, rollout_times, solves, unpruned_solves, pruned_shares;
+  std::vector<double> reference_steps, reference_rollouts, reference_solves;
+  bool same_rollouts = true;
+  struct {
+    double steps = 0, world_queries = 0, pair_distances = 0, obstacle_terms = 0, self_terms = 0;
+  } work;  // summed over the states of every problem's rollout
   for (const ManipulationProblem& problem : problems) {
     const ValidityChecker checker(robot, problem.world);
     if (checker.Check(problem.start, &data) != Validity::kValid) continue;
-    const Fabric fabric(robot, problem.world, c.fabric);
-    FabricWorkspace ws = fabric.MakeWorkspace();
-    JointVector qdd;
-    steps.push_back(SecondsPerCall(a.repeats, calls, [&](int i) {
-      fabric.Acceleration(problem.start, 0.1 * qds[static_cast<std::size_t>(i) % qds.size()],
-                          problem.goal, &ws, &qdd);
-    }));
-    RolloutResult r;
-    rollouts.push_back(SecondsPerCall(a.repeats, 1, [&](int) {
-      r = fabric.Rollout(problem.start, JointVector::Zero(), problem.goal, &ws);
-    }));
-    rollout_times.push_back(r.t);
-    UniformSampler sampler(limits.lower, limits.upper);
-    GfcsParams params = c.gfcs;
-    params.batches = 1;
     GfcsQuery query;
     query.start = problem.start;
     query.goal = problem.goal;
-    SolveGfcop(fabric, query, &sampler, params);  // warm-up: neither timed solve runs cold
+    UniformSampler sampler(limits.lower, limits.upper);
+    GfcsParams params = c.gfcs;
+    params.batches = 1;
+    // One fabric's step, rollout and pruned solve, appended to the three lists.
+    const auto measure = [&](const Fabric& fabric, std::vector<double>* step_times,
+                             std::vector<double>* rollout_times_s, RolloutResult* r) {
+      FabricWorkspace ws = fabric.MakeWorkspace();
+      JointVector qdd;
+      step_times->push_back(SecondsPerCall(a.repeats, calls, [&](int i) {
+        fabric.Acceleration(problem.start, 0.1 * qds[static_cast<std::size_t>(i) % qds.size()],
+                            problem.goal, &ws, &qdd);
+      }));
+      rollout_times_s->push_back(SecondsPerCall(a.repeats, 1, [&](int) {
+        *r = fabric.Rollout(problem.start, JointVector::Zero(), problem.goal, &ws);
+      }));
+      SolveGfcop(fabric, query, &sampler, params);  // warm-up: no timed solve runs cold
+    };
+    const Fabric fabric(robot, problem.world, c.fabric);
+    RolloutResult r;
+    measure(fabric, &steps, &rollouts, &r);
+    rollout_times.push_back(r.t);
     params.prune = false;
     unpruned_solves.push_back(
         SecondsPerCall(a.repeats, 1, [&](int) { SolveGfcop(fabric, query, &sampler, params); }));
@@ -95,11 +110,40 @@ void RunManipulationBench(const BenchRequest& req, const ManipulationBenchOption
         a.repeats, 1, [&](int) { solution = SolveGfcop(fabric, query, &sampler, params); }));
     pruned_shares.push_back(static_cast<double>(solution.pruned) /
                             std::max(1, solution.evaluations));
+
+    const Fabric reference(robot, problem.world, reference_params);
+    RolloutResult reference_r;
+    measure(reference, &reference_steps, &reference_rollouts, &reference_r);
+    // The broad phase's work along the rollout: distances computed per step.
+    {
+      FabricWorkspace ws = fabric.MakeWorkspace();
+      std::vector<JointVector> path{problem.start};
+      fabric.Rollout(problem.start, JointVector::Zero(), problem.goal, &ws, &path);
+      JointVector qdd;
+      for (std::size_t k = 0; k + 1 < path.size(); ++k) {
+        fabric.Acceleration(path[k], (path[k + 1] - path[k]) / c.fabric.dt, problem.goal, &ws,
+                            &qdd);
+        work.steps += 1;
+        work.world_queries += ws.probe.obstacle_distances;
+        work.pair_distances += ws.probe.pair_distances;
+        work.obstacle_terms += ws.probe.active_obstacle_terms;
+        work.self_terms += ws.probe.active_self_terms;
+      }
+    }
+    same_rollouts = same_rollouts && reference_r.status == r.status && reference_r.q == r.q &&
+                    reference_r.qd == r.qd && reference_r.steps == r.steps;
+    reference_solves.push_back(
+        SecondsPerCall(a.repeats, 1, [&](int) { SolveGfcop(reference, query, &sampler, params); }));
   }
   FS_THROW_UNLESS(!steps.empty(), "bench: no problem has a valid start");
   const double step = Median(steps), rollout = Median(rollouts), solve = Median(solves);
   const double unpruned = Median(unpruned_solves), pruned_share = Median(pruned_shares);
   const double integrated = Median(rollout_times);
+  const double reference_step = Median(reference_steps);
+  const double reference_rollout = Median(reference_rollouts);
+  const double reference_solve = Median(reference_solves);
+  const auto per_step = [&](double total) { return total / std::max(1.0, work.steps); };
+  const char* reference_name = reference_params.broad_phase ? "broad_phase" : "full";
 
   if (req.json) {
     std::cout << std::setprecision(6) << "{\"spheres\": " << robot.num_spheres()
@@ -109,7 +153,17 @@ void RunManipulationBench(const BenchRequest& req, const ManipulationBenchOption
               << ", \"gfcs_solve_unpruned_s\": " << unpruned
               << ", \"gfcs_pruned_share\": " << pruned_share
               << ", \"gfcs_batch_size\": " << c.gfcs.batch_size
-              << ", \"problems\": " << steps.size() << "}\n";
+              << ", \"problems\": " << steps.size()
+              << ", \"broad_phase\": " << (c.fabric.broad_phase ? "true" : "false")
+              << ", \"fabric_step_" << reference_name << "_us\": " << reference_step * 1e6
+              << ", \"rollout_" << reference_name << "_ms\": " << reference_rollout * 1e3
+              << ", \"gfcs_solve_" << reference_name << "_s\": " << reference_solve
+              << ", \"same_rollouts\": " << (same_rollouts ? "true" : "false")
+              << ", \"per_step\": {\"world_queries\": " << per_step(work.world_queries)
+              << ", \"pair_distances\": " << per_step(work.pair_distances)
+              << ", \"active_obstacle_terms\": " << per_step(work.obstacle_terms)
+              << ", \"active_self_terms\": " << per_step(work.self_terms)
+              << ", \"checked_pairs\": " << robot.self_collision_pairs().size() << "}}\n";
     return;
   }
   std::cout << std::fixed << std::setprecision(2) << "robot: " << robot.num_spheres()
@@ -125,7 +179,18 @@ void RunManipulationBench(const BenchRequest& req, const ManipulationBenchOption
             << " threads, 0: all cores; pruned, median share of candidates stopped " << pruned_share
             << ")\n"
             << "  the same, unpruned              " << std::setw(8) << unpruned << " s   ("
-            << unpruned / solve << "x the pruned time)\n";
+            << unpruned / solve << "x the pruned time)\n"
+            << "broad phase " << (c.fabric.broad_phase ? "on" : "off") << " (the config) vs "
+            << (reference_params.broad_phase ? "on" : "off") << ": step " << step * 1e6 << " vs "
+            << reference_step * 1e6 << " us, rollout " << rollout * 1e3 << " vs "
+            << reference_rollout * 1e3 << " ms, solve " << std::setprecision(3) << solve << " vs "
+            << reference_solve << std::setprecision(2) << " s; rollouts "
+            << (same_rollouts ? "identical" : "DIFFERENT") << "\n"
+            << "per step along the rollouts: " << per_step(work.world_queries)
+            << " world distance queries, " << per_step(work.pair_distances) << " of "
+            << robot.self_collision_pairs().size() << " pair distances, "
+            << per_step(work.obstacle_terms) << " obstacle and " << per_step(work.self_terms)
+            << " self-collision terms active\n";
 }
 }  // namespace
 
