@@ -3,7 +3,7 @@
 # 6 s), RRT-Connect and GFCS (1 and 5 batches, uniform sampler) on problems 51-75 of the seven
 # MotionBenchMaker Panda families (needs ../shared/data or FORESIGHT_DATA); writes
 # runs/plan_<family>/ and runs/plan_<family>_reactivity/, results/manipulation.md,
-# results/manipulation_<family>_ee_paths.png, results/manipulation_bench_fabric.json and
+# results/manipulation_<family>_ee_paths.png, results/manipulation_bench_fabric{,_table_under}.json and
 # results/manipulation_bench_kinematics.json.
 #   experiments/manipulation.sh [key.path=value ...]   (overrides apply to every family)
 #   FORESIGHT_BIN=build-notorch/bin/foresight experiments/manipulation.sh   (another build)
@@ -32,6 +32,8 @@ cp runs/plan_table_under_pick/ee_paths.png "$OUT/manipulation_table_under_pick_e
 cp runs/plan_bookshelf_tall/ee_paths.png "$OUT/manipulation_bookshelf_tall_ee_paths.png"
 "$BIN" bench configs/manipulation/bookshelf_thin.yaml problems.last=60 --json \
   > "$OUT/manipulation_bench_fabric.json"
+"$BIN" bench configs/manipulation/table_under_pick.yaml problems.last=60 --json \
+  > "$OUT/manipulation_bench_fabric_table_under.json"
 # FK of the 59 spheres with Jacobians: ours against KDL's solvers in the same run (Google Benchmark).
 "$(dirname "$BIN")/bench_kinematics" --benchmark_repetitions=5 --benchmark_report_aggregates_only=true \
   --benchmark_format=json > "$OUT/manipulation_bench_kinematics.json"

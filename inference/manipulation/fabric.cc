@@ -27,6 +27,30 @@ bool AddBarrierTerm(const BarrierParams& p, const ScalarTask& t, Matrix7* M, Joi
   return true;
 }
 
+/// The obstacle task of a sphere with clearance x and unit normal n at its centre p_W;
+/// `gradient(p, &g)` gives the distance gradient at p, for the curvature's central difference.
+template <class Gradient>
+ScalarTask ObstacleTask(double x, const Eigen::Vector3d& n, const Eigen::Vector3d& p_W,
+                        const Gradient& gradient, const PointJacobian& J_p,
+                        const Eigen::Vector3d& jdq_p, const JointVector& qd) {
+  ScalarTask t;
+  t.x = x;
+  t.J = n.transpose() * J_p;
+  const Eigen::Vector3d v = J_p * qd;
+  t.xd = n.dot(v);
+  double curvature = 0;
+  const double speed = v.norm();
+  if (speed > 0) {
+    const Eigen::Vector3d u = v / speed;
+    Eigen::Vector3d n_plus, n_minus;
+    gradient(Eigen::Vector3d(p_W + kCurvatureStep * u), &n_plus);
+    gradient(Eigen::Vector3d(p_W - kCurvatureStep * u), &n_minus);
+    curvature = speed * speed * u.dot(n_plus - n_minus) / (2 * kCurvatureStep);
+  }
+  t.jdq = n.dot(jdq_p) + curvature;
+  return t;
+}
+
 }  // namespace
 
 double BarrierMetric(const BarrierParams& p, double x, double xd) {
@@ -37,46 +61,25 @@ double BarrierMetric(const BarrierParams& p, double x, double xd) {
 ScalarTask SphereObstacleTask(const World& world, const Eigen::Vector3d& p_W, double radius,
                               const PointJacobian& J_p, const Eigen::Vector3d& jdq_p,
                               const JointVector& qd) {
-  ScalarTask t;
   Eigen::Vector3d n;
-  t.x = world.SignedDistance(p_W, &n) - radius;
-  t.J = n.transpose() * J_p;
-  const Eigen::Vector3d v = J_p * qd;
-  t.xd = n.dot(v);
-  double curvature = 0;
-  const double speed = v.norm();
-  if (speed > 0) {
-    const Eigen::Vector3d u = v / speed;
-    Eigen::Vector3d n_plus, n_minus;
-    world.SignedDistance(p_W + kCurvatureStep * u, &n_plus);
-    world.SignedDistance(p_W - kCurvatureStep * u, &n_minus);
-    curvature = speed * speed * u.dot(n_plus - n_minus) / (2 * kCurvatureStep);
-  }
-  t.jdq = n.dot(jdq_p) + curvature;
-  return t;
+  const double clearance = world.SignedDistance(p_W, &n) - radius;
+  return ObstacleTask(
+      clearance, n, p_W,
+      [&](const Eigen::Vector3d& p, Eigen::Vector3d* g) { world.SignedDistance(p, g); }, J_p, jdq_p,
+      qd);
 }
 
 ScalarTask SphereObstacleTask(const World& world, double signed_distance, int closest,
                               const Eigen::Vector3d& p_W, double radius, const PointJacobian& J_p,
                               const Eigen::Vector3d& jdq_p, const JointVector& qd) {
-  ScalarTask t;
   Eigen::Vector3d n;
   world.ObstacleSignedDistance(closest, p_W, &n);
-  t.x = signed_distance - radius;
-  t.J = n.transpose() * J_p;
-  const Eigen::Vector3d v = J_p * qd;
-  t.xd = n.dot(v);
-  double curvature = 0;
-  const double speed = v.norm();
-  if (speed > 0) {
-    const Eigen::Vector3d u = v / speed;
-    Eigen::Vector3d n_plus, n_minus;
-    world.ObstacleSignedDistance(closest, p_W + kCurvatureStep * u, &n_plus);
-    world.ObstacleSignedDistance(closest, p_W - kCurvatureStep * u, &n_minus);
-    curvature = speed * speed * u.dot(n_plus - n_minus) / (2 * kCurvatureStep);
-  }
-  t.jdq = n.dot(jdq_p) + curvature;
-  return t;
+  return ObstacleTask(
+      signed_distance - radius, n, p_W,
+      [&](const Eigen::Vector3d& p, Eigen::Vector3d* g) {
+        world.ObstacleSignedDistance(closest, p, g);
+      },
+      J_p, jdq_p, qd);
 }
 
 ScalarTask SpherePairTask(const Eigen::Vector3d& p_a, double r_a, const PointJacobian& J_a,
