@@ -183,7 +183,13 @@ void Fabric::BuildBroadPhase() {
   }
 }
 
-FabricWorkspace Fabric::MakeWorkspace() const { return FabricWorkspace{robot_.MakeData(), {}}; }
+FabricWorkspace Fabric::MakeWorkspace() const {
+  FabricWorkspace ws{robot_.MakeData(), {}, {}, {}};
+  const auto n = static_cast<std::size_t>(world_.num_obstacles());
+  ws.obstacle_distances.resize(n);
+  ws.candidates.resize(static_cast<std::size_t>(kDof + 1) * n);
+  return ws;
+}
 
 bool Fabric::Acceleration(const JointVector& q, const JointVector& qd, const JointVector& command,
                           FabricWorkspace* ws, JointVector* qdd) const {
@@ -227,26 +233,46 @@ bool Fabric::Acceleration(const JointVector& q, const JointVector& qd, const Joi
     const BodyBound& bound = body_bounds_[static_cast<std::size_t>(k)];
     c_W[static_cast<std::size_t>(k)] = kin.X_WB[static_cast<std::size_t>(bound.body)] * bound.p_BC;
   }
-  std::array<bool, kDof + 1> near_world{};
+  // Per body, the obstacles within its bounding sphere's reach (ascending indices); a sphere is
+  // measured against those only. Without the broad phase: every obstacle for every body.
+  const int num_obstacles = world_.num_obstacles();
+  FS_THROW_UNLESS(static_cast<int>(ws->obstacle_distances.size()) == num_obstacles &&
+                      ws->candidates.size() == static_cast<std::size_t>((kDof + 1) * num_obstacles),
+                  "fabric: the workspace was made for another world (use this fabric's "
+                  "MakeWorkspace)");
+  std::array<int, kDof + 1> num_candidates{};
   const Eigen::AlignedBox3d& bounds = world_.bounds();
-  if (!p.broad_phase) {
-    near_world.fill(world_.num_obstacles() > 0);
-  } else if (world_.num_obstacles() > 0) {
-    for (int k = 0; k < num_bounds; ++k) {
-      const double reach = p.obstacles.range + body_bounds_[static_cast<std::size_t>(k)].radius;
-      const Eigen::Vector3d& c = c_W[static_cast<std::size_t>(k)];
-      if (bounds.exteriorDistance(c) > reach) continue;
-      ++probe.obstacle_distances;
-      near_world[static_cast<std::size_t>(k)] = !(world_.SignedDistance(c, nullptr) > reach);
+  for (int k = 0; k < num_bounds && num_obstacles > 0; ++k) {
+    int* candidates = ws->candidates.data() + static_cast<std::ptrdiff_t>(k) * num_obstacles;
+    int& count = num_candidates[static_cast<std::size_t>(k)];
+    if (!p.broad_phase) {
+      for (int i = 0; i < num_obstacles; ++i) candidates[count++] = i;
+      continue;
     }
+    const double reach = p.obstacles.range + body_bounds_[static_cast<std::size_t>(k)].radius;
+    const Eigen::Vector3d& c = c_W[static_cast<std::size_t>(k)];
+    if (bounds.exteriorDistance(c) > reach) continue;
+    ++probe.obstacle_distances;
+    world_.ObstacleDistances(c, ws->obstacle_distances.data());
+    for (int i = 0; i < num_obstacles; ++i)
+      if (!(ws->obstacle_distances[static_cast<std::size_t>(i)] > reach)) candidates[count++] = i;
   }
   for (int s = 0; s < num_spheres; ++s) {
-    if (!near_world[static_cast<std::size_t>(sphere_bound_[static_cast<std::size_t>(s)])]) continue;
+    const int k = sphere_bound_[static_cast<std::size_t>(s)];
+    const int count = num_candidates[static_cast<std::size_t>(k)];
+    if (count == 0) continue;
     const double cutoff = p.obstacles.range + spheres[s].radius;
     if (bounds.exteriorDistance(Eigen::Vector3d(kin.p_WS.col(s))) > cutoff) continue;
     int closest = -1;
     ++probe.obstacle_distances;
-    const double d = world_.SignedDistance(kin.p_WS.col(s), nullptr, &closest);
+    // All obstacles: the world's SIMD minimum; a few: those alone (the same numbers).
+    const double d =
+        count == num_obstacles
+            ? world_.SignedDistance(kin.p_WS.col(s), nullptr, &closest)
+            : world_.SignedDistanceAmong(
+                  kin.p_WS.col(s),
+                  ws->candidates.data() + static_cast<std::ptrdiff_t>(k) * num_obstacles, count,
+                  nullptr, &closest);
     const double x = d - spheres[s].radius;
     probe.min_obstacle_clearance = std::min(probe.min_obstacle_clearance, x);
     if (!(x < p.obstacles.range) || x <= 0) continue;

@@ -209,12 +209,14 @@ struct RolloutResult {
 /// metric and energised geometry for tests.
 ///
 /// Broad phase: the spheres of one body (those moved by the same arm joints) lie in a bounding
-/// sphere fixed to the body. Since a signed distance is 1-Lipschitz, a body whose bounding sphere
-/// is farther than obstacles.range from the world (or from the box around all obstacles) has no
-/// sphere within range, and two bodies whose bounding spheres are farther apart than self.range
-/// have no pair within range, nor has a sphere farther than that from the other body's bounding
-/// sphere: their distances are not computed. Skipped spheres and
-/// pairs could not add a term or collide, so M and the forces are those of the full sums.
+/// sphere fixed to the body. Since a signed distance is 1-Lipschitz, an obstacle farther than
+/// obstacles.range from a body's bounding sphere is farther than that from each of its spheres:
+/// a body's spheres are measured against the obstacles within its reach only (none: skipped;
+/// World::SignedDistanceAmong, the same numbers as the world's minimum), and two bodies whose
+/// bounding spheres are farther apart than self.range have no pair within range, nor has a sphere
+/// farther than that from the other body's bounding sphere: their distances are not computed.
+/// Skipped spheres and pairs could not add a term or collide, so M and the forces are those of the
+/// full sums.
 struct FabricProbe {
   Eigen::Matrix<double, kDof, kDof> metric = Eigen::Matrix<double, kDof, kDof>::Zero();  ///< M
   JointVector energized = JointVector::Zero();  ///< q_dd_e (before forcing and damping)
@@ -234,6 +236,10 @@ struct FabricProbe {
 struct FabricWorkspace {
   KinematicsData kinematics;
   FabricProbe probe;
+  /// The broad phase's buffers (sized by Fabric::MakeWorkspace for its world): the distance from
+  /// a body's bounding sphere to each obstacle, and per body the obstacles within its reach.
+  std::vector<double> obstacle_distances;  ///< [num_obstacles]
+  std::vector<int> candidates;             ///< [(kDof + 1) x num_obstacles]
 };
 
 class Fabric {

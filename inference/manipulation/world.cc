@@ -283,9 +283,53 @@ int World::FindObstacle(const std::string& id) const {
   return -1;
 }
 
+World::Lanes World::BoxLanes(int k0, double px, double py, double pz) const {
+  // sd = |max(q, 0)| + min(max_i q_i, 0), q = |p_L| - h.
+  auto c = [&](int j) { return box_table_.col(j).segment<kLanes>(k0).array(); };
+  const Lanes qx =
+      (c(kBoxR + 0) * px + c(kBoxR + 1) * py + c(kBoxR + 2) * pz + c(kBoxP + 0)).abs() -
+      c(kBoxH + 0);
+  const Lanes qy =
+      (c(kBoxR + 3) * px + c(kBoxR + 4) * py + c(kBoxR + 5) * pz + c(kBoxP + 1)).abs() -
+      c(kBoxH + 1);
+  const Lanes qz =
+      (c(kBoxR + 6) * px + c(kBoxR + 7) * py + c(kBoxR + 8) * pz + c(kBoxP + 2)).abs() -
+      c(kBoxH + 2);
+  const Lanes outside = (qx.max(0.0).square() + qy.max(0.0).square() + qz.max(0.0).square()).sqrt();
+  return outside + qx.max(qy).max(qz).min(0.0);
+}
+
+World::Lanes World::CylinderLanes(int k0, double px, double py, double pz) const {
+  // d = (rho - r, |z| - hh), sd = |max(d, 0)| + min(max(d0, d1), 0).
+  auto c = [&](int j) { return cylinder_table_.col(j).segment<kLanes>(k0).array(); };
+  const Lanes lx = c(kCylR + 0) * px + c(kCylR + 1) * py + c(kCylR + 2) * pz + c(kCylP + 0);
+  const Lanes ly = c(kCylR + 3) * px + c(kCylR + 4) * py + c(kCylR + 5) * pz + c(kCylP + 1);
+  const Lanes lz = c(kCylR + 6) * px + c(kCylR + 7) * py + c(kCylR + 8) * pz + c(kCylP + 2);
+  const Lanes d0 = (lx.square() + ly.square()).sqrt() - c(kCylRadius);
+  const Lanes d1 = lz.abs() - c(kCylHalfHeight);
+  return (d0.max(0.0).square() + d1.max(0.0).square()).sqrt() + d0.max(d1).min(0.0);
+}
+
+void World::ClosestGradient(const Eigen::Vector3d& p_W, int index, Eigen::Vector3d* grad_W) const {
+  if (index < 0) {
+    grad_W->setZero();
+    return;
+  }
+  const auto slot = static_cast<std::size_t>(slot_of_[static_cast<std::size_t>(index)]);
+  Eigen::Vector3d g_L;
+  if (obstacles_[static_cast<std::size_t>(index)].is_box()) {
+    const BoxSlot& s = boxes_[slot];
+    BoxDistanceGradient(s.R_LW * p_W + s.p_LW, s.half_size, &g_L);
+    *grad_W = s.R_LW.transpose() * g_L;
+  } else {
+    const CylinderSlot& s = cylinders_[slot];
+    CylinderDistanceGradient(s.R_LW * p_W + s.p_LW, s.radius, s.half_height, &g_L);
+    *grad_W = s.R_LW.transpose() * g_L;
+  }
+}
+
 double World::SignedDistance(const Eigen::Vector3d& p_W, Eigen::Vector3d* grad_W,
                              int* closest) const {
-  using Lanes = Eigen::Array<double, kLanes, 1>;
   const double px = p_W.x(), py = p_W.y(), pz = p_W.z();
   if (!p_W.allFinite()) {
     if (closest) *closest = -1;
@@ -295,23 +339,10 @@ double World::SignedDistance(const Eigen::Vector3d& p_W, Eigen::Vector3d* grad_W
   double best = kInf;
   int best_index = -1;
   Eigen::Index best_slot = -1;
-  bool best_is_box = true;
-  // Boxes, kLanes at a time: sd = |max(q, 0)| + min(max_i q_i, 0), q = |p_L| - h.
+  // Boxes, kLanes at a time.
   const int nb = num_boxes();
   for (int k0 = 0; k0 < nb; k0 += kLanes) {
-    auto c = [&](int j) { return box_table_.col(j).segment<kLanes>(k0).array(); };
-    const Lanes qx =
-        (c(kBoxR + 0) * px + c(kBoxR + 1) * py + c(kBoxR + 2) * pz + c(kBoxP + 0)).abs() -
-        c(kBoxH + 0);
-    const Lanes qy =
-        (c(kBoxR + 3) * px + c(kBoxR + 4) * py + c(kBoxR + 5) * pz + c(kBoxP + 1)).abs() -
-        c(kBoxH + 1);
-    const Lanes qz =
-        (c(kBoxR + 6) * px + c(kBoxR + 7) * py + c(kBoxR + 8) * pz + c(kBoxP + 2)).abs() -
-        c(kBoxH + 2);
-    const Lanes outside =
-        (qx.max(0.0).square() + qy.max(0.0).square() + qz.max(0.0).square()).sqrt();
-    const Lanes d = outside + qx.max(qy).max(qz).min(0.0);
+    const Lanes d = BoxLanes(k0, px, py, pz);
     Eigen::Index i = 0;
     const double m = d.minCoeff(&i);  // the first lane on ties
     if (m < best) {
@@ -320,16 +351,10 @@ double World::SignedDistance(const Eigen::Vector3d& p_W, Eigen::Vector3d* grad_W
     }
   }
   if (best_slot >= 0) best_index = box_index_[static_cast<std::size_t>(best_slot)];
-  // Cylinders: d = (rho - r, |z| - hh), sd = |max(d, 0)| + min(max(d0, d1), 0).
+  // Cylinders: ties go to the lower obstacle index.
   const int nc = num_cylinders();
   for (int k0 = 0; k0 < nc; k0 += kLanes) {
-    auto c = [&](int j) { return cylinder_table_.col(j).segment<kLanes>(k0).array(); };
-    const Lanes lx = c(kCylR + 0) * px + c(kCylR + 1) * py + c(kCylR + 2) * pz + c(kCylP + 0);
-    const Lanes ly = c(kCylR + 3) * px + c(kCylR + 4) * py + c(kCylR + 5) * pz + c(kCylP + 1);
-    const Lanes lz = c(kCylR + 6) * px + c(kCylR + 7) * py + c(kCylR + 8) * pz + c(kCylP + 2);
-    const Lanes d0 = (lx.square() + ly.square()).sqrt() - c(kCylRadius);
-    const Lanes d1 = lz.abs() - c(kCylHalfHeight);
-    const Lanes d = (d0.max(0.0).square() + d1.max(0.0).square()).sqrt() + d0.max(d1).min(0.0);
+    const Lanes d = CylinderLanes(k0, px, py, pz);
     Eigen::Index i = 0;
     const double m = d.minCoeff(&i);
     if (m <= best) {
@@ -337,26 +362,50 @@ double World::SignedDistance(const Eigen::Vector3d& p_W, Eigen::Vector3d* grad_W
       if (m < best || index < best_index) {
         best = m;
         best_index = index;
-        best_slot = k0 + i;
-        best_is_box = false;
       }
     }
   }
   if (closest) *closest = best_index;
-  if (grad_W) {
-    Eigen::Vector3d g_L;
-    if (best_index < 0) {
-      grad_W->setZero();
-    } else if (best_is_box) {
-      const BoxSlot& s = boxes_[static_cast<std::size_t>(best_slot)];
-      BoxDistanceGradient(s.R_LW * p_W + s.p_LW, s.half_size, &g_L);
-      *grad_W = s.R_LW.transpose() * g_L;
-    } else {
-      const CylinderSlot& s = cylinders_[static_cast<std::size_t>(best_slot)];
-      CylinderDistanceGradient(s.R_LW * p_W + s.p_LW, s.radius, s.half_height, &g_L);
-      *grad_W = s.R_LW.transpose() * g_L;
+  if (grad_W) ClosestGradient(p_W, best_index, grad_W);
+  return best;
+}
+
+void World::ObstacleDistances(const Eigen::Vector3d& p_W, double* distances) const {
+  const double px = p_W.x(), py = p_W.y(), pz = p_W.z();
+  const int nb = num_boxes(), nc = num_cylinders();
+  for (int k0 = 0; k0 < nb; k0 += kLanes) {
+    const Lanes d = BoxLanes(k0, px, py, pz);
+    for (int i = 0; i < kLanes && k0 + i < nb; ++i)
+      distances[box_index_[static_cast<std::size_t>(k0 + i)]] = d[i];
+  }
+  for (int k0 = 0; k0 < nc; k0 += kLanes) {
+    const Lanes d = CylinderLanes(k0, px, py, pz);
+    for (int i = 0; i < kLanes && k0 + i < nc; ++i)
+      distances[cylinder_index_[static_cast<std::size_t>(k0 + i)]] = d[i];
+  }
+}
+
+double World::SignedDistanceAmong(const Eigen::Vector3d& p_W, const int* obstacles, int count,
+                                  Eigen::Vector3d* grad_W, int* closest) const {
+  if (!p_W.allFinite()) return SignedDistance(p_W, grad_W, closest);
+  const double px = p_W.x(), py = p_W.y(), pz = p_W.z();
+  double best = kInf;
+  int best_index = -1;
+  for (int k = 0; k < count; ++k) {
+    const int i = obstacles[k];
+    const int slot = slot_of_[static_cast<std::size_t>(i)];
+    const int k0 = slot / kLanes * kLanes;
+    // The lane of the packet SignedDistance evaluates: the same number, bit for bit.
+    const double d = obstacles_[static_cast<std::size_t>(i)].is_box()
+                         ? BoxLanes(k0, px, py, pz)[slot - k0]
+                         : CylinderLanes(k0, px, py, pz)[slot - k0];
+    if (d < best) {  // ascending indices: ties keep the lower one, as SignedDistance
+      best = d;
+      best_index = i;
     }
   }
+  if (closest) *closest = best_index;
+  if (grad_W) ClosestGradient(p_W, best_index, grad_W);
   return best;
 }
 

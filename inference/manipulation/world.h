@@ -114,6 +114,14 @@ class World {
                         const Eigen::Ref<const Eigen::VectorXd>& radii,
                         Eigen::Ref<Eigen::VectorXd> clearance,
                         Eigen::Matrix3Xd* grad_W = nullptr) const;
+  /// The signed distance from p_W to every obstacle (m): distances[i] for obstacle i, i <
+  /// num_obstacles(); each the number SignedDistance compares for that obstacle.
+  void ObstacleDistances(const Eigen::Vector3d& p_W, double* distances) const;
+  /// min over the `count` obstacles listed (indices, ascending) of the signed distance from p_W,
+  /// with SignedDistance's numbers, tie rule and gradient convention: equal to SignedDistance,
+  /// bit for bit, whenever the world's closest obstacle is listed (+infinity when none is).
+  double SignedDistanceAmong(const Eigen::Vector3d& p_W, const int* obstacles, int count,
+                             Eigen::Vector3d* grad_W, int* closest = nullptr) const;
   /// Signed distance from p_W to obstacle i alone (m), with its gradient.
   double ObstacleSignedDistance(int i, const Eigen::Vector3d& p_W, Eigen::Vector3d* grad_W) const;
 
@@ -165,6 +173,13 @@ class World {
   };
   using BoxTable = Eigen::Matrix<double, Eigen::Dynamic, kBoxColumns>;
   using CylinderTable = Eigen::Matrix<double, Eigen::Dynamic, kCylColumns>;
+  using Lanes = Eigen::Array<double, kLanes, 1>;
+  /// Signed distances from (px, py, pz) to the kLanes boxes (cylinders) of the table's rows
+  /// [k0, k0 + kLanes): one branch-free SIMD expression; padding rows give +infinity.
+  Lanes BoxLanes(int k0, double px, double py, double pz) const;
+  Lanes CylinderLanes(int k0, double px, double py, double pz) const;
+  /// The unit gradient at p_W of obstacle `index` (conventions above); zero for index -1.
+  void ClosestGradient(const Eigen::Vector3d& p_W, int index, Eigen::Vector3d* grad_W) const;
 
   std::vector<Obstacle> obstacles_;
   std::vector<BoxSlot> boxes_;

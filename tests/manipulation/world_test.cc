@@ -7,9 +7,11 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
+#include <vector>
 
 #include "tests/alloc_counter.h"  // replaces operator new: one per binary
 #include "tests/test_util.h"
@@ -392,6 +394,74 @@ TEST(World, SphereClearancesMatchSingleQueries) {
   }
 }
 
+TEST(World, DistancesPerObstacleAndAmongAFewAreTheMinimumsNumbers) {
+  std::mt19937_64 rng(8);
+  const World w = RandomWorld(&rng, 7, 6);  // two SIMD chunks of each type, interleaved
+  const int n = w.num_obstacles();
+  std::normal_distribution<double> n01;
+  std::bernoulli_distribution keep(0.4);
+  std::vector<double> distances(static_cast<std::size_t>(n));
+  int with_closest = 0, without = 0;
+  for (int t = 0; t < 500; ++t) {
+    const Eigen::Vector3d p(n01(rng), n01(rng), n01(rng));
+    w.ObstacleDistances(p, distances.data());
+    for (int i = 0; i < n; ++i)
+      EXPECT_NEAR(distances[static_cast<std::size_t>(i)], w.ObstacleSignedDistance(i, p, nullptr),
+                  1e-12);
+    Eigen::Vector3d g_all, g_some;
+    int closest_all = -2, closest_some = -2;
+    const double all = w.SignedDistance(p, &g_all, &closest_all);
+    // The full list: the same minimum, bit for bit.
+    std::vector<int> every(static_cast<std::size_t>(n));
+    for (int i = 0; i < n; ++i) every[static_cast<std::size_t>(i)] = i;
+    EXPECT_EQ(w.SignedDistanceAmong(p, every.data(), n, &g_some, &closest_some), all);
+    EXPECT_EQ(closest_some, closest_all);
+    EXPECT_EQ(g_some, g_all);
+    // A random subset: the minimum over it (bit for bit the world's when its closest is listed).
+    std::vector<int> some;
+    for (int i = 0; i < n; ++i)
+      if (keep(rng)) some.push_back(i);
+    double expected = std::numeric_limits<double>::infinity();
+    int expected_closest = -1;
+    for (int i : some) {
+      if (distances[static_cast<std::size_t>(i)] < expected) {
+        expected = distances[static_cast<std::size_t>(i)];
+        expected_closest = i;
+      }
+    }
+    const double among = w.SignedDistanceAmong(p, some.data(), static_cast<int>(some.size()),
+                                               &g_some, &closest_some);
+    EXPECT_EQ(among, expected);
+    EXPECT_EQ(closest_some, expected_closest);
+    if (std::find(some.begin(), some.end(), closest_all) != some.end()) {
+      ++with_closest;
+      EXPECT_EQ(among, all);
+      EXPECT_EQ(g_some, g_all);
+    } else {
+      ++without;
+      EXPECT_GE(among, all);
+    }
+  }
+  EXPECT_GT(with_closest, 50);
+  EXPECT_GT(without, 50);
+  // Ties: the lowest listed index, as the minimum.
+  World twins;
+  twins.AddCylinder("c", Cylinder{Eigen::Isometry3d::Identity(), 0.5, 1.0});
+  twins.AddBox("b", Box{Eigen::Isometry3d::Identity(), Eigen::Vector3d(2, 2, 1)});
+  const int both[] = {0, 1}, box_only[] = {1};
+  int closest = -1;
+  EXPECT_EQ(twins.SignedDistanceAmong(Eigen::Vector3d(0, 0, 5), both, 2, nullptr, &closest), 4.0);
+  EXPECT_EQ(closest, 0);
+  EXPECT_EQ(twins.SignedDistanceAmong(Eigen::Vector3d(0, 0, 5), box_only, 1, nullptr, &closest),
+            4.0);
+  EXPECT_EQ(closest, 1);
+  Eigen::Vector3d g;
+  EXPECT_EQ(twins.SignedDistanceAmong(Eigen::Vector3d(0, 0, 5), both, 0, &g, &closest),
+            std::numeric_limits<double>::infinity());
+  EXPECT_EQ(closest, -1);
+  EXPECT_EQ(g, Eigen::Vector3d::Zero());
+}
+
 TEST(World, QueriesAllocateNothing) {
   std::mt19937_64 rng(8);
   const World w = RandomWorld(&rng, 12, 9);
@@ -402,12 +472,16 @@ TEST(World, QueriesAllocateNothing) {
   Eigen::Vector3d g;
   int closest = 0;
   double sink = 0;
+  std::vector<double> distances(static_cast<std::size_t>(w.num_obstacles()));
+  const int listed[] = {1, 4, 7};
   g_allocations = 0;
   g_counting = true;
   for (int s = 0; s < 59; ++s) {
     sink +=
         w.SignedDistance(centres.col(s), &g, &closest) + w.SignedDistance(centres.col(s), nullptr);
     sink += w.ObstacleSignedDistance(closest, centres.col(s), &g);
+    sink += w.SignedDistanceAmong(centres.col(s), listed, 3, &g, &closest);
+    w.ObstacleDistances(centres.col(s), distances.data());
   }
   w.SphereClearances(centres, radii, clearance, &grad);
   g_counting = false;
