@@ -347,6 +347,10 @@ void Group::RaiseFlag(const std::string& name) {
   }
 }
 
+void Group::LowerLocalFlag(const std::string& name) {
+  if (!distributed()) impl_->local_flags.erase(name);
+}
+
 bool Group::FlagRaised(const std::string& name) {
   if (!distributed()) return impl_->local_flags.count(name) > 0;
   try {

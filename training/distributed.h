@@ -77,6 +77,11 @@ class Group {
   /// Whether some rank raised `name`: one look-up in the store (a file read or a round trip to
   /// rank 0's TCPStore), so cheap enough between two solves, not inside a step.
   bool FlagRaised(const std::string& name);
+  /// Starts a new job's use of `name` in a Local() group: the process-wide DefaultGroup() would
+  /// otherwise keep a flag raised by an earlier run in the same process. A distributed group's
+  /// flags live in the launch's store, which a new launch replaces: there it does nothing (a rank
+  /// deleting a key another rank may already have raised would lose that stop).
+  void LowerLocalFlag(const std::string& name);
 
  private:
   struct Impl;

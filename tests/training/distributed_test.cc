@@ -156,6 +156,8 @@ TEST(DistributedGroup, LocalCollectivesAreNoOps) {
   group->RaiseFlag("stop");
   EXPECT_TRUE(group->FlagRaised("stop"));
   EXPECT_FALSE(group->FlagRaised("other"));
+  group->LowerLocalFlag("stop");  // a later run in the same process starts without it
+  EXPECT_FALSE(group->FlagRaised("stop"));
   const auto params = task.module().parameters();
   for (std::size_t i = 0; i < params.size(); ++i)
     EXPECT_TRUE(torch::equal(params[i].grad(), grads[i]));

@@ -654,6 +654,7 @@ void Loop::TrainRound() {
 
 LoopStats Loop::Run(bool resume, const std::atomic<bool>* interrupt) {
   torch::set_num_threads(c_.loop.threads);
+  group_->LowerLocalFlag(kStopFlag);  // a stop of an earlier run in this process is not this one's
   Resume(resume);
   if (resume && st_.block_start + st_.rounds > 0)
     log::Info("resuming the loop at solve ", walk_from_ + 1, " (", st_.rounds,
