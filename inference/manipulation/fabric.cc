@@ -120,7 +120,6 @@ const char* ToString(RolloutStatus status) {
 
 Fabric::Fabric(const RobotModel& robot, const World& world, const FabricParams& params)
     : robot_(robot), world_(world), params_(params) {
-  BuildBroadPhase();
   FS_THROW_UNLESS(params.dt > 0 && params.t_max >= params.dt,
                   "fabric: dt must be positive and at most t_max (dt ", params.dt, ", t_max ",
                   params.t_max, ")");
@@ -135,6 +134,7 @@ Fabric::Fabric(const RobotModel& robot, const World& world, const FabricParams& 
                   params.stall_window, ", ", params.stall_progress, " and ", params.stall_fraction);
   FS_THROW_UNLESS(params.base_inertia > 0, "fabric: base_inertia must be positive, got ",
                   params.base_inertia);
+  BuildBroadPhase();
 }
 
 void Fabric::BuildBroadPhase() {
@@ -170,15 +170,14 @@ void Fabric::BuildBroadPhase() {
     bound.radius += 1e-9;
     body_bounds_.push_back(bound);
   }
-  const int num_bounds = static_cast<int>(body_bounds_.size());
   pair_runs_.clear();
   const auto& pairs = robot_.self_collision_pairs();
   for (std::size_t i = 0; i < pairs.size(); ++i) {
     const auto [a, b] = pairs[i];
     const int other = sphere_bound_[static_cast<std::size_t>(b)];
-    const int group = sphere_bound_[static_cast<std::size_t>(a)] * num_bounds + other;
-    if (pair_runs_.empty() || pair_runs_.back().sphere != a || pair_runs_.back().group != group)
-      pair_runs_.push_back({static_cast<int>(i), static_cast<int>(i), a, group, other});
+    if (pair_runs_.empty() || pair_runs_.back().sphere != a ||
+        pair_runs_.back().other_bound != other)
+      pair_runs_.push_back({static_cast<int>(i), static_cast<int>(i), a, other});
     ++pair_runs_.back().end;
   }
 }
@@ -186,9 +185,36 @@ void Fabric::BuildBroadPhase() {
 FabricWorkspace Fabric::MakeWorkspace() const {
   FabricWorkspace ws{robot_.MakeData(), {}, {}, {}};
   const auto n = static_cast<std::size_t>(world_.num_obstacles());
-  ws.obstacle_distances.resize(n);
+  ws.bound_distances.resize(n);
   ws.candidates.resize(static_cast<std::size_t>(kDof + 1) * n);
   return ws;
+}
+
+void Fabric::SelectObstacles(const std::array<Eigen::Vector3d, kDof + 1>& c_W, FabricWorkspace* ws,
+                             std::array<int, kDof + 1>* count) const {
+  const int num_obstacles = world_.num_obstacles();
+  FS_THROW_UNLESS(static_cast<int>(ws->bound_distances.size()) == num_obstacles &&
+                      ws->candidates.size() == static_cast<std::size_t>((kDof + 1) * num_obstacles),
+                  "fabric: the workspace was made for another world (use this fabric's "
+                  "MakeWorkspace)");
+  const int num_bounds = static_cast<int>(body_bounds_.size());
+  if (num_obstacles == 0) return;
+  if (!params_.broad_phase) {
+    for (int k = 0; k < num_bounds; ++k) (*count)[static_cast<std::size_t>(k)] = num_obstacles;
+    return;
+  }
+  const Eigen::AlignedBox3d& bounds = world_.bounds();
+  for (int k = 0; k < num_bounds; ++k) {
+    const double reach = params_.obstacles.range + body_bounds_[static_cast<std::size_t>(k)].radius;
+    const Eigen::Vector3d& c = c_W[static_cast<std::size_t>(k)];
+    if (bounds.exteriorDistance(c) > reach) continue;
+    ++ws->probe.obstacle_distances;
+    world_.ObstacleDistances(c, ws->bound_distances.data());
+    int* candidates = ws->candidates.data() + static_cast<std::ptrdiff_t>(k) * num_obstacles;
+    int& n = (*count)[static_cast<std::size_t>(k)];
+    for (int i = 0; i < num_obstacles; ++i)
+      if (!(ws->bound_distances[static_cast<std::size_t>(i)] > reach)) candidates[n++] = i;
+  }
 }
 
 bool Fabric::Acceleration(const JointVector& q, const JointVector& qd, const JointVector& command,
@@ -222,9 +248,10 @@ bool Fabric::Acceleration(const JointVector& q, const JointVector& qd, const Joi
   }
 
   // Body spheres vs the world (closest obstacle) and checked sphere pairs. The broad phase
-  // first (FabricProbe): bodies whose bounding sphere is out of range skip their spheres; then
-  // the cheap distance test; the pull-back only for terms within range. Spheres and pairs keep
-  // their order, so the sums are those of the full loops.
+  // first (FabricProbe): a body's spheres against the obstacles within its bound's reach, a run
+  // of pairs only when its sphere is within reach of the other body's bound; then the cheap
+  // distance test; the pull-back only for terms within range. Spheres and pairs keep their
+  // order, so the sums are those of the full loops.
   const auto& spheres = robot_.spheres();
   const int num_spheres = static_cast<int>(spheres.size());
   const int num_bounds = static_cast<int>(body_bounds_.size());
@@ -233,30 +260,10 @@ bool Fabric::Acceleration(const JointVector& q, const JointVector& qd, const Joi
     const BodyBound& bound = body_bounds_[static_cast<std::size_t>(k)];
     c_W[static_cast<std::size_t>(k)] = kin.X_WB[static_cast<std::size_t>(bound.body)] * bound.p_BC;
   }
-  // Per body, the obstacles within its bounding sphere's reach (ascending indices); a sphere is
-  // measured against those only. Without the broad phase: every obstacle for every body.
-  const int num_obstacles = world_.num_obstacles();
-  FS_THROW_UNLESS(static_cast<int>(ws->obstacle_distances.size()) == num_obstacles &&
-                      ws->candidates.size() == static_cast<std::size_t>((kDof + 1) * num_obstacles),
-                  "fabric: the workspace was made for another world (use this fabric's "
-                  "MakeWorkspace)");
   std::array<int, kDof + 1> num_candidates{};
+  SelectObstacles(c_W, ws, &num_candidates);
+  const int num_obstacles = world_.num_obstacles();
   const Eigen::AlignedBox3d& bounds = world_.bounds();
-  for (int k = 0; k < num_bounds && num_obstacles > 0; ++k) {
-    int* candidates = ws->candidates.data() + static_cast<std::ptrdiff_t>(k) * num_obstacles;
-    int& count = num_candidates[static_cast<std::size_t>(k)];
-    if (!p.broad_phase) {
-      for (int i = 0; i < num_obstacles; ++i) candidates[count++] = i;
-      continue;
-    }
-    const double reach = p.obstacles.range + body_bounds_[static_cast<std::size_t>(k)].radius;
-    const Eigen::Vector3d& c = c_W[static_cast<std::size_t>(k)];
-    if (bounds.exteriorDistance(c) > reach) continue;
-    ++probe.obstacle_distances;
-    world_.ObstacleDistances(c, ws->obstacle_distances.data());
-    for (int i = 0; i < num_obstacles; ++i)
-      if (!(ws->obstacle_distances[static_cast<std::size_t>(i)] > reach)) candidates[count++] = i;
-  }
   for (int s = 0; s < num_spheres; ++s) {
     const int k = sphere_bound_[static_cast<std::size_t>(s)];
     const int count = num_candidates[static_cast<std::size_t>(k)];
@@ -280,20 +287,9 @@ bool Fabric::Acceleration(const JointVector& q, const JointVector& qd, const Joi
                                             kin.J_WS[s], kin.Jdot_qdot_WS[s], qd);
     probe.active_obstacle_terms += AddBarrierTerm(p.obstacles, t, &M, &f);
   }
-  std::array<bool, (kDof + 1) * (kDof + 1)> near_pair{};
-  for (int a = 0; a < num_bounds; ++a) {
-    for (int b = 0; b < num_bounds; ++b) {
-      const double reach = p.self.range + body_bounds_[static_cast<std::size_t>(a)].radius +
-                           body_bounds_[static_cast<std::size_t>(b)].radius;
-      near_pair[static_cast<std::size_t>(a * num_bounds + b)] =
-          !p.broad_phase ||
-          !((c_W[static_cast<std::size_t>(a)] - c_W[static_cast<std::size_t>(b)]).norm() > reach);
-    }
-  }
   const auto& pairs = robot_.self_collision_pairs();
   double min_self_clearance = std::numeric_limits<double>::infinity();
   for (const PairRun& run : pair_runs_) {
-    if (!near_pair[static_cast<std::size_t>(run.group)]) continue;
     if (p.broad_phase) {
       const double reach = p.self.range + spheres[run.sphere].radius +
                            body_bounds_[static_cast<std::size_t>(run.other_bound)].radius;

@@ -36,6 +36,7 @@
 /// do not allocate.
 
 #include <Eigen/Core>
+#include <array>
 #include <limits>
 #include <string>
 #include <vector>
@@ -212,9 +213,9 @@ struct RolloutResult {
 /// sphere fixed to the body. Since a signed distance is 1-Lipschitz, an obstacle farther than
 /// obstacles.range from a body's bounding sphere is farther than that from each of its spheres:
 /// a body's spheres are measured against the obstacles within its reach only (none: skipped;
-/// World::SignedDistanceAmong, the same numbers as the world's minimum), and two bodies whose
-/// bounding spheres are farther apart than self.range have no pair within range, nor has a sphere
-/// farther than that from the other body's bounding sphere: their distances are not computed.
+/// World::SignedDistanceAmong, the same numbers as the world's minimum), and a sphere farther than
+/// self.range from another body's bounding sphere has no pair within range with that body's
+/// spheres: their distances are not computed.
 /// Skipped spheres and pairs could not add a term or collide, so M and the forces are those of the
 /// full sums.
 struct FabricProbe {
@@ -238,8 +239,8 @@ struct FabricWorkspace {
   FabricProbe probe;
   /// The broad phase's buffers (sized by Fabric::MakeWorkspace for its world): the distance from
   /// a body's bounding sphere to each obstacle, and per body the obstacles within its reach.
-  std::vector<double> obstacle_distances;  ///< [num_obstacles]
-  std::vector<int> candidates;             ///< [(kDof + 1) x num_obstacles]
+  std::vector<double> bound_distances;  ///< [num_obstacles]
+  std::vector<int> candidates;          ///< [(kDof + 1) x num_obstacles]
 };
 
 class Fabric {
@@ -281,18 +282,23 @@ class Fabric {
   };
   /// Fills body_bounds_, sphere_bound_ and pair_runs_ from the robot's spheres (FK at q = 0).
   void BuildBroadPhase();
+  /// The broad phase's obstacle side: per bound k, the obstacles within its reach (ascending) in
+  /// ws->candidates[k * num_obstacles ..], their number in (*count)[k]; every obstacle without
+  /// the broad phase (then the list is not written: a sphere's query is the world's minimum).
+  /// @param c_W [bounds] bounding-sphere centres in W.
+  void SelectObstacles(const std::array<Eigen::Vector3d, kDof + 1>& c_W, FabricWorkspace* ws,
+                       std::array<int, kDof + 1>* count) const;
 
   const RobotModel& robot_;
   const World& world_;
   FabricParams params_;
   std::vector<BodyBound> body_bounds_;  ///< bodies that carry spheres
   std::vector<int> sphere_bound_;       ///< [num_spheres] index into body_bounds_
-  /// Maximal runs of consecutive self-collision pairs (in the robot's order) of one sphere a with
-  /// the spheres of one other body: [begin, end), a, the group a_bound * bounds + b_bound and
-  /// b_bound. The broad phase skips whole runs: when the two bodies' bounds are out of range, or
-  /// sphere a is out of range of the other body's bound.
+  /// Maximal runs of consecutive self-collision pairs (in the robot's order) of one sphere with
+  /// the spheres of one other body: [begin, end), the sphere and the other body's bound. The broad
+  /// phase skips a whole run when the sphere is out of range of that bound.
   struct PairRun {
-    int begin = 0, end = 0, sphere = 0, group = 0, other_bound = 0;
+    int begin = 0, end = 0, sphere = 0, other_bound = 0;
   };
   std::vector<PairRun> pair_runs_;
 };

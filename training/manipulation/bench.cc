@@ -37,6 +37,29 @@ struct ManipulationBenchOptions {
   }
 };
 
+/// The fabric's work per step along rollouts (FabricProbe's counts), summed over their states.
+struct StepWork {
+  double steps = 0, world_queries = 0, pair_distances = 0, obstacle_terms = 0, self_terms = 0;
+
+  /// Adds the states of one rollout from the problem's start (at rest) to its goal.
+  void AddRollout(const Fabric& fabric, const ManipulationProblem& problem) {
+    FabricWorkspace ws = fabric.MakeWorkspace();
+    std::vector<JointVector> path{problem.start};
+    fabric.Rollout(problem.start, JointVector::Zero(), problem.goal, &ws, &path);
+    JointVector qdd;
+    for (std::size_t k = 0; k + 1 < path.size(); ++k) {
+      fabric.Acceleration(path[k], (path[k + 1] - path[k]) / fabric.params().dt, problem.goal, &ws,
+                          &qdd);
+      steps += 1;
+      world_queries += ws.probe.obstacle_distances;
+      pair_distances += ws.probe.pair_distances;
+      obstacle_terms += ws.probe.active_obstacle_terms;
+      self_terms += ws.probe.active_self_terms;
+    }
+  }
+  double PerStep(double total) const { return total / std::max(1.0, steps); }
+};
+
 void RunManipulationBench(const BenchRequest& req, const ManipulationBenchOptions& a) {
   const auto c = LoadBenchConfig<ExperimentConfig>(req);
   const RobotModel robot = LoadExperimentRobot(c);
@@ -71,9 +94,7 @@ void RunManipulationBench(const BenchRequest& req, const ManipulationBenchOption
   std::vector<double> steps, rollouts, rollout_times, solves, unpruned_solves, pruned_shares;
   std::vector<double> reference_steps, reference_rollouts, reference_solves;
   bool same_rollouts = true;
-  struct {
-    double steps = 0, world_queries = 0, pair_distances = 0, obstacle_terms = 0, self_terms = 0;
-  } work;  // summed over the states of every problem's rollout
+  StepWork work;  // along every problem's rollout
   for (const ManipulationProblem& problem : problems) {
     const ValidityChecker checker(robot, problem.world);
     if (checker.Check(problem.start, &data) != Validity::kValid) continue;
@@ -114,22 +135,7 @@ void RunManipulationBench(const BenchRequest& req, const ManipulationBenchOption
     const Fabric reference(robot, problem.world, reference_params);
     RolloutResult reference_r;
     measure(reference, &reference_steps, &reference_rollouts, &reference_r);
-    // The broad phase's work along the rollout: distances computed per step.
-    {
-      FabricWorkspace ws = fabric.MakeWorkspace();
-      std::vector<JointVector> path{problem.start};
-      fabric.Rollout(problem.start, JointVector::Zero(), problem.goal, &ws, &path);
-      JointVector qdd;
-      for (std::size_t k = 0; k + 1 < path.size(); ++k) {
-        fabric.Acceleration(path[k], (path[k + 1] - path[k]) / c.fabric.dt, problem.goal, &ws,
-                            &qdd);
-        work.steps += 1;
-        work.world_queries += ws.probe.obstacle_distances;
-        work.pair_distances += ws.probe.pair_distances;
-        work.obstacle_terms += ws.probe.active_obstacle_terms;
-        work.self_terms += ws.probe.active_self_terms;
-      }
-    }
+    work.AddRollout(fabric, problem);
     same_rollouts = same_rollouts && reference_r.status == r.status && reference_r.q == r.q &&
                     reference_r.qd == r.qd && reference_r.steps == r.steps;
     reference_solves.push_back(
@@ -142,7 +148,7 @@ void RunManipulationBench(const BenchRequest& req, const ManipulationBenchOption
   const double reference_step = Median(reference_steps);
   const double reference_rollout = Median(reference_rollouts);
   const double reference_solve = Median(reference_solves);
-  const auto per_step = [&](double total) { return total / std::max(1.0, work.steps); };
+  const auto per_step = [&](double total) { return work.PerStep(total); };
   const char* reference_name = reference_params.broad_phase ? "broad_phase" : "full";
 
   if (req.json) {
