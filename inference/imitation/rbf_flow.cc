@@ -12,14 +12,18 @@ template <int D>
 RbfFlow<D>::RbfFlow(RbfGrid<D> grid, Eigen::MatrixXd weights, FlowSettings<D> settings,
                     const std::string& source)
     : grid_(std::move(grid)), weights_(std::move(weights)), settings_(settings) {
-  FS_THROW_UNLESS(weights_.rows() == grid_.size() && weights_.cols() == D, source, ": weights are ",
-                  weights_.rows(), " x ", weights_.cols(), ", expected ", grid_.size(), " x ", D,
-                  " (inducing states x dimension)");
   FS_THROW_UNLESS(weights_.allFinite(), source, ": weights are not finite");
   FS_THROW_UNLESS(std::isfinite(settings_.time) && settings_.time > 0, source, ": flow time ",
                   settings_.time, " must be positive and finite");
   FS_THROW_UNLESS(settings_.steps >= 1, source, ": flow steps ", settings_.steps,
                   " must be at least 1");
+  FS_THROW_UNLESS(settings_.segments >= 1 && settings_.segments <= settings_.steps, source,
+                  ": flow segments ", settings_.segments,
+                  " must be in [1, steps = ", settings_.steps, "]");
+  FS_THROW_UNLESS(weights_.rows() == settings_.segments * grid_.size() && weights_.cols() == D,
+                  source, ": weights are ", weights_.rows(), " x ", weights_.cols(), ", expected ",
+                  settings_.segments * grid_.size(), " x ", D,
+                  " (segments x inducing states, dimension)");
   rows_ = weights_.transpose();
   const double max_row = weights_.size() ? weights_.rowwise().norm().maxCoeff() : 0.0;
   discontinuity_ = 2 * grid_.truncation() * max_row;
@@ -34,17 +38,19 @@ FlowWorkspace<D> RbfFlow<D>::MakeWorkspace() const {
 
 // V = sum_t W_t phi_t,  DV = sum_t W_t (d phi_t / ds)' = -2 g sum_t (W_t phi_t) r_t'.
 template <int D>
-Vec<D> RbfFlow<D>::Field(const Vec<D>& s, FlowWorkspace<D>* ws, Mat<D>* jacobian) const {
+Vec<D> RbfFlow<D>::Field(const Vec<D>& s, FlowWorkspace<D>* ws, Mat<D>* jacobian,
+                         int segment) const {
   RbfFeatures<D>& f = *ws->features;
   grid_.Evaluate(s, &f);
+  const int base = segment * grid_.size();
   Vec<D> v = Vec<D>::Zero();
   if (jacobian == nullptr) {
-    for (int i = 0; i < f.count; ++i) v.noalias() += f.phi[i] * rows_.col(f.index[i]);
+    for (int i = 0; i < f.count; ++i) v.noalias() += f.phi[i] * rows_.col(base + f.index[i]);
     return v;
   }
   Mat<D> dv = Mat<D>::Zero();
   for (int i = 0; i < f.count; ++i) {
-    const Vec<D> a = f.phi[i] * rows_.col(f.index[i]);
+    const Vec<D> a = f.phi[i] * rows_.col(base + f.index[i]);
     v += a;
     dv.noalias() += a * f.offset[i].transpose();
   }
@@ -57,12 +63,13 @@ Vec<D> RbfFlow<D>::Forward(const Vec<D>& x, FlowWorkspace<D>* ws, Mat<D>* jacobi
   const double h = settings_.time / settings_.steps;
   Vec<D> s = x;
   if (jacobian == nullptr) {
-    for (int k = 0; k < settings_.steps; ++k) s += h * Field(s, ws);
+    for (int k = 0; k < settings_.steps; ++k)
+      s += h * Field(s, ws, nullptr, SegmentOfStep(settings_, k));
     return s;
   }
   Mat<D> j = Mat<D>::Identity(), dv;
   for (int k = 0; k < settings_.steps; ++k) {
-    const Vec<D> v = Field(s, ws, &dv);
+    const Vec<D> v = Field(s, ws, &dv, SegmentOfStep(settings_, k));
     j = (Mat<D>::Identity() + h * dv) * j;
     s += h * v;
   }
@@ -75,8 +82,9 @@ bool RbfFlow<D>::Inverse(const Vec<D>& z, FlowWorkspace<D>* ws, Vec<D>* x, doubl
                          int max_iterations) const {
   const double h = settings_.time / settings_.steps;
   return detail::InvertEulerMap<D>(
-      z, settings_.steps, h, [&](const Vec<D>& s) { return Field(s, ws); }, tolerance,
-      h * discontinuity_, max_iterations, x);
+      z, settings_.steps, h,
+      [&](const Vec<D>& s, int k) { return Field(s, ws, nullptr, SegmentOfStep(settings_, k)); },
+      tolerance, h * discontinuity_, max_iterations, x);
 }
 
 std::string InvertibilityReport::Describe() const {
@@ -99,7 +107,7 @@ InvertibilityReport CheckInvertible(const RbfFlow<D>& flow,
   for (Eigen::Index p = 0; p < points.cols(); ++p) {
     Vec<D> s = points.col(p);
     for (int k = 0; k < flow.settings().steps; ++k) {
-      const Vec<D> v = flow.Field(s, &ws, &dv);
+      const Vec<D> v = flow.Field(s, &ws, &dv, SegmentOfStep(flow.settings(), k));
       const double det = (Mat<D>::Identity() + h * dv).determinant();
       if (!(det >= r.min_step_determinant)) r.min_step_determinant = det;  // NaN too
       s += h * v;

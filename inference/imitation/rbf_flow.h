@@ -3,9 +3,14 @@
 /// Generators from Demonstrations"): the time-T flow of the RBF vector field
 ///   V(s) = W' phi(s)      (phi: rbf_grid.h, W [m x D])
 /// by K explicit Euler steps of h = T / K:
-///   s_0 = x,  s_{k+1} = s_k + h V(s_k),  psi(x) = s_K,
+///   s_0 = x,  s_{k+1} = s_k + h V_{g(k)}(s_k),  psi(x) = s_K,
 /// with its Jacobian propagated exactly through the same steps (the discrete variational equation):
-///   J_0 = I,  J_{k+1} = (I + h DV(s_k)) J_k,  DV(s) = sum_t W_t (d phi_t/ds)'  [D x D].
+///   J_0 = I,  J_{k+1} = (I + h DV_{g(k)}(s_k)) J_k,  DV(s) = sum_t W_t (d phi_t/ds)'  [D x D].
+/// Segments: with S >= 1 segments the field is piecewise constant in time, one weight matrix W_g
+/// per segment, step k using segment g(k) = floor(k S / K) (so 1 <= S <= K). S = 1 is the thesis's
+/// stationary generator; S > 1 composes S flows of RBF fields (each a diffeomorphism, so psi is
+/// one too) and deforms further at the same step cost. The weights are stacked [S m x D], segment g
+/// in rows g m .. (g + 1) m - 1.
 /// Inverse: the exact inverse of the Euler map, step by step from s_K back to s_0, each step
 /// solving s_k = s_{k+1} - h V(s_k) by fixed-point iteration started at the thesis's backward step
 /// s_{k+1} - h V(s_{k+1}) (gamma(-t, .)). The Euler map is invertible where h Lip(V) < 1; the
@@ -38,7 +43,14 @@ template <int D>
 struct FlowSettings {
   double time = 1.0;  ///< T > 0
   int steps = 10;     ///< K >= 1 Euler steps
+  int segments = 1;   ///< S, 1 <= S <= K: time segments with their own weights (file comment)
 };
+
+/// The segment g(k) = floor(k S / K) of Euler step k (file comment).
+template <int D>
+int SegmentOfStep(const FlowSettings<D>& s, int step) {
+  return static_cast<int>(static_cast<long long>(step) * s.segments / s.steps);
+}
 
 /// Per-caller scratch (features buffer); made by RbfFlow::MakeWorkspace.
 template <int D>
@@ -50,7 +62,8 @@ template <int D>
 class RbfFlow {
  public:
   RbfFlow() = default;
-  /// @param weights [m x D], m = grid.size(); all finite (an Error naming `source` otherwise).
+  /// @param weights [S m x D], m = grid.size(), S = settings.segments; all finite (an Error naming
+  /// `source` otherwise).
   RbfFlow(RbfGrid<D> grid, Eigen::MatrixXd weights, FlowSettings<D> settings,
           const std::string& source = "rbf flow");
 
@@ -61,8 +74,9 @@ class RbfFlow {
   /// Bound on the jump of V across cut-off spheres: 2 truncation max_t ||W_t|| (see above).
   double discontinuity() const { return discontinuity_; }
 
-  /// V(s) and optionally DV(s) (nullptr: skipped). No allocation.
-  Vec<D> Field(const Vec<D>& s, FlowWorkspace<D>* ws, Mat<D>* jacobian = nullptr) const;
+  /// V_g(s) of segment g and optionally DV_g(s) (nullptr: skipped). No allocation.
+  Vec<D> Field(const Vec<D>& s, FlowWorkspace<D>* ws, Mat<D>* jacobian = nullptr,
+               int segment = 0) const;
   /// psi(x) and optionally its Jacobian J = d psi / dx. No allocation.
   Vec<D> Forward(const Vec<D>& x, FlowWorkspace<D>* ws, Mat<D>* jacobian = nullptr) const;
   /// psi^-1(z) into *x; false when a step's fixed point does not converge to `tolerance` (relative:
@@ -73,8 +87,8 @@ class RbfFlow {
 
  private:
   RbfGrid<D> grid_;
-  Eigen::MatrixXd weights_;                        // [m x D]
-  Eigen::Matrix<double, D, Eigen::Dynamic> rows_;  // W' [D x m]: W_t contiguous per state
+  Eigen::MatrixXd weights_;                        // [S m x D]
+  Eigen::Matrix<double, D, Eigen::Dynamic> rows_;  // W' [D x S m]: W_t contiguous per state
   FlowSettings<D> settings_;
   double discontinuity_ = 0;
 };
@@ -95,7 +109,8 @@ InvertibilityReport CheckInvertible(const RbfFlow<D>& flow,
                                     const Eigen::Matrix<double, D, -1>& points, double tolerance);
 
 namespace detail {
-/// Inverts the K-step Euler map s_{k+1} = s_k + h V(s_k) of any field `field(s)` -> V(s): step by
+/// Inverts the K-step Euler map s_{k+1} = s_k + h V_k(s_k) of any field `field(s, k)` -> V_k(s)
+/// (k: the forward step being inverted): step by
 /// step from s_K = z, each by the fixed point s_k = s_{k+1} - h V(s_k) started at the backward step
 /// s_{k+1} - h V(s_{k+1}). Converged when a correction is at most tolerance (1 + ||s||), or when
 /// the iteration has stopped contracting (a correction >= 0.99 times the previous one) at a level
@@ -105,12 +120,12 @@ template <int D, typename Field>
 bool InvertEulerMap(const Vec<D>& z, int steps, double h, const Field& field, double tolerance,
                     double slack, int max_iterations, Vec<D>* x) {
   Vec<D> next = z;
-  for (int k = 0; k < steps; ++k) {
-    Vec<D> s = next - h * field(next);
+  for (int k = steps - 1; k >= 0; --k) {
+    Vec<D> s = next - h * field(next, k);
     bool converged = false;
     double previous = std::numeric_limits<double>::infinity();
     for (int it = 0; it < max_iterations; ++it) {
-      const Vec<D> update = next - h * field(s);
+      const Vec<D> update = next - h * field(s, k);
       const double change = (update - s).norm();
       s = update;
       if (!std::isfinite(change)) return false;

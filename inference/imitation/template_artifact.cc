@@ -37,6 +37,7 @@ void SaveTemplate(const std::string& path, const ImitationSystem<D>& system,
     f->SetAttr("/model", "dimension", std::int64_t{D});
     f->SetAttr("/model", "steps", std::int64_t{flow.settings().steps});
     f->SetAttr("/model", "time", flow.settings().time);
+    f->SetAttr("/model", "segments", std::int64_t{flow.settings().segments});
     f->SetAttr("/model", "speed", system.speed());
     f->SetAttr("/model", "gamma", g.gamma);
     f->SetAttr("/model", "cutoff_radius", g.cutoff_radius);
@@ -91,6 +92,9 @@ TemplateArtifact<D> LoadTemplate(const std::string& path) {
   FlowSettings<D> settings;
   settings.steps = a.IntAttr("/model", "steps", 1, 100000);
   settings.time = a.DoubleAttr("/model", "time", 1e-12, 1e6);
+  // Absent in templates written before segments existed: one stationary field.
+  settings.segments =
+      f.HasAttr("/model", "segments") ? a.IntAttr("/model", "segments", 1, settings.steps) : 1;
   const double speed = a.DoubleAttr("/model", "speed", 1e-12, 1e12);
   RbfGridSpec<D> spec;
   spec.gamma = a.DoubleAttr("/model", "gamma", 1e-12, 1e12);
@@ -109,7 +113,7 @@ TemplateArtifact<D> LoadTemplate(const std::string& path) {
   TemplateArtifact<D> out;
   try {
     RbfGrid<D> grid(spec, path + ": /model grid");
-    Eigen::MatrixXd weights = f.ReadMatrixD("/model/weights", grid.size(), D);
+    Eigen::MatrixXd weights = f.ReadMatrixD("/model/weights", settings.segments * grid.size(), D);
     FS_THROW_UNLESS(weights.allFinite(), path, ": dataset '/model/weights' is not finite");
     const Vec<D> goal = ReadVec<D>(f, "/model/goal");
     out.normalisation.offset = ReadVec<D>(f, "/normalisation/offset");
@@ -120,7 +124,7 @@ TemplateArtifact<D> LoadTemplate(const std::string& path) {
     const InvertibilityReport report =
         CheckInvertible(flow, InvertibilityCheckPoints(grid), tolerance);
     FS_THROW_UNLESS(report.ok, path, ": the flow (/model/weights, steps ", settings.steps,
-                    ", time ", settings.time,
+                    ", segments ", settings.segments, ", time ", settings.time,
                     ") is not invertible over the grid: ", report.Describe());
     out.system = ImitationSystem<D>(std::move(flow), goal, speed);
   } catch (const Error& e) {

@@ -2,9 +2,10 @@
 /// The exported imitation model of diffeomorphic templates (thesis ch 8): an ImitationSystem with
 /// the normalisation of its coordinates, as one artifact (docs/artifact_schema.md) of model_type
 /// "diffeo_template":
-///   /model attrs  dimension (2 | 3), steps (K), time (T), speed, gamma, cutoff_radius, spacing
+///   /model attrs  dimension (2 | 3), steps (K), time (T), speed, gamma, cutoff_radius, spacing,
+///                 segments (S, optional: absent = 1)
 ///   /model/lower [D], /model/counts [D] (int64)   the RBF grid of inducing states
-///   /model/weights [m x D]                         W of V(s) = W' phi(s), m = prod counts
+///   /model/weights [S m x D]                       W_g of V_g(s) = W_g' phi(s), m = prod counts
 ///   /model/goal [D]                                the goal in normalised coordinates
 ///   /normalisation/offset [D], attr scale          x_normalised = (x_raw - offset) * scale
 /// Loading checks every shape, finite value and range (an Error naming the file and the field)

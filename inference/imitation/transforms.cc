@@ -47,7 +47,7 @@ bool ObstacleTransform<D>::Inverse(const Vec<D>& x, RbfFeatures<D>* ws, Vec<D>* 
   OccupancyValue<D> v;
   return detail::InvertEulerMap<D>(
       x, settings_.steps, h,
-      [&](const Vec<D>& s) {
+      [&](const Vec<D>& s, int) {
         field_.Evaluate(s, ws, false, &v);
         return v.gradient;
       },

@@ -22,8 +22,12 @@ torch::Tensor NaturalGradientVelocity(const torch::Tensor& z, const torch::Tenso
 }
 
 RbfFlowNetImpl::RbfFlowNetImpl(const torch::Tensor& centres, double gamma, double cutoff_radius,
-                               double time, int steps, double initial_speed)
-    : gamma_(gamma), cutoff_radius_(cutoff_radius), time_(time), steps_(steps) {
+                               double time, int steps, double initial_speed, int segments)
+    : gamma_(gamma),
+      cutoff_radius_(cutoff_radius),
+      time_(time),
+      steps_(steps),
+      segments_(segments) {
   FS_THROW_UNLESS(centres.dim() == 2 && centres.size(0) >= 1 && centres.size(1) >= 1,
                   "RbfFlowNet: centres must be [m, d] with m, d >= 1, got ", centres.sizes());
   FS_THROW_UNLESS(std::isfinite(gamma) && gamma > 0, "RbfFlowNet: gamma must be > 0, got ", gamma);
@@ -31,12 +35,14 @@ RbfFlowNetImpl::RbfFlowNetImpl(const torch::Tensor& centres, double gamma, doubl
                   "RbfFlowNet: cutoff_radius must be > 0, got ", cutoff_radius);
   FS_THROW_UNLESS(std::isfinite(time) && time > 0, "RbfFlowNet: time must be > 0, got ", time);
   FS_THROW_UNLESS(steps >= 1, "RbfFlowNet: steps must be >= 1, got ", steps);
+  FS_THROW_UNLESS(segments >= 1 && segments <= steps,
+                  "RbfFlowNet: segments must be in [1, steps = ", steps, "], got ", segments);
   FS_THROW_UNLESS(std::isfinite(initial_speed) && initial_speed > 0,
                   "RbfFlowNet: initial_speed must be > 0, got ", initial_speed);
   const torch::Tensor c = centres.detach().to(torch::kFloat64).contiguous().clone();
   FS_THROW_UNLESS(AllFinite(c), "RbfFlowNet: centres contain a non-finite value");
   centres_ = register_buffer("centres", c);
-  weights = register_parameter("weights", torch::zeros({c.size(0), c.size(1)}, kDouble));
+  weights = register_parameter("weights", torch::zeros({segments * c.size(0), c.size(1)}, kDouble));
   log_speed = register_parameter("log_speed", torch::full({}, std::log(initial_speed), kDouble));
 }
 
@@ -55,13 +61,23 @@ std::pair<torch::Tensor, torch::Tensor> RbfFlowNetImpl::Features(const torch::Te
   return {torch::exp(-gamma_ * d2) * inside, offset};
 }
 
-std::pair<torch::Tensor, torch::Tensor> RbfFlowNetImpl::Field(const torch::Tensor& s) {
+torch::Tensor RbfFlowNetImpl::StepWeights(int k) const {
+  const std::int64_t m = centres_.size(0);
+  const std::int64_t segment = static_cast<std::int64_t>(k) * segments_ / steps_;
+  return weights.narrow(0, segment * m, m);
+}
+
+std::pair<torch::Tensor, torch::Tensor> RbfFlowNetImpl::Field(const torch::Tensor& s, int segment) {
   CheckPoints(s, "s");
+  FS_THROW_UNLESS(segment >= 0 && segment < segments_, "RbfFlowNet: segment ", segment,
+                  " is outside [0, ", segments_, ")");
+  const std::int64_t m = centres_.size(0);
+  const torch::Tensor w = weights.narrow(0, segment * m, m);
   auto [phi, offset] = Features(s);
-  const torch::Tensor v = torch::matmul(phi, weights);  // [B, d]
+  const torch::Tensor v = torch::matmul(phi, w);  // [B, d]
   // d phi_t/ds = -2 gamma phi_t (s - c_t): [B, m, d]; DV = W' dphi/ds: [d, m] x [B, m, d].
   const torch::Tensor dphi = (-2 * gamma_) * phi.unsqueeze(2) * offset;
-  return {v, torch::matmul(weights.t(), dphi)};
+  return {v, torch::matmul(w.t(), dphi)};
 }
 
 torch::Tensor RbfFlowNetImpl::Integrate(const torch::Tensor& x, torch::Tensor* jacobian) {
@@ -71,13 +87,14 @@ torch::Tensor RbfFlowNetImpl::Integrate(const torch::Tensor& x, torch::Tensor* j
   torch::Tensor j;
   if (jacobian) j = torch::eye(d, kDouble).expand({b, d, d});
   for (int k = 0; k < steps_; ++k) {
+    const torch::Tensor w = StepWeights(k);
     auto [phi, offset] = Features(s);
     if (jacobian) {
       const torch::Tensor dphi = (-2 * gamma_) * phi.unsqueeze(2) * offset;
-      const torch::Tensor dv = torch::matmul(weights.t(), dphi);  // [B, d, d]
+      const torch::Tensor dv = torch::matmul(w.t(), dphi);  // [B, d, d]
       j = j + h * torch::matmul(dv, j);
     }
-    s = s + h * torch::matmul(phi, weights);
+    s = s + h * torch::matmul(phi, w);
   }
   if (jacobian) *jacobian = j;
   return s;
@@ -112,12 +129,13 @@ torch::Tensor RbfFlowNetImpl::InvertibilityPenalty(const torch::Tensor& x) {
   torch::Tensor s = x;
   torch::Tensor total = torch::zeros({}, x.options());
   for (int k = 0; k < steps_; ++k) {
+    const torch::Tensor w = StepWeights(k);
     auto [phi, offset] = Features(s);
     const torch::Tensor dphi = (-2 * gamma_) * phi.unsqueeze(2) * offset;
-    const torch::Tensor dv = torch::matmul(weights.t(), dphi);  // [B, d, d]
+    const torch::Tensor dv = torch::matmul(w.t(), dphi);  // [B, d, d]
     const torch::Tensor norm = torch::sqrt(dv.square().sum({1, 2}) + 1e-30);
     total = total + torch::relu(h * norm - kStepLipschitz).square().mean();
-    s = s + h * torch::matmul(phi, weights);
+    s = s + h * torch::matmul(phi, w);
   }
   return total / steps_;
 }

@@ -6,8 +6,9 @@
 /// (inference/imitation/rbf_flow.h) so that WeightsAsEigen() and speed() exported into RbfFlow /
 /// ImitationSystem give the same velocities:
 ///   phi_t(s) = exp(-gamma ||s - c_t||^2) if ||s - c_t|| <= cutoff_radius, else 0   (errata ch 8)
-///   V(s) = W' phi(s),  s_0 = x,  s_{k+1} = s_k + h V(s_k),  psi(x) = s_K,  h = T / K,
-///   J_0 = I,  J_{k+1} = (I + h DV(s_k)) J_k,  DV(s) = sum_t W_t (d phi_t/ds)',
+///   V_g(s) = W_g' phi(s),  s_0 = x,  s_{k+1} = s_k + h V_{g(k)}(s_k),  psi(x) = s_K,  h = T / K,
+///   J_0 = I,  J_{k+1} = (I + h DV_{g(k)}(s_k)) J_k,  DV(s) = sum_t W_t (d phi_t/ds)',
+///   g(k) = floor(k S / K) the time segment of step k (S = 1: one stationary field),
 ///   d phi_t/ds = -2 gamma phi_t (s - c_t).
 /// J is propagated explicitly (not by autograd), so autograd differentiates the training loss
 /// through the Euler integration and through J.
@@ -59,17 +60,18 @@ class RbfFlowNetImpl : public VelocityModel {
  public:
   /// @param centres [m, d] inducing states c_t (as RbfGrid::Centre(t)), d >= 1;
   /// @param gamma > 0 kernel width; @param cutoff_radius > 0; @param time T > 0;
-  /// @param steps K >= 1 Euler steps; @param initial_speed > 0.
+  /// @param steps K >= 1 Euler steps; @param initial_speed > 0;
+  /// @param segments S in [1, K] time segments with their own weights.
   /// W starts at zero (psi = identity), log_speed at log(initial_speed). Bad values are an Error.
   RbfFlowNetImpl(const torch::Tensor& centres, double gamma, double cutoff_radius, double time,
-                 int steps, double initial_speed);
+                 int steps, double initial_speed, int segments = 1);
 
   /// z = psi(x) [B, d] and J = d psi/dx [B, d, d] for x [B, d].
   std::pair<torch::Tensor, torch::Tensor> Forward(const torch::Tensor& x);
   /// psi(x) [B, d] only (no Jacobian).
   torch::Tensor Map(const torch::Tensor& x);
-  /// V(s) [B, d] and DV(s) [B, d, d] of the field at s [B, d].
-  std::pair<torch::Tensor, torch::Tensor> Field(const torch::Tensor& s);
+  /// V_g(s) [B, d] and DV_g(s) [B, d, d] of segment g's field at s [B, d].
+  std::pair<torch::Tensor, torch::Tensor> Field(const torch::Tensor& s, int segment = 0);
   /// The natural-gradient velocity (file comment); z_e = psi(goal) is computed in the same pass as
   /// psi(x) (differentiable).
   torch::Tensor Velocity(const torch::Tensor& x, const torch::Tensor& goal) override;
@@ -80,13 +82,14 @@ class RbfFlowNetImpl : public VelocityModel {
   torch::Tensor InvertibilityPenalty(const torch::Tensor& x) override;
   static constexpr double kStepLipschitz = 0.7;
 
-  /// W [m, d] as the engine's weights matrix.
+  /// W [S m, d] as the engine's weights matrix.
   Eigen::MatrixXd WeightsAsEigen() const;
   double speed() const;
   int dimension() const { return static_cast<int>(centres_.size(1)); }
   int num_centres() const { return static_cast<int>(centres_.size(0)); }
+  int segments() const { return segments_; }
 
-  torch::Tensor weights;    ///< W [m, d], parameter "weights"
+  torch::Tensor weights;    ///< W [S m, d], parameter "weights"
   torch::Tensor log_speed;  ///< scalar, parameter "log_speed"
 
  private:
@@ -95,10 +98,12 @@ class RbfFlowNetImpl : public VelocityModel {
   /// phi [B, m] (zero beyond the cut-off) and s - c_t [B, m, d].
   std::pair<torch::Tensor, torch::Tensor> Features(const torch::Tensor& s) const;
   void CheckPoints(const torch::Tensor& x, const char* what) const;
+  /// W_g [m, d] of the segment of Euler step k.
+  torch::Tensor StepWeights(int k) const;
 
   torch::Tensor centres_;  // buffer "centres" [m, d]
   double gamma_, cutoff_radius_, time_;
-  int steps_;
+  int steps_, segments_;
 };
 TORCH_MODULE(RbfFlowNet);
 

@@ -33,12 +33,12 @@ torch::Tensor GridCentres(double lo, double hi, int n) {
 }
 
 /// A net on a 6 x 6 grid over [-1, 1]^2 with random weights (a clearly non-linear psi).
-RbfFlowNet RandomNet(std::uint64_t seed, int steps = 8) {
+RbfFlowNet RandomNet(std::uint64_t seed, int steps = 8, int segments = 1) {
   RbfFlowNet net(GridCentres(-1, 1, 6), /*gamma=*/6.0, /*cutoff_radius=*/1.0, /*time=*/1.0, steps,
-                 /*initial_speed=*/1.3);
+                 /*initial_speed=*/1.3, segments);
   torch::manual_seed(seed);
   torch::NoGradGuard no_grad;
-  net->weights.copy_(0.4 * torch::randn({36, 2}, kDouble));
+  net->weights.copy_(0.4 * torch::randn({36 * segments, 2}, kDouble));
   return net;
 }
 
@@ -48,16 +48,19 @@ torch::Tensor RandomPoints(int n, std::uint64_t seed) {
 }
 
 TEST(RbfFlowNet, JacobianMatchesAutograd) {
-  RbfFlowNet net = RandomNet(1);
-  const torch::Tensor x = RandomPoints(6, 2).requires_grad_(true);
-  auto [z, j] = net->Forward(x);
-  // Rows of d z / d x by autograd: samples are independent, so grad of sum_b z[b, i] is row i.
-  for (int i = 0; i < 2; ++i) {
-    const torch::Tensor row =
-        torch::autograd::grad({z.select(1, i).sum()}, {x}, {}, /*retain_graph=*/true)[0];
-    EXPECT_LT((row - j.select(1, i)).abs().max().item<double>(), 1e-12) << "row " << i;
+  for (const int segments : {1, 3}) {  // 3 segments over 8 steps: uneven, floor(k S / K)
+    RbfFlowNet net = RandomNet(1, 8, segments);
+    const torch::Tensor x = RandomPoints(6, 2).requires_grad_(true);
+    auto [z, j] = net->Forward(x);
+    // Rows of d z / d x by autograd: samples are independent, so grad of sum_b z[b, i] is row i.
+    for (int i = 0; i < 2; ++i) {
+      const torch::Tensor row =
+          torch::autograd::grad({z.select(1, i).sum()}, {x}, {}, /*retain_graph=*/true)[0];
+      EXPECT_LT((row - j.select(1, i)).abs().max().item<double>(), 1e-12)
+          << "row " << i << ", segments " << segments;
+    }
+    EXPECT_GT((j - torch::eye(2, kDouble)).abs().max().item<double>(), 0.1);  // not trivial
   }
-  EXPECT_GT((j - torch::eye(2, kDouble)).abs().max().item<double>(), 0.1);  // not trivial
 }
 
 TEST(RbfFlowNet, JacobianMatchesCentralDifferences) {
@@ -184,6 +187,8 @@ TEST(RbfFlowNet, BadArgumentsAreErrors) {
   ExpectErrorContains([&] { RbfFlowNet(c, -1, 0.5, 1, 4, 1); }, {"gamma", "-1"});
   ExpectErrorContains([&] { RbfFlowNet(c, 1, 0.5, 1, 0, 1); }, {"steps", "0"});
   ExpectErrorContains([&] { RbfFlowNet(c, 1, 0.5, 1, 4, 0); }, {"initial_speed"});
+  ExpectErrorContains([&] { RbfFlowNet(c, 1, 0.5, 1, 4, 1, 5); }, {"segments", "steps = 4", "5"});
+  ExpectErrorContains([&] { RbfFlowNet(c, 1, 0.5, 1, 4, 1, 2)->Field(c, 2); }, {"segment 2"});
   ExpectErrorContains([&] { RbfFlowNet(torch::zeros({3}, kDouble), 1, 0.5, 1, 4, 1); },
                       {"centres"});
   RbfFlowNet net(c, 1, 0.5, 1, 4, 1);
@@ -212,7 +217,7 @@ TEST(RbfFlowNet, BadArgumentsAreErrors) {
 }
 
 #ifdef FORESIGHT_HAVE_RBF_FLOW_ENGINE
-TEST(RbfFlowNet, EngineParity) {
+void CheckEngineParity(int segments) {
   RbfGridSpec<2> spec;
   spec.lower = Vec<2>(-1.0, -0.8);
   spec.counts = {9, 7};
@@ -225,15 +230,16 @@ TEST(RbfFlowNet, EngineParity) {
     centres[t][0] = grid.Centre(t)[0];
     centres[t][1] = grid.Centre(t)[1];
   }
-  RbfFlowNet net(centres, spec.gamma, spec.cutoff_radius, 0.8, 7, 1.4);
+  RbfFlowNet net(centres, spec.gamma, spec.cutoff_radius, 0.8, 7, 1.4, segments);
   torch::manual_seed(11);
   {
     torch::NoGradGuard no_grad;
-    net->weights.copy_(0.3 * torch::randn({grid.size(), 2}, kDouble));
+    net->weights.copy_(0.3 * torch::randn({segments * grid.size(), 2}, kDouble));
   }
   const Vec<2> goal(0.13, 0.21);  // off the lattice: no centre at exactly the cut-off radius
-  const ImitationSystem<2> system(RbfFlow<2>(grid, net->WeightsAsEigen(), FlowSettings<2>{0.8, 7}),
-                                  goal, net->speed());
+  const ImitationSystem<2> system(
+      RbfFlow<2>(grid, net->WeightsAsEigen(), FlowSettings<2>{0.8, 7, segments}), goal,
+      net->speed());
   FlowWorkspace<2> ws = system.flow().MakeWorkspace();
 
   torch::NoGradGuard no_grad;
@@ -255,6 +261,10 @@ TEST(RbfFlowNet, EngineParity) {
     }
   }
 }
+
+TEST(RbfFlowNet, EngineParity) { CheckEngineParity(1); }
+// 3 segments over 7 steps (uneven): the net and the engine pick the same segment per step.
+TEST(RbfFlowNet, EngineParityWithSegments) { CheckEngineParity(3); }
 #endif
 
 }  // namespace

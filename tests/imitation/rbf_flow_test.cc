@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <random>
+#include <vector>
 
 #include "inference/imitation/transforms.h"
 #include "tests/test_util.h"
@@ -301,6 +302,109 @@ TEST(RbfFlow, BadInputIsAnError) {
       {"steps"});
   const RbfFlow<2> f(grid, Eigen::MatrixXd::Zero(grid.size(), 2), {1.0, 10});
   testing::ExpectErrorContains([&] { ImitationSystem<2> s(f, Vec<2>(0, 0), -1); }, {"speed"});
+}
+
+// ---- time segments -----------------------------------------------------------------------------
+
+// A flow of S segments is the composition of S one-segment flows, segment g with its own weights,
+// time T / S and K / S steps (when S divides K): psi = psi_{S-1} o ... o psi_0, and the Jacobian is
+// the product of theirs in the same order (the chain rule).
+template <int D>
+void CheckSegmentsCompose(const RbfGridSpec<D>& spec, double scale, std::uint64_t seed) {
+  const RbfGrid<D> grid(spec);
+  const int segments = 3, steps = 12, m = grid.size();
+  const Eigen::MatrixXd w = RandomWeights<D>(segments * m, scale, seed);
+  const RbfFlow<D> flow(grid, w, {1.2, steps, segments});
+  std::vector<RbfFlow<D>> parts;
+  for (int g = 0; g < segments; ++g)
+    parts.emplace_back(grid, w.middleRows(g * m, m), FlowSettings<D>{0.4, steps / segments, 1});
+  FlowWorkspace<D> ws = flow.MakeWorkspace();
+  std::mt19937_64 rng(seed);
+  double moved = 0;
+  for (int n = 0; n < 20; ++n) {
+    const Vec<D> x = RandomPoint<D>(&rng, -0.5, 0.5);
+    Mat<D> j;
+    const Vec<D> z = flow.Forward(x, &ws, &j);
+    Vec<D> composed = x;
+    Mat<D> composed_j = Mat<D>::Identity();
+    for (const RbfFlow<D>& part : parts) {
+      Mat<D> jp;
+      composed = part.Forward(composed, &ws, &jp);
+      composed_j = jp * composed_j;
+    }
+    EXPECT_TRUE(testing::MatricesNear(z, composed, 1e-14)) << x.transpose();
+    EXPECT_TRUE(testing::MatricesNear(j, composed_j, 1e-12 * (1 + j.norm()))) << x.transpose();
+    moved = std::max(moved, (z - x).norm());
+    Vec<D> back;
+    ASSERT_TRUE(flow.Inverse(z, &ws, &back));
+    EXPECT_LE((back - x).norm(), 1e-10) << x.transpose();
+  }
+  EXPECT_GT(moved, 0.05);
+  // The segments differ: the same flow with segment 0's weights everywhere maps elsewhere.
+  Eigen::MatrixXd first = w;
+  for (int g = 1; g < segments; ++g) first.middleRows(g * m, m) = w.topRows(m);
+  const RbfFlow<D> stationary(grid, first, {1.2, steps, segments});
+  const Vec<D> x = Vec<D>::Constant(0.1);
+  EXPECT_GT((stationary.Forward(x, &ws) - flow.Forward(x, &ws)).norm(), 1e-3);
+}
+
+TEST(RbfFlow, SegmentsAreACompositionOfFlows2D) { CheckSegmentsCompose(Grid2(), 0.08, 31); }
+TEST(RbfFlow, SegmentsAreACompositionOfFlows3D) { CheckSegmentsCompose(Grid3(), 0.05, 32); }
+
+// When S does not divide K, step k uses segment floor(k S / K): checked against a loop over the
+// steps with each segment's own one-step flow, and the Jacobian against finite differences.
+TEST(RbfFlow, UnevenSegmentsFollowTheStepRuleAndTheirJacobianIsExact) {
+  const RbfGrid<2> grid(SmoothGrid<2>());
+  const int segments = 3, steps = 7, m = grid.size();
+  const Eigen::MatrixXd w = RandomWeights<2>(segments * m, 0.1, 33);
+  const RbfFlow<2> flow(grid, w, {0.7, steps, segments});
+  EXPECT_EQ(SegmentOfStep(flow.settings(), 0), 0);
+  EXPECT_EQ(SegmentOfStep(flow.settings(), 2), 0);  // floor(6 / 7)
+  EXPECT_EQ(SegmentOfStep(flow.settings(), 3), 1);  // floor(9 / 7)
+  EXPECT_EQ(SegmentOfStep(flow.settings(), 6), 2);  // floor(18 / 7)
+  FlowWorkspace<2> ws = flow.MakeWorkspace();
+  std::mt19937_64 rng(33);
+  for (int n = 0; n < 10; ++n) {
+    const Vec<2> x = RandomPoint<2>(&rng, -0.15, 0.15);
+    Vec<2> s = x;
+    for (int k = 0; k < steps; ++k) {
+      const int g = static_cast<int>(std::floor(k * 3.0 / 7.0));
+      const RbfFlow<2> one(grid, w.middleRows(g * m, m), {0.1, 1});
+      s = one.Forward(s, &ws);
+    }
+    Mat<2> j;
+    EXPECT_TRUE(testing::MatricesNear(flow.Forward(x, &ws, &j), s, 1e-14));
+    const Mat<2> j_fd =
+        FiniteDifferenceJacobian<2>([&](const Vec<2>& p) { return flow.Forward(p, &ws); }, x);
+    EXPECT_TRUE(testing::MatricesNear(j, j_fd, 1e-6 * (1 + j.norm())));
+    EXPECT_GT((j - Mat<2>::Identity()).norm(), 0.02);  // a non-trivial map
+    Vec<2> back;
+    ASSERT_TRUE(flow.Inverse(flow.Forward(x, &ws), &ws, &back));
+    EXPECT_LE((back - x).norm(), 1e-10);
+  }
+  Eigen::Matrix<double, 2, -1> points(2, 25);
+  for (Eigen::Index i = 0; i < points.cols(); ++i) points.col(i) = RandomPoint<2>(&rng, -0.2, 0.2);
+  const InvertibilityReport report = CheckInvertible<2>(flow, points, 1e-10);
+  EXPECT_TRUE(report.ok) << report.Describe();
+}
+
+TEST(RbfFlow, BadSegmentsAreAnError) {
+  const RbfGrid<2> grid(Grid2());
+  testing::ExpectErrorContains(
+      [&] {
+        RbfFlow<2> f(grid, Eigen::MatrixXd::Zero(grid.size(), 2), {1.0, 10, 2}, "flow y");
+      },
+      {"flow y", "441 x 2", "882 x 2"});
+  testing::ExpectErrorContains(
+      [&] {
+        RbfFlow<2> f(grid, Eigen::MatrixXd::Zero(11 * grid.size(), 2), {1.0, 10, 11});
+      },
+      {"segments 11", "steps = 10"});
+  testing::ExpectErrorContains(
+      [&] {
+        RbfFlow<2> f(grid, Eigen::MatrixXd::Zero(grid.size(), 2), {1.0, 10, 0});
+      },
+      {"segments 0"});
 }
 
 // ---- imitation system --------------------------------------------------------------------------

@@ -30,7 +30,7 @@ ImitationSystem<D> RandomSystem(double scale, std::uint64_t seed,
   const RbfGrid<D> grid(s);
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> n01;
-  Eigen::MatrixXd w(grid.size(), D);
+  Eigen::MatrixXd w(settings.segments * grid.size(), D);
   for (Eigen::Index i = 0; i < w.size(); ++i) w.data()[i] = scale * n01(rng);
   return ImitationSystem<D>(RbfFlow<D>(grid, w, settings), Vec<D>::Constant(0.1), 0.8);
 }
@@ -44,10 +44,11 @@ TemplateNormalisation Normalisation() {
 }
 
 template <int D>
-void CheckRoundTrip() {
+void CheckRoundTrip(int segments = 1) {
   testing::TempDir dir;
   const std::string path = dir.File("template.h5");
-  const ImitationSystem<D> system = RandomSystem<D>(D == 2 ? 0.05 : 0.03, 1);
+  const ImitationSystem<D> system =
+      RandomSystem<D>(D == 2 ? 0.05 : 0.03, 1, FlowSettings<D>{1.0, 10, segments});
   SaveTemplate<D>(path, system, Normalisation<D>(), "kind: imitation\n", 42);
   EXPECT_EQ(TemplateDimension(path), D);
   const TemplateArtifact<D> loaded = LoadTemplate<D>(path);
@@ -57,6 +58,7 @@ void CheckRoundTrip() {
   EXPECT_TRUE(testing::MatricesNear(loaded.normalisation.offset, Normalisation<D>().offset, 0));
   EXPECT_EQ(loaded.system.speed(), system.speed());
   EXPECT_EQ(loaded.system.flow().settings().steps, 10);
+  EXPECT_EQ(loaded.system.flow().settings().segments, segments);
   EXPECT_TRUE(testing::MatricesNear(loaded.system.goal(), system.goal(), 0));
   FlowWorkspace<D> a = system.flow().MakeWorkspace(), b = loaded.system.flow().MakeWorkspace();
   std::mt19937_64 rng(2);
@@ -75,6 +77,8 @@ void CheckRoundTrip() {
 
 TEST(TemplateArtifact, RoundTripIsBitForBit2D) { CheckRoundTrip<2>(); }
 TEST(TemplateArtifact, RoundTripIsBitForBit3D) { CheckRoundTrip<3>(); }
+TEST(TemplateArtifact, RoundTripWithSegmentsIsBitForBit2D) { CheckRoundTrip<2>(4); }
+TEST(TemplateArtifact, RoundTripWithSegmentsIsBitForBit3D) { CheckRoundTrip<3>(3); }
 
 // Replaces dataset `name` by a double array of `shape` (HDF5 C API: independent of core/h5).
 void ReplaceDataset(const std::string& path, const std::string& name,
@@ -161,6 +165,21 @@ TEST_F(BadTemplate, OutOfRangeAttributes) {
   testing::OverwriteAttr(path_, "/normalisation", "scale", 1.0);
   testing::OverwriteAttr(path_, "/model", "dimension", std::int64_t{4});
   ExpectErrorContains([&] { TemplateDimension(path_); }, {path_, "dimension", "4"});
+}
+
+// Templates written before segments existed have no /model/segments: one stationary field.
+TEST_F(BadTemplate, SegmentsAttributeIsOptionalAndChecked) {
+  {
+    const hid_t f = H5Fopen(path_.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    ASSERT_GE(f, 0);
+    EXPECT_GE(H5Adelete_by_name(f, "/model", "segments", H5P_DEFAULT), 0);
+    EXPECT_GE(H5Fclose(f), 0);
+  }
+  EXPECT_EQ(LoadTemplate<2>(path_).system.flow().settings().segments, 1);
+  testing::OverwriteAttr(path_, "/model", "segments", std::int64_t{11});
+  ExpectErrorContains([&] { LoadTemplate<2>(path_); }, {path_, "segments", "11"});
+  testing::OverwriteAttr(path_, "/model", "segments", std::int64_t{2});  // 169 rows, 338 needed
+  ExpectErrorContains([&] { LoadTemplate<2>(path_); }, {path_, "/model/weights", "338"});
 }
 
 TEST_F(BadTemplate, NonInvertibleFlowIsRefused) {

@@ -33,7 +33,7 @@ imitation::ExperimentConfig Tiny(const std::vector<std::string>& overrides = {})
 
 TEST(DiffeoRun, ResumeAfterLosingTheLastArtifactsGivesTheSameModelsAndFigures) {
   const testing::TempDir dir;
-  const imitation::ExperimentConfig c = Tiny();
+  const imitation::ExperimentConfig c = Tiny({"flow.segments=2"});  // time segments end to end
   const std::string run = dir.File("run");
   ASSERT_TRUE(imitation::TrainRun(c, run, false, nullptr));
   const std::string eval = imitation::EvaluateRun(c, run);
@@ -48,6 +48,7 @@ TEST(DiffeoRun, ResumeAfterLosingTheLastArtifactsGivesTheSameModelsAndFigures) {
   const auto shape2 = imitation::LoadTemplate<2>(run + "/models/s_curve.h5");
   const auto eflow2 = imitation::EFlowModel::Load(run + "/models/s_curve.eflow.h5");
   EXPECT_EQ(shape2.system.flow().weights(), shape.system.flow().weights());
+  EXPECT_EQ(shape.system.flow().settings().segments, 2);
   EXPECT_EQ(shape2.system.speed(), shape.system.speed());
   const Eigen::Vector2d x(0.2, -0.1);
   EXPECT_EQ(eflow2.Velocity(x), eflow.Velocity(x));
@@ -91,6 +92,8 @@ TEST(DiffeoConfig, RulesAcrossKeysNameTheKey) {
   testing::ExpectErrorContains([] { Tiny({"obstacle.times=[0.004, 0.002]"}); },
                                {"obstacle.times", "not increasing"});
   testing::ExpectErrorContains([] { Tiny({"data.task=stack_box"}); }, {"data.task", "stack_box"});
+  testing::ExpectErrorContains([] { Tiny({"flow.segments=5"}); },
+                               {"flow.segments (5)", "flow.steps (4)"});
   testing::ExpectErrorContains(
       [] {
         Tiny({"bias.enabled=true", "bias.target=[0.1]"});

@@ -76,7 +76,7 @@ RbfFlowNet TorchNet(const ImitationSystem<D>& s) {
   for (int i = 0; i < grid.size(); ++i)
     for (int k = 0; k < D; ++k) centres[i][k] = grid.Centre(i)[k];
   RbfFlowNet net(centres, grid.gamma(), grid.spec().cutoff_radius, s.flow().settings().time,
-                 s.flow().settings().steps, s.speed());
+                 s.flow().settings().steps, s.speed(), s.flow().settings().segments);
   torch::NoGradGuard no_grad;
   const Eigen::MatrixXd& w = s.flow().weights();
   for (Eigen::Index i = 0; i < w.rows(); ++i)

@@ -42,6 +42,8 @@ void ExperimentConfig::Validate(const std::string& source) const {
   FS_THROW_UNLESS(flow.cutoff_radius >= flow.spacing, source, ": flow.cutoff_radius (",
                   flow.cutoff_radius, ") is below flow.spacing (", flow.spacing,
                   "): most states would have no feature");
+  FS_THROW_UNLESS(flow.segments <= flow.steps, source, ": flow.segments (", flow.segments,
+                  ") exceeds flow.steps (", flow.steps, "): each segment needs an Euler step");
   if (bias.enabled) {
     const std::size_t d = data.source == DemoSource::kTaskSpace ? 3 : 2;
     FS_THROW_UNLESS(bias.target.size() == d, source, ": bias.target: ", bias.target.size(),

@@ -76,6 +76,7 @@ struct FlowConfig {
   double cutoff_radius = 0.425;     ///< features beyond this are zero
   double time = 1.0;                ///< flow time T
   int steps = 10;                   ///< Euler steps K
+  int segments = 1;                 ///< time segments S (1: one stationary field, the thesis)
   double inverse_tolerance = 1e-9;  ///< refuse a flow whose psi^-1(psi(x)) misses x by more
   /// Weight of the training penalty that keeps every Euler step contracting (h ||DV|| < 0.7) on the
   /// batch and on a lattice of `penalty_lattice` points per axis over the grid's box.
@@ -91,6 +92,8 @@ struct FlowConfig {
     a->Visit("cutoff_radius", &cutoff_radius, Range::Positive(), "RBF cut-off radius");
     a->Visit("time", &time, Range::Positive(), "flow time T");
     a->Visit("steps", &steps, Range::Closed(1, 10000), "Euler steps K");
+    a->Visit("segments", &segments, Range::Closed(1, 10000),
+             "time segments S <= K, each with its own RBF weights (1: one stationary field)");
     a->Visit("inverse_tolerance", &inverse_tolerance, Range::Positive(),
              "largest round-trip error psi^-1(psi(x)) - x accepted at export");
     a->Visit("invertibility_weight", &invertibility_weight, Range::NonNegative(),

@@ -108,7 +108,7 @@ RbfFlowNet MakeFlowNet(const ExperimentConfig& c, const ShapeData& s) {
   const torch::Tensor centres = s.dimension == 2 ? Centres<2>(ShapeGrid<2>(c, s.positions))
                                                  : Centres<3>(ShapeGrid<3>(c, s.positions));
   return RbfFlowNet(centres, c.flow.gamma, c.flow.cutoff_radius, c.flow.time, c.flow.steps,
-                    s.initial_speed);
+                    s.initial_speed, c.flow.segments);
 }
 
 EFlowNet MakeEflowNet(const ExperimentConfig& c, const ShapeData& s) {
@@ -147,6 +147,7 @@ void ExportFlow(const ExperimentConfig& c, const PreparedDemos& d, const ShapeDa
   FlowSettings<D> settings;
   settings.time = c.flow.time;
   settings.steps = c.flow.steps;
+  settings.segments = c.flow.segments;
   const RbfFlow<D> flow(grid, net->WeightsAsEigen(), settings, d.name);
   // Invertible where it is used: on the grid's box and at every training sample.
   const Eigen::Matrix<double, D, Eigen::Dynamic> box = InvertibilityCheckPoints<D>(grid);
