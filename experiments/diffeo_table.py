@@ -73,17 +73,27 @@ thesis = {"ours, with avoidance": ("0.124 / 0", "0.127 / 0"), "ours, no avoidanc
           "EFlow": ("0.068 / 0.012", "0.093 / 0.152"), "EFlow + repulsor": ("0.168 / 0", "0.252 / 0.001"),
           "linear": ("0.242 / 0.147", "0.205 / 0.031")}
 if push or lift:
-    out += ["## JACO arm in C-space: push box, lift box (F.D. / M.C.D., metres)", "",
+    out += ["## JACO arm in C-space: push box, lift box (F.D. / M.C.D. in metres / reach rate)", "",
             "Task-space demonstrations are generated (the thesis's recordings are not public: "
-            "datasets/synthetic_demos.h), so the thesis columns are not the same data.", "",
-            "| method | push box | lift box | thesis push box | thesis lift box |", "|---|---|---|---|---|"]
+            "datasets/synthetic_demos.h), so the thesis columns (F.D. / M.C.D.) are not the same data. "
+            "Reach rate: share of rollouts from the demos' starts whose end effector reaches the goal.",
+            "", "| method | push box | lift box | thesis push box | thesis lift box |", "|---|---|---|---|---|"]
     for label, p in [("ours, with avoidance", "avoid_"), ("ours, no avoidance", ""),
                      ("EFlow", "eflow_"), ("EFlow + repulsor", "eflow_repulsor_"), ("linear", "linear_")]:
         cells = []
         for r in (push, lift):
             s = r["mean"] if r else {}
-            cells.append("-" if (p + "frechet") not in s else f"{f(s.get(p + 'frechet'))} / {f(s.get(p + 'mcd'), 4)}")
+            cells.append("-" if (p + "frechet") not in s else
+                         f"{f(s.get(p + 'frechet'))} / {f(s.get(p + 'mcd'), 4)} / {f(s.get(p + 'reach_rate'), 2)}")
         out.append(f"| {label} | {cells[0]} | {cells[1]} | {thesis[label][0]} | {thesis[label][1]} |")
+    for name, r in (("push box", push), ("lift box", lift)):
+        if r and "obstacle_flow_time" in r["mean"]:
+            s = r["mean"]
+            out.append(f"\n{name}: obstacle-flow time {s['obstacle_flow_time']:g} "
+                       f"({s.get('obstacle_flow_steps', 0):.0f} Euler steps), cleared on the map from the "
+                       f"training starts: {'yes' if s.get('obstacle_cleared_on_map') else 'no'}; EFlow "
+                       f"repulsor gain {s.get('eflow_repulsor_gain', 0):g}, cleared: "
+                       f"{'yes' if s.get('eflow_repulsor_cleared_on_map') else 'no'}.")
     out.append("")
 if bench:
     arts = ", ".join(bench.get(p, {}).get("artifact", "-") for p in ("planar", "cspace"))

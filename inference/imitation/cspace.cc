@@ -12,8 +12,8 @@ namespace foresight::imitation {
 // ---- CSpaceObstacleTransform ----------------------------------------------------------------
 
 CSpaceObstacleTransform::CSpaceObstacleTransform(SerialChain chain, OccupancyField<3> field,
-                                                 FlowSettings<kArmDof> settings)
-    : chain_(std::move(chain)), field_(std::move(field)), settings_(settings) {
+                                                 FlowSettings<kArmDof> settings, GoalGate gate)
+    : chain_(std::move(chain)), field_(std::move(field)), settings_(settings), gate_(gate) {
   FS_THROW_UNLESS(std::isfinite(settings_.time) && settings_.time > 0,
                   "C-space obstacle transform: flow time must be finite and > 0, got ",
                   settings_.time);
@@ -23,6 +23,10 @@ CSpaceObstacleTransform::CSpaceObstacleTransform(SerialChain chain, OccupancyFie
                   "' has no body points");
   FS_THROW_UNLESS(field_.grid().size() > 0,
                   "C-space obstacle transform: the occupancy field is empty");
+  FS_THROW_UNLESS(gate_.goal.allFinite() && std::isfinite(gate_.length) && gate_.length >= 0,
+                  "C-space obstacle transform: the goal gate needs a finite goal and length >= 0, "
+                  "got goal (",
+                  gate_.goal.transpose(), ") length ", gate_.length);
 }
 
 CSpaceTransformWorkspace CSpaceObstacleTransform::MakeWorkspace() const {
@@ -39,6 +43,16 @@ ArmVector CSpaceObstacleTransform::Field(const ArmVector& q, CSpaceTransformWork
   ArmVector V;
   const double total = CSpacePotentialField(chain_, q, at_point, &ws->chain, &V, jacobian);
   if (occupancy != nullptr) *occupancy = total;
+  if (gate_.length > 0) {  // w V_q, d(w V_q) = w dV_q + V_q grad w' (file comment)
+    const Eigen::Vector3d d = ws->chain.p_ee - gate_.goal;
+    const double l2 = gate_.length * gate_.length;
+    const double e = std::exp(-d.squaredNorm() / (2 * l2));
+    if (jacobian != nullptr) {
+      const ArmVector grad_w = (e / l2) * (ws->chain.J_ee.transpose() * d);
+      *jacobian = (1 - e) * *jacobian + V * grad_w.transpose();
+    }
+    V *= 1 - e;
+  }
   return V;
 }
 

@@ -16,6 +16,14 @@
 ///   when a step does not converge (h Lip(V_q) >= 1 there: the settings are not invertible).
 ///   The outer configurations p = psi_o^-1(q) are the inner ones flowed down the occupancy of the
 ///   body points, so the outer system keeps the arm away from the obstacle.
+///   Goal gate (optional, length l > 0): V_q is multiplied by w(q) = 1 - exp(-r^2 / (2 l^2)),
+///   r = ||x_ee(q) - x_goal||, so the field vanishes on every configuration whose end effector is
+///   at the goal; dV = w dV_q + V_q grad w',  grad w = exp(-r^2 / (2 l^2)) J_ee' (x_ee - x_goal) /
+///   l^2. Without it a map that is not negligible at the goal moves the composed system's
+///   equilibrium: psi_o fixes those configurations only where V_q = 0, and the outer arm then
+///   stops short of the goal. With it psi_o fixes the goal set pointwise, so x_ee(psi_o(p)) is the
+///   goal exactly when x_ee(p) is (an addition to the thesis's V^o_q, which assumes p(o) = 0
+///   there).
 /// - CSpaceSystem: thesis eq. CspaceNG with the errata's pull-back (never form G^-1):
 ///     q = psi_o^q(p),  q_dot = J_ee(q)^+ f_world(x_ee(q)),  p_dot = J_o(p)^-1 q_dot,
 ///   J^+ = J' (J J' + lambda^2 I)^-1 (damped least squares; lambda = 0 is the thesis's
@@ -63,21 +71,29 @@ struct CSpaceTransformWorkspace {
   std::unique_ptr<RbfFeatures<3>> features;
 };
 
+/// The goal gate of CSpaceObstacleTransform (file comment); length 0 = no gate.
+struct GoalGate {
+  Eigen::Vector3d goal = Eigen::Vector3d::Zero();  ///< end-effector goal in the world (m)
+  double length = 0;                               ///< l (m), >= 0
+};
+
 /// psi_o^q (see the file comment).
 class CSpaceObstacleTransform {
  public:
   CSpaceObstacleTransform() = default;
   /// `settings`: time T > 0 and steps K >= 1 (an Error naming the value otherwise); `chain` with
-  /// at least one body point.
+  /// at least one body point; `gate`: finite goal, length >= 0.
   CSpaceObstacleTransform(SerialChain chain, OccupancyField<3> field,
-                          FlowSettings<kArmDof> settings);
+                          FlowSettings<kArmDof> settings, GoalGate gate = {});
 
   const SerialChain& chain() const { return chain_; }
   const OccupancyField<3>& field() const { return field_; }
   const FlowSettings<kArmDof>& settings() const { return settings_; }
+  const GoalGate& gate() const { return gate_; }
   CSpaceTransformWorkspace MakeWorkspace() const;
 
-  /// V_q(q) and optionally dV_q/dq [6 x 6] and sum_j p(x_j(q)). No allocation.
+  /// V_q(q) (gated when a gate is set) and optionally its Jacobian dV_q/dq [6 x 6] and
+  /// sum_j p(x_j(q)) (never gated). No allocation.
   /// @param q [6] joint angles (rad)
   ArmVector Field(const ArmVector& q, CSpaceTransformWorkspace* ws, ArmMatrix* jacobian = nullptr,
                   double* occupancy = nullptr) const;
@@ -93,6 +109,7 @@ class CSpaceObstacleTransform {
   SerialChain chain_;
   OccupancyField<3> field_;
   FlowSettings<kArmDof> settings_;
+  GoalGate gate_;
 };
 
 /// World <-> normalised coordinates of the imitation model: s = (x - offset) scale.

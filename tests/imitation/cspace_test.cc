@@ -210,6 +210,49 @@ TEST(CSpaceObstacleTransform, FieldIsTheGradientOfTheOccupancyAndItsJacobianMatc
   EXPECT_GE(informative, 2) << "the rollout should pass through the field";
 }
 
+// The goal gate: w V_q with w = 1 - exp(-r^2 / (2 l^2)); its Jacobian against central
+// differences where w varies (a goal 5 cm from the end effector, l = 4 cm), and the field and the
+// flow are exactly zero / the identity where the end effector is at the goal.
+TEST(CSpaceObstacleTransform, GoalGateVanishesAtTheGoalAndItsJacobianMatches) {
+  const SerialChain chain = Arm();
+  ChainData data = chain.MakeData();
+  const CSpaceObstacleTransform plain = Transform(0.2, 40);
+  CSpaceTransformWorkspace ws = plain.MakeWorkspace();
+  int informative = 0;
+  for (const ArmVector& q : ConfigurationsNearTheObstacle()) {
+    Kinematics(chain, q, &data);
+    GoalGate gate;
+    gate.goal = data.p_ee + Eigen::Vector3d(0.03, -0.04, 0.0);
+    gate.length = 0.04;
+    const CSpaceObstacleTransform gated(chain, TheScenario().field, {0.2, 40}, gate);
+    ArmMatrix dV;
+    const ArmVector V = gated.Field(q, &ws, &dV);
+    const double w = 1 - std::exp(-0.05 * 0.05 / (2 * 0.04 * 0.04));
+    EXPECT_TRUE(MatricesNear(V, w * plain.Field(q, &ws), 1e-12 * (1 + V.norm())));
+    if (V.norm() > 1e-2) ++informative;
+    constexpr double h = 1e-6;
+    ArmMatrix dV_fd;
+    for (int k = 0; k < kArmDof; ++k) {
+      const ArmVector e = ArmVector::Unit(k) * h;
+      dV_fd.col(k) = (gated.Field(q + e, &ws) - gated.Field(q - e, &ws)) / (2 * h);
+    }
+    EXPECT_TRUE(MatricesNear(dV, dV_fd, 1e-5 * (1 + dV.cwiseAbs().maxCoeff())));
+    // A gate at this configuration's own end effector: V = 0 and psi_o(q) = q.
+    gate.goal = data.p_ee;
+    const CSpaceObstacleTransform at_goal(chain, TheScenario().field, {0.2, 40}, gate);
+    EXPECT_EQ(at_goal.Field(q, &ws).norm(), 0.0);
+    EXPECT_TRUE(MatricesNear(at_goal.Forward(q, &ws), q, 0));
+  }
+  EXPECT_GE(informative, 2) << "the rollout should pass through the field";
+  GoalGate bad;
+  bad.length = -1;
+  ExpectErrorContains(
+      [&] {
+        CSpaceObstacleTransform(chain, TheScenario().field, {1, 10}, bad);
+      },
+      {"goal gate", "-1"});
+}
+
 TEST(CSpaceObstacleTransform, JacobianMatchesFiniteDifferences) {
   const CSpaceObstacleTransform transform = Transform(0.2, 40);
   CSpaceTransformWorkspace ws = transform.MakeWorkspace();

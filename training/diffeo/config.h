@@ -157,6 +157,9 @@ struct ObstacleConfig {
   std::vector<double> times{0.002, 0.004, 0.008, 0.016, 0.032, 0.064};
   double step = 0.0005;  ///< Euler step of the obstacle flow (steps = ceil(time / step))
   double clear_probability = 0.5;
+  /// Task space: the C-space obstacle field fades out within about this distance (m) of the goal
+  /// (inference/imitation/cspace.h, goal gate), so the arm still reaches it; 0 = no gate.
+  double goal_gate = 0;
   std::vector<double> repulsor_gains{0.01, 0.03, 0.1, 0.3, 1, 3};  ///< EFlow + repulsor, likewise
 
   template <class A>
@@ -180,6 +183,9 @@ struct ObstacleConfig {
     a->Visit("step", &step, Range::Positive(), "obstacle-flow Euler step (steps = time / step)");
     a->Visit("clear_probability", &clear_probability, Range::Closed(0.01, 0.99),
              "rollouts must keep the map's p(occupied) below this");
+    a->Visit("goal_gate", &goal_gate, Range::NonNegative(),
+             "task space: length (m) within which the C-space obstacle field fades out at the "
+             "goal (0: no gate)");
     a->Visit("repulsor_gains", &repulsor_gains, Range::Any(), "EFlow repulsor gains tried");
   }
 };

@@ -234,7 +234,10 @@ Scores EvaluateTaskSpaceShape(const ExperimentConfig& c, const PreparedDemos& de
       FlowSettings<kArmDof> fs;
       fs.time = t;
       fs.steps = ObstacleSteps(t, h);
-      return CSpaceSystem(chain, art.system, tn, CSpaceObstacleTransform(chain, field, fs));
+      GoalGate gate;
+      gate.goal = goal;
+      gate.length = c.obstacle.goal_gate;
+      return CSpaceSystem(chain, art.system, tn, CSpaceObstacleTransform(chain, field, fs, gate));
     };
     // Invertibility is checked along the rollouts (every configuration the arm passes).
     const auto invertible = [&](const CSpaceSystem& sys, const std::vector<ArmPath>& rs) {
