@@ -101,8 +101,8 @@ if bench:
             f"Artifacts: {arts}. The composed 2-D step uses a 16-step obstacle flow and the C-space step "
             "a 10-step one; the evaluation's selected obstacle flows take 7 to 760 steps, and the step "
             "time grows with them.", "", "| step | us |", "|---|---|"]
-    for part in ("planar", "cspace"):
+    for part, label in (("planar", "planar"), ("cspace", "JACO")):
         for k, v in bench.get(part, {}).get("steps_us", {}).items():
-            out.append(f"| {k} | {f(v, 2)} |")
+            out.append(f"| {label}: {k} | {f(v, 2)} |")
     out.append("")
 print("\n".join(out))

@@ -33,7 +33,9 @@ imitation::ExperimentConfig Tiny(const std::vector<std::string>& overrides = {})
 
 TEST(DiffeoRun, ResumeAfterLosingTheLastArtifactsGivesTheSameModelsAndFigures) {
   const testing::TempDir dir;
-  const imitation::ExperimentConfig c = Tiny({"flow.segments=2"});  // time segments end to end
+  // Time segments and tube samples end to end.
+  const imitation::ExperimentConfig c =
+      Tiny({"flow.segments=2", "flow.tube_sigma=0.02", "flow.tube_gain=1"});
   const std::string run = dir.File("run");
   ASSERT_TRUE(imitation::TrainRun(c, run, false, nullptr));
   const std::string eval = imitation::EvaluateRun(c, run);

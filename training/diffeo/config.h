@@ -82,6 +82,12 @@ struct FlowConfig {
   /// batch and on a lattice of `penalty_lattice` points per axis over the grid's box.
   double invertibility_weight = 10;
   int penalty_lattice = 12;
+  /// Tube samples (ours only; 0 = off): `tube_copies` copies of every training pair with the
+  /// position moved by N(0, tube_sigma^2 I) and the velocity v - tube_gain * offset, so the field
+  /// is taught near the demonstrations too (rollouts that drift off them are led back).
+  double tube_sigma = 0;
+  int tube_copies = 4;
+  double tube_gain = 0;
 
   template <class A>
   void Serialize(A* a) {
@@ -100,6 +106,11 @@ struct FlowConfig {
              "weight of the penalty keeping each Euler step contracting (0: off)");
     a->Visit("penalty_lattice", &penalty_lattice, Range::Closed(2, 100),
              "points per axis of the penalty lattice over the grid's box");
+    a->Visit("tube_sigma", &tube_sigma, Range::NonNegative(),
+             "std of the position offsets of the tube samples (normalised units; 0: none)");
+    a->Visit("tube_copies", &tube_copies, Range::Closed(1, 100), "tube samples per training pair");
+    a->Visit("tube_gain", &tube_gain, Range::NonNegative(),
+             "tube samples' velocity v - gain * offset (1/s; 0: parallel to the demo)");
   }
 };
 
@@ -157,6 +168,9 @@ struct ObstacleConfig {
   std::vector<double> times{0.002, 0.004, 0.008, 0.016, 0.032, 0.064};
   double step = 0.0005;  ///< Euler step of the obstacle flow (steps = ceil(time / step))
   double clear_probability = 0.5;
+  /// Largest round-trip error psi_o^-1(psi_o(y)) - y accepted when checking a flow time
+  /// (normalised units in 2-D, rad in C-space); every inverse must also converge.
+  double inverse_tolerance = 1e-8;
   /// Task space: the C-space obstacle field fades out within about this distance (m) of the goal
   /// (inference/imitation/cspace.h, goal gate), so the arm still reaches it; 0 = no gate.
   double goal_gate = 0;
@@ -183,6 +197,8 @@ struct ObstacleConfig {
     a->Visit("step", &step, Range::Positive(), "obstacle-flow Euler step (steps = time / step)");
     a->Visit("clear_probability", &clear_probability, Range::Closed(0.01, 0.99),
              "rollouts must keep the map's p(occupied) below this");
+    a->Visit("inverse_tolerance", &inverse_tolerance, Range::Positive(),
+             "largest obstacle-flow round-trip error accepted (2-D normalised units; C-space rad)");
     a->Visit("goal_gate", &goal_gate, Range::NonNegative(),
              "task space: length (m) within which the C-space obstacle field fades out at the "
              "goal (0: no gate)");

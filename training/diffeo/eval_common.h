@@ -174,11 +174,11 @@ OuterTransform<D> ObstacleOuter(const OccupancyField<D>& field, double time, dou
   return t;
 }
 
-/// Whether psi_o^-1(psi_o(y)) = y (to 1e-8) on a lattice of spacing `spacing` over [lo, hi]: the
-/// settings keep the Euler map invertible there.
+/// Whether psi_o^-1(psi_o(y)) = y (to `tolerance`) on a lattice of spacing `spacing` over [lo, hi]:
+/// the settings keep the Euler map invertible there.
 template <int D>
 bool ObstacleInvertible(const ObstacleTransform<D>& t, const Vec<D>& lo, const Vec<D>& hi,
-                        double spacing) {
+                        double spacing, double tolerance) {
   auto ws = t.MakeWorkspace();
   std::array<int, D> n{};
   int total = 1;
@@ -194,7 +194,7 @@ bool ObstacleInvertible(const ObstacleTransform<D>& t, const Vec<D>& lo, const V
       r /= n[a];
     }
     Vec<D> back;
-    if (!t.Inverse(t.Forward(y, ws.get()), ws.get(), &back) || (back - y).norm() > 1e-8)
+    if (!t.Inverse(t.Forward(y, ws.get()), ws.get(), &back) || (back - y).norm() > tolerance)
       return false;
   }
   return true;

@@ -145,7 +145,8 @@ Scores EvaluatePlanarShape(const ExperimentConfig& c, const PreparedDemos& demos
     for (double t : c.obstacle.times) {
       const OuterTransform<2> outer = ObstacleOuter<2>(field, t, h);
       // Larger times only bend the map further: stop at the first non-invertible one.
-      if (!ObstacleInvertible<2>(outer.obstacle, box_lo, box_hi, c.obstacle.sample_spacing * 2))
+      if (!ObstacleInvertible<2>(outer.obstacle, box_lo, box_hi, c.obstacle.sample_spacing * 2,
+                                 c.obstacle.inverse_tolerance))
         break;
       chosen = t;
       const ComposedSystem<2> sys(system, {outer});

@@ -104,6 +104,22 @@ ShapeData Prepare(const ExperimentConfig& c, const PreparedDemos& d) {
   return s;
 }
 
+/// The flow's training data: `s` with the tube samples of flow.tube_* appended to the training
+/// pairs (validation pairs unchanged); `s` itself when tube_sigma is 0. Deterministic in the seed.
+ShapeData WithTube(const ExperimentConfig& c, ShapeData s) {
+  if (c.flow.tube_sigma <= 0) return s;
+  const torch::Tensor x = s.train_x.repeat({c.flow.tube_copies, 1});
+  const torch::Tensor v = s.train_v.repeat({c.flow.tube_copies, 1});
+  torch::Tensor offset = torch::empty_like(x);
+  std::mt19937_64 rng(static_cast<std::uint64_t>(c.seed) + 5);
+  std::normal_distribution<double> normal(0.0, c.flow.tube_sigma);
+  double* o = offset.data_ptr<double>();
+  for (std::int64_t i = 0; i < offset.numel(); ++i) o[i] = normal(rng);
+  s.train_x = torch::cat({s.train_x, x + offset});
+  s.train_v = torch::cat({s.train_v, v - c.flow.tube_gain * offset});
+  return s;
+}
+
 RbfFlowNet MakeFlowNet(const ExperimentConfig& c, const ShapeData& s) {
   const torch::Tensor centres = s.dimension == 2 ? Centres<2>(ShapeGrid<2>(c, s.positions))
                                                  : Centres<3>(ShapeGrid<3>(c, s.positions));
@@ -175,8 +191,8 @@ bool TrainShape(const ExperimentConfig& c, const PreparedDemos& demos, const Sha
   const ShapeData s = Prepare(c, demos);
   const auto seed = static_cast<std::uint64_t>(c.seed);
   RbfFlowNet flow = MakeFlowNet(c, s);
-  if (!TrainModel(flow.ptr(), s, c.train, c.flow.invertibility_weight, paths.FlowDir(), seed,
-                  resume, interrupt, demos.name + " flow"))
+  if (!TrainModel(flow.ptr(), WithTube(c, s), c.train, c.flow.invertibility_weight, paths.FlowDir(),
+                  seed, resume, interrupt, demos.name + " flow"))
     return false;
   if (!c.eflow.enabled) return true;
   EFlowNet eflow = MakeEflowNet(c, s);
