@@ -99,8 +99,9 @@ if bench:
     arts = ", ".join(bench.get(p, {}).get("artifact", "-") for p in ("planar", "cspace"))
     out += ["## Time per rollout step (one core; `foresight bench ARTIFACT`)", "",
             f"Artifacts: {arts}. The composed 2-D step uses a 16-step obstacle flow and the C-space step "
-            "a 10-step one; the evaluation's selected obstacle flows take 7 to 760 steps, and the step "
-            "time grows with them.", "", "| step | us |", "|---|---|"]
+            "a 10-step one; the evaluation's selected obstacle flows are longer (LASA: up to hundreds of "
+            "steps; JACO: the Euler steps in the notes above), and the step time grows with them.", "",
+            "| step | us |", "|---|---|"]
     for part, label in (("planar", "planar"), ("cspace", "JACO")):
         for k, v in bench.get(part, {}).get("steps_us", {}).items():
             out.append(f"| {label}: {k} | {f(v, 2)} |")
