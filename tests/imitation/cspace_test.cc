@@ -174,6 +174,18 @@ CSpaceObstacleTransform Transform(double time, int steps) {
   return CSpaceObstacleTransform(Arm(), TheScenario().field, {time, steps});
 }
 
+/// The Jacobian of `f` at q by central differences of step 1e-6 rad.
+template <typename F>
+ArmMatrix CentralDifferences(const F& f, const ArmVector& q) {
+  constexpr double h = 1e-6;
+  ArmMatrix out;
+  for (int k = 0; k < kArmDof; ++k) {
+    const ArmVector e = ArmVector::Unit(k) * h;
+    out.col(k) = (f(q + e) - f(q - e)) / (2 * h);
+  }
+  return out;
+}
+
 // ---- the field and the transform --------------------------------------------------------------
 
 /// Configurations of the plain rollout near the obstacle (where the field is not negligible).
@@ -230,12 +242,8 @@ TEST(CSpaceObstacleTransform, GoalGateVanishesAtTheGoalAndItsJacobianMatches) {
     const double w = 1 - std::exp(-0.05 * 0.05 / (2 * 0.04 * 0.04));
     EXPECT_TRUE(MatricesNear(V, w * plain.Field(q, &ws), 1e-12 * (1 + V.norm())));
     if (V.norm() > 1e-2) ++informative;
-    constexpr double h = 1e-6;
-    ArmMatrix dV_fd;
-    for (int k = 0; k < kArmDof; ++k) {
-      const ArmVector e = ArmVector::Unit(k) * h;
-      dV_fd.col(k) = (gated.Field(q + e, &ws) - gated.Field(q - e, &ws)) / (2 * h);
-    }
+    const ArmMatrix dV_fd =
+        CentralDifferences([&](const ArmVector& x) { return gated.Field(x, &ws); }, q);
     EXPECT_TRUE(MatricesNear(dV, dV_fd, 1e-5 * (1 + dV.cwiseAbs().maxCoeff())));
     // A gate at this configuration's own end effector: V = 0 and psi_o(q) = q.
     gate.goal = data.p_ee;
@@ -260,12 +268,8 @@ TEST(CSpaceObstacleTransform, JacobianMatchesFiniteDifferences) {
     ArmMatrix J;
     const ArmVector q = transform.Forward(p, &ws, &J);
     EXPECT_GT((q - p).norm(), 0) << "the flow moves configurations near the obstacle";
-    constexpr double h = 1e-6;
-    ArmMatrix J_fd;
-    for (int k = 0; k < kArmDof; ++k) {
-      const ArmVector e = ArmVector::Unit(k) * h;
-      J_fd.col(k) = (transform.Forward(p + e, &ws) - transform.Forward(p - e, &ws)) / (2 * h);
-    }
+    const ArmMatrix J_fd =
+        CentralDifferences([&](const ArmVector& x) { return transform.Forward(x, &ws); }, p);
     EXPECT_TRUE(MatricesNear(J, J_fd, 1e-6 * (1 + J.cwiseAbs().maxCoeff())));
   }
 }
