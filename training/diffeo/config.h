@@ -78,6 +78,7 @@ struct FlowConfig {
   int steps = 10;                   ///< Euler steps K
   int segments = 1;                 ///< time segments S (1: one stationary field, the thesis)
   double inverse_tolerance = 1e-9;  ///< refuse a flow whose psi^-1(psi(x)) misses x by more
+                                    ///< (plus the truncation allowance LoadTemplate grants)
   /// Weight of the training penalty that keeps every Euler step contracting (h ||DV|| < 0.7) on the
   /// batch and on a lattice of `penalty_lattice` points per axis over the grid's box.
   double invertibility_weight = 10;
@@ -101,7 +102,8 @@ struct FlowConfig {
     a->Visit("segments", &segments, Range::Closed(1, 10000),
              "time segments S <= K, each with its own RBF weights (1: one stationary field)");
     a->Visit("inverse_tolerance", &inverse_tolerance, Range::Positive(),
-             "largest round-trip error psi^-1(psi(x)) - x accepted at export");
+             "largest round-trip error psi^-1(psi(x)) - x accepted at export, on top of the "
+             "truncation allowance 10 T discontinuity (as at load)");
     a->Visit("invertibility_weight", &invertibility_weight, Range::NonNegative(),
              "weight of the penalty keeping each Euler step contracting (0: off)");
     a->Visit("penalty_lattice", &penalty_lattice, Range::Closed(2, 100),
