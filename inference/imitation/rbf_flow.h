@@ -73,6 +73,9 @@ class RbfFlow {
   FlowWorkspace<D> MakeWorkspace() const;
   /// Bound on the jump of V across cut-off spheres: 2 truncation max_t ||W_t|| (see above).
   double discontinuity() const { return discontinuity_; }
+  /// The round-trip error psi^-1(psi(x)) - x the truncation allows: h discontinuity per step over
+  /// K steps, with a safety factor of 10 (10 T discontinuity). Export and load both grant it.
+  double TruncationAllowance() const { return 10 * settings_.time * discontinuity_; }
 
   /// V_g(s) of segment g and optionally DV_g(s) (nullptr: skipped). No allocation.
   Vec<D> Field(const Vec<D>& s, FlowWorkspace<D>* ws, Mat<D>* jacobian = nullptr,

@@ -119,8 +119,7 @@ TemplateArtifact<D> LoadTemplate(const std::string& path) {
     out.normalisation.offset = ReadVec<D>(f, "/normalisation/offset");
     out.normalisation.scale = a.DoubleAttr("/normalisation", "scale", 1e-300, 1e300);
     RbfFlow<D> flow(grid, std::move(weights), settings, path + ": /model/weights");
-    // Exact to the truncation level (rbf_flow.h): h disc per step, K steps, a safety factor.
-    const double tolerance = kRoundTripTolerance + 10 * settings.time * flow.discontinuity();
+    const double tolerance = kRoundTripTolerance + flow.TruncationAllowance();
     const InvertibilityReport report =
         CheckInvertible(flow, InvertibilityCheckPoints(grid), tolerance);
     FS_THROW_UNLESS(report.ok, path, ": the flow (/model/weights, steps ", settings.steps,

@@ -61,18 +61,20 @@ std::pair<torch::Tensor, torch::Tensor> RbfFlowNetImpl::Features(const torch::Te
   return {torch::exp(-gamma_ * d2) * inside, offset};
 }
 
-torch::Tensor RbfFlowNetImpl::StepWeights(int k) const {
+torch::Tensor RbfFlowNetImpl::SegmentWeights(int segment) const {
   const std::int64_t m = centres_.size(0);
-  const std::int64_t segment = static_cast<std::int64_t>(k) * segments_ / steps_;
   return weights.narrow(0, segment * m, m);
+}
+
+torch::Tensor RbfFlowNetImpl::StepWeights(int k) const {
+  return SegmentWeights(static_cast<int>(static_cast<std::int64_t>(k) * segments_ / steps_));
 }
 
 std::pair<torch::Tensor, torch::Tensor> RbfFlowNetImpl::Field(const torch::Tensor& s, int segment) {
   CheckPoints(s, "s");
   FS_THROW_UNLESS(segment >= 0 && segment < segments_, "RbfFlowNet: segment ", segment,
                   " is outside [0, ", segments_, ")");
-  const std::int64_t m = centres_.size(0);
-  const torch::Tensor w = weights.narrow(0, segment * m, m);
+  const torch::Tensor w = SegmentWeights(segment);
   auto [phi, offset] = Features(s);
   const torch::Tensor v = torch::matmul(phi, w);  // [B, d]
   // d phi_t/ds = -2 gamma phi_t (s - c_t): [B, m, d]; DV = W' dphi/ds: [d, m] x [B, m, d].

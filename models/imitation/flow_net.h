@@ -98,7 +98,8 @@ class RbfFlowNetImpl : public VelocityModel {
   /// phi [B, m] (zero beyond the cut-off) and s - c_t [B, m, d].
   std::pair<torch::Tensor, torch::Tensor> Features(const torch::Tensor& s) const;
   void CheckPoints(const torch::Tensor& x, const char* what) const;
-  /// W_g [m, d] of the segment of Euler step k.
+  /// W_g [m, d] of segment g, and of the segment floor(k S / K) of Euler step k.
+  torch::Tensor SegmentWeights(int segment) const;
   torch::Tensor StepWeights(int k) const;
 
   torch::Tensor centres_;  // buffer "centres" [m, d]

@@ -169,9 +169,8 @@ void ExportFlow(const ExperimentConfig& c, const PreparedDemos& d, const ShapeDa
   const Eigen::Matrix<double, D, Eigen::Dynamic> box = InvertibilityCheckPoints<D>(grid);
   Eigen::Matrix<double, D, Eigen::Dynamic> points(D, box.cols() + s.positions.cols());
   points << box, s.positions;
-  // Exact to the truncation level near cut-off spheres (rbf_flow.h: h discontinuity per step): the
-  // same allowance as LoadTemplate, so an exported flow always loads.
-  const double tolerance = c.flow.inverse_tolerance + 10 * c.flow.time * flow.discontinuity();
+  // The loader's allowance on top (RbfFlow::TruncationAllowance), so an exported flow always loads.
+  const double tolerance = c.flow.inverse_tolerance + flow.TruncationAllowance();
   const InvertibilityReport report = CheckInvertible<D>(flow, points, tolerance);
   FS_THROW_UNLESS(report.ok, d.name, ": the trained flow is not invertible with flow.time ",
                   c.flow.time, " and flow.steps ", c.flow.steps, " (", report.Describe(),
