@@ -10,6 +10,30 @@ namespace {
 
 bool AllFinite(const torch::Tensor& t) { return torch::isfinite(t).all().item<bool>(); }
 
+/// A loss whose gradients were computed beside it (flow_objective.h): backward scales them by the
+/// incoming gradient.
+struct PrecomputedLoss : public torch::autograd::Function<PrecomputedLoss> {
+  static torch::Tensor forward(torch::autograd::AutogradContext* ctx, const torch::Tensor& weights,
+                               const torch::Tensor& log_speed, const torch::Tensor& loss,
+                               const torch::Tensor& grad_weights,
+                               const torch::Tensor& grad_log_speed) {
+    (void)weights, (void)log_speed;
+    ctx->save_for_backward({grad_weights, grad_log_speed});
+    return loss.clone();
+  }
+  static torch::autograd::variable_list backward(torch::autograd::AutogradContext* ctx,
+                                                 torch::autograd::variable_list grad_output) {
+    const auto saved = ctx->get_saved_variables();
+    const torch::Tensor g = grad_output[0];
+    return {saved[0] * g, saved[1] * g, torch::Tensor(), torch::Tensor(), torch::Tensor()};
+  }
+};
+
+/// [n, d] float64 contiguous (a view when it already is).
+torch::Tensor Contiguous64(const torch::Tensor& t) {
+  return t.detach().to(torch::kFloat64).contiguous();
+}
+
 }  // namespace
 
 torch::Tensor NaturalGradientVelocity(const torch::Tensor& z, const torch::Tensor& jacobian,
@@ -142,6 +166,56 @@ torch::Tensor RbfFlowNetImpl::InvertibilityPenalty(const torch::Tensor& x) {
   return total / steps_;
 }
 
+void RbfFlowNetImpl::SetObjective(std::shared_ptr<const FlowObjective> objective) {
+  if (objective != nullptr) {
+    FS_THROW_UNLESS(
+        objective->dimension() == dimension() && objective->num_centres() == num_centres() &&
+            objective->segments() == segments_,
+        "RbfFlowNet: the objective is for ", objective->num_centres(), " centres in ",
+        objective->dimension(), "-D with ", objective->segments(), " segment(s), the net has ",
+        num_centres(), " in ", dimension(), "-D with ", segments_);
+  }
+  objective_ = std::move(objective);
+}
+
+torch::Tensor RbfFlowNetImpl::ObjectiveLoss(const torch::Tensor& x, const torch::Tensor& v,
+                                            const torch::Tensor& goal,
+                                            const torch::Tensor& penalty_points,
+                                            double penalty_weight, bool with_gradient) {
+  if (objective_ == nullptr) return {};
+  CheckPoints(x, "x");
+  FS_THROW_UNLESS(v.sizes() == x.sizes(), "RbfFlowNet: velocities ", v.sizes(), " and positions ",
+                  x.sizes(), " must be the same [B, d]");
+  FS_THROW_UNLESS(goal.dim() == 1 && goal.size(0) == centres_.size(1), "RbfFlowNet: goal must be [",
+                  centres_.size(1), "], got ", goal.sizes());
+  const torch::Tensor xs = Contiguous64(x), vs = Contiguous64(v), gs = Contiguous64(goal);
+  torch::Tensor ps;
+  if (penalty_points.defined() && penalty_points.numel() > 0) {
+    CheckPoints(penalty_points, "penalty points");
+    ps = Contiguous64(penalty_points);
+  }
+  FlowObjectiveBatch batch;
+  batch.x = xs.data_ptr<double>();
+  batch.v = vs.data_ptr<double>();
+  batch.batch = static_cast<int>(xs.size(0));
+  batch.goal = gs.data_ptr<double>();
+  batch.penalty = ps.defined() ? ps.data_ptr<double>() : nullptr;
+  batch.penalty_count = ps.defined() ? static_cast<int>(ps.size(0)) : 0;
+  batch.penalty_weight = penalty_weight;
+  const torch::Tensor w = weights.detach().contiguous();
+  const double ls = log_speed.item<double>();
+  const int threads = std::max(1, torch::get_num_threads());
+  if (!with_gradient)
+    return torch::scalar_tensor(
+        objective_->Evaluate(w.data_ptr<double>(), ls, batch, threads, nullptr, nullptr), kDouble);
+  torch::Tensor grad_w = torch::empty_like(w);
+  double grad_ls = 0;
+  const double loss = objective_->Evaluate(w.data_ptr<double>(), ls, batch, threads,
+                                           grad_w.data_ptr<double>(), &grad_ls);
+  return PrecomputedLoss::apply(weights, log_speed, torch::scalar_tensor(loss, kDouble), grad_w,
+                                torch::scalar_tensor(grad_ls, kDouble));
+}
+
 Eigen::MatrixXd RbfFlowNetImpl::WeightsAsEigen() const {
   const torch::Tensor w = weights.detach().contiguous();
   return Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
@@ -198,6 +272,10 @@ ImitationTask::ImitationTask(std::shared_ptr<VelocityModel> model, torch::Tensor
 torch::Tensor ImitationTask::BatchLoss(const torch::Tensor& indices) {
   const torch::Tensor i = indices.to(torch::kInt64);
   const torch::Tensor x = positions_.index_select(0, i);
+  const torch::Tensor objective =
+      model_->ObjectiveLoss(x, velocities_.index_select(0, i), goal_, penalty_points_,
+                            penalty_weight_, /*with_gradient=*/true);
+  if (objective.defined()) return objective;
   torch::Tensor loss = VelocityLoss(model_->Velocity(x, goal_), velocities_.index_select(0, i));
   if (penalty_weight_ > 0)
     loss = loss +
@@ -208,6 +286,9 @@ torch::Tensor ImitationTask::BatchLoss(const torch::Tensor& indices) {
 
 double ImitationTask::ValidationLoss() {
   torch::NoGradGuard no_grad;
+  const torch::Tensor objective = model_->ObjectiveLoss(val_positions_, val_velocities_, goal_, {},
+                                                        0.0, /*with_gradient=*/false);
+  if (objective.defined()) return objective.item<double>();
   return VelocityLoss(model_->Velocity(val_positions_, goal_), val_velocities_).item<double>();
 }
 

@@ -24,6 +24,7 @@
 #include <memory>
 #include <utility>
 
+#include "models/imitation/flow_objective.h"
 #include "training/trainer.h"
 
 namespace foresight::imitation {
@@ -52,6 +53,17 @@ class VelocityModel : public torch::nn::Module {
   /// differentiable); 0 for models invertible by construction (the default).
   virtual torch::Tensor InvertibilityPenalty(const torch::Tensor& x) {
     return torch::zeros({}, x.options());
+  }
+  /// ImitationTask's loss by a hand-written objective (flow_objective.h) instead of autograd:
+  /// mean ||Velocity(x) - v||^2 + penalty_weight * InvertibilityPenalty([x; penalty_points]), a
+  /// scalar whose backward gives the parameters' gradients (computed eagerly when with_gradient);
+  /// an undefined tensor when the model has none (the default: ImitationTask uses autograd).
+  virtual torch::Tensor ObjectiveLoss(const torch::Tensor& x, const torch::Tensor& v,
+                                      const torch::Tensor& goal,
+                                      const torch::Tensor& penalty_points, double penalty_weight,
+                                      bool with_gradient) {
+    (void)x, (void)v, (void)goal, (void)penalty_points, (void)penalty_weight, (void)with_gradient;
+    return {};
   }
 };
 
@@ -82,6 +94,16 @@ class RbfFlowNetImpl : public VelocityModel {
   torch::Tensor InvertibilityPenalty(const torch::Tensor& x) override;
   static constexpr double kStepLipschitz = 0.7;
 
+  /// Trains through `objective` (MakeFlowObjective on this net's grid, time, steps, segments,
+  /// kStepLipschitz and kGoalEpsilon: the same loss to rounding, sparse in the cut-off, no graph)
+  /// instead of autograd; null = autograd. A mismatched dimension, centre or segment count is an
+  /// Error.
+  void SetObjective(std::shared_ptr<const FlowObjective> objective);
+  bool has_objective() const { return objective_ != nullptr; }
+  torch::Tensor ObjectiveLoss(const torch::Tensor& x, const torch::Tensor& v,
+                              const torch::Tensor& goal, const torch::Tensor& penalty_points,
+                              double penalty_weight, bool with_gradient) override;
+
   /// W [S m, d] as the engine's weights matrix.
   Eigen::MatrixXd WeightsAsEigen() const;
   double speed() const;
@@ -105,6 +127,7 @@ class RbfFlowNetImpl : public VelocityModel {
   torch::Tensor centres_;  // buffer "centres" [m, d]
   double gamma_, cutoff_radius_, time_;
   int steps_, segments_;
+  std::shared_ptr<const FlowObjective> objective_;
 };
 TORCH_MODULE(RbfFlowNet);
 

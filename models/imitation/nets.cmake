@@ -3,4 +3,4 @@
 # (foresight_trainer is defined later, in training/; CMake resolves the name at generate time.)
 foresight_add_library(foresight_models_imitation_nets
   SOURCES imitation/flow_net.cc imitation/eflow_net.cc
-  DEPS foresight_imitation_eflow foresight_trainer ${TORCH_LIBRARIES})
+  DEPS foresight_imitation_eflow foresight_models_imitation foresight_trainer ${TORCH_LIBRARIES})

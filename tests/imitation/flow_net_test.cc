@@ -8,11 +8,11 @@
 #include <cmath>
 #include <random>
 
+#include "inference/imitation/rbf_grid.h"
+#include "models/imitation/flow_objective.h"
 #include "tests/test_util.h"
-
 #ifdef FORESIGHT_HAVE_RBF_FLOW_ENGINE
 #include "inference/imitation/rbf_flow.h"
-#include "inference/imitation/rbf_grid.h"
 #endif
 
 namespace foresight::imitation {
@@ -117,6 +117,151 @@ TEST(RbfFlowNet, LossGradientMatchesFiniteDifferences) {
   EXPECT_NEAR(grad_speed, central(net->log_speed), 1e-6);
 }
 
+/// The grid RandomNet's centres come from (6 x 6 over [-1, 1]^2), as an RbfGridSpec.
+RbfGridSpec<2> RandomNetGrid() {
+  RbfGridSpec<2> g;
+  g.lower = Vec<2>(-1, -1);
+  g.counts = {6, 6};
+  g.spacing = 0.4;
+  g.gamma = 6.0;
+  g.cutoff_radius = 1.0;
+  return g;
+}
+
+/// Loss and gradients (W, log_speed) of ImitationTask's batch loss on `net` (autograd, or the net's
+/// objective when it has one).
+struct LossAndGradient {
+  double loss = 0;
+  torch::Tensor grad_w;
+  double grad_speed = 0;
+};
+LossAndGradient TaskLoss(const std::shared_ptr<RbfFlowNetImpl>& net, const torch::Tensor& x,
+                         const torch::Tensor& v, const torch::Tensor& goal,
+                         const torch::Tensor& penalty_points, double penalty_weight) {
+  ImitationTask task(net, x, v, x, v, goal, penalty_points, penalty_weight);
+  net->zero_grad();
+  const torch::Tensor loss = task.BatchLoss(torch::arange(x.size(0), torch::kInt64));
+  loss.backward();
+  return {loss.item<double>(), net->weights.grad().clone(), net->log_speed.grad().item<double>()};
+}
+
+// The hand-written objective (flow_objective.h) against autograd through RbfFlowNet: the same
+// loss and gradients, with and without the invertibility penalty (active on some steps), with
+// segments, in 2-D and 3-D.
+TEST(RbfFlowNet, ObjectiveMatchesAutograd) {
+  for (const int segments : {1, 3})
+    for (const double weight_scale : {1.0, 6.0}) {  // 6: the penalty is active
+      const auto make = [&] {
+        RbfFlowNet net = RandomNet(11, 8, segments);
+        torch::NoGradGuard no_grad;
+        net->weights.mul_(weight_scale);
+        return net.ptr();
+      };
+      const auto autograd = make(), fused = make();
+      fused->SetObjective(MakeFlowObjective<2>(RandomNetGrid(), 1.0, 8, segments,
+                                               RbfFlowNetImpl::kStepLipschitz, kGoalEpsilon));
+      const torch::Tensor x = RandomPoints(13, 12), penalty = RandomPoints(5, 14);
+      torch::manual_seed(15);
+      const torch::Tensor v = torch::randn({13, 2}, kDouble);
+      const torch::Tensor goal = torch::tensor({0.1, -0.2}, kDouble);
+      for (const double pw : {0.0, 10.0}) {
+        const LossAndGradient a = TaskLoss(autograd, x, v, goal, penalty, pw);
+        const LossAndGradient f = TaskLoss(fused, x, v, goal, penalty, pw);
+        const std::string what = "segments " + std::to_string(segments) + ", weights x" +
+                                 std::to_string(weight_scale) + ", penalty " + std::to_string(pw);
+        EXPECT_NEAR(f.loss, a.loss, 1e-11 * std::max(1.0, a.loss)) << what;
+        const double scale = std::max(1.0, a.grad_w.abs().max().item<double>());
+        EXPECT_LT((f.grad_w - a.grad_w).abs().max().item<double>(), 1e-10 * scale) << what;
+        EXPECT_NEAR(f.grad_speed, a.grad_speed, 1e-10 * std::max(1.0, std::abs(a.grad_speed)))
+            << what;
+        EXPECT_GT(a.grad_w.abs().max().item<double>(), 1e-3) << what;
+      }
+      if (weight_scale > 1) {  // the penalty term must have been exercised
+        torch::NoGradGuard no_grad;
+        EXPECT_GT(autograd->InvertibilityPenalty(torch::cat({x, penalty})).item<double>(), 1e-4);
+      }
+    }
+}
+
+TEST(RbfFlowNet, ObjectiveMatchesAutogradIn3d) {
+  RbfGridSpec<3> grid;
+  grid.lower = Vec<3>(-1, -1, -1);
+  grid.counts = {4, 4, 4};
+  grid.spacing = 2.0 / 3;
+  grid.gamma = 3.0;
+  grid.cutoff_radius = 1.5;
+  torch::Tensor centres = torch::empty({64, 3}, kDouble);
+  const RbfGrid<3> g(grid);
+  for (int t = 0; t < 64; ++t)
+    for (int a = 0; a < 3; ++a) centres[t][a] = g.Centre(t)[a];
+  const auto make = [&] {
+    auto net =
+        std::make_shared<RbfFlowNetImpl>(centres, grid.gamma, grid.cutoff_radius, 0.8, 6, 0.9, 2);
+    torch::manual_seed(21);
+    torch::NoGradGuard no_grad;
+    net->weights.copy_(1.5 * torch::randn({128, 3}, kDouble));
+    return net;
+  };
+  const auto autograd = make(), fused = make();
+  fused->SetObjective(
+      MakeFlowObjective<3>(grid, 0.8, 6, 2, RbfFlowNetImpl::kStepLipschitz, kGoalEpsilon));
+  torch::manual_seed(22);
+  const torch::Tensor x = torch::rand({9, 3}, kDouble) * 1.4 - 0.7;
+  const torch::Tensor v = torch::randn({9, 3}, kDouble);
+  const torch::Tensor penalty = torch::rand({4, 3}, kDouble) - 0.5;
+  const torch::Tensor goal = torch::tensor({0.05, 0.1, -0.1}, kDouble);
+  const LossAndGradient a = TaskLoss(autograd, x, v, goal, penalty, 10.0);
+  const LossAndGradient f = TaskLoss(fused, x, v, goal, penalty, 10.0);
+  EXPECT_NEAR(f.loss, a.loss, 1e-11 * std::max(1.0, a.loss));
+  const double scale = std::max(1.0, a.grad_w.abs().max().item<double>());
+  EXPECT_LT((f.grad_w - a.grad_w).abs().max().item<double>(), 1e-10 * scale);
+  EXPECT_NEAR(f.grad_speed, a.grad_speed, 1e-10 * std::max(1.0, std::abs(a.grad_speed)));
+  torch::NoGradGuard no_grad;
+  EXPECT_GT(autograd->InvertibilityPenalty(torch::cat({x, penalty})).item<double>(), 1e-4);
+}
+
+// Chunks are summed in a fixed order: any number of threads gives the same bits; the validation
+// loss (no gradient) equals the batch loss without the penalty.
+TEST(RbfFlowNet, ObjectiveIsThreadCountIndependent) {
+  const auto objective = MakeFlowObjective<2>(RandomNetGrid(), 1.0, 8, 1,
+                                              RbfFlowNetImpl::kStepLipschitz, kGoalEpsilon);
+  RbfFlowNet net = RandomNet(31, 8, 1);
+  const torch::Tensor w = net->weights.detach().mul(4).contiguous();
+  const torch::Tensor x = RandomPoints(45, 32), penalty = RandomPoints(20, 33);
+  torch::manual_seed(34);
+  const torch::Tensor v = torch::randn({45, 2}, kDouble);
+  const std::vector<double> goal = {0.2, 0.1};
+  FlowObjectiveBatch b;
+  b.x = x.data_ptr<double>();
+  b.v = v.data_ptr<double>();
+  b.batch = 45;
+  b.goal = goal.data();
+  b.penalty = penalty.data_ptr<double>();
+  b.penalty_count = 20;
+  b.penalty_weight = 10;
+  std::vector<double> g1(72), g3(72);
+  double s1 = 0, s3 = 0;
+  const double l1 = objective->Evaluate(w.data_ptr<double>(), 0.3, b, 1, g1.data(), &s1);
+  const double l3 = objective->Evaluate(w.data_ptr<double>(), 0.3, b, 3, g3.data(), &s3);
+  EXPECT_EQ(l1, l3);
+  EXPECT_EQ(s1, s3);
+  EXPECT_EQ(g1, g3);
+  EXPECT_EQ(objective->Evaluate(w.data_ptr<double>(), 0.3, b, 2, nullptr, nullptr), l1);
+  b.penalty_weight = 0;
+  const double plain = objective->Evaluate(w.data_ptr<double>(), 0.3, b, 2, nullptr, nullptr);
+  EXPECT_LT(plain, l1);  // the penalty is active at these weights
+  b.penalty_weight = -1;
+  ExpectErrorContains(
+      [&] { objective->Evaluate(w.data_ptr<double>(), 0.3, b, 1, nullptr, nullptr); },
+      {"penalty weight", "-1"});
+  // An objective for another grid is refused by the net.
+  RbfGridSpec<2> other = RandomNetGrid();
+  other.counts = {5, 6};
+  ExpectErrorContains(
+      [&] { net->SetObjective(MakeFlowObjective<2>(other, 1.0, 8, 1, 0.7, kGoalEpsilon)); },
+      {"30 centres", "36"});
+}
+
 TEST(RbfFlowNet, VelocityAtTheGoalIsZeroWithFiniteGradients) {
   RbfFlowNet net = RandomNet(8);
   const torch::Tensor goal = torch::tensor({0.25, -0.3}, kDouble);
@@ -165,21 +310,34 @@ TEST(RbfFlowNet, TrainingOnAnArcLowersTheValidationLoss) {
   Arc(15, 0.6, &pv, &vv);
   // 8 x 8 grid over [-0.4, 1.4]^2, spacing 0.257: gamma = 1 / (2 spacing^2), cut-off 3 spacings.
   const double spacing = 1.8 / 7;
-  auto net = std::make_shared<RbfFlowNetImpl>(
-      GridCentres(-0.4, 1.4, 8), 1 / (2 * spacing * spacing), 3 * spacing, 1.0, 10, 1.0);
-  ImitationTask task(net, p, v, pv, vv, torch::zeros({2}, kDouble));
-  EXPECT_EQ(task.num_train(), 40);
-  const double before = task.ValidationLoss();
-  torch::optim::Adam adam(net->parameters(), torch::optim::AdamOptions(0.05));
-  const torch::Tensor all = torch::arange(40, torch::kInt64);
-  for (int it = 0; it < 60; ++it) {
-    adam.zero_grad();
-    task.BatchLoss(all).backward();
-    adam.step();
+  for (const bool objective : {false, true}) {
+    auto net = std::make_shared<RbfFlowNetImpl>(
+        GridCentres(-0.4, 1.4, 8), 1 / (2 * spacing * spacing), 3 * spacing, 1.0, 10, 1.0);
+    if (objective) {  // the hand-written loss and gradient (flow_objective.h) train it as well
+      RbfGridSpec<2> grid;
+      grid.lower = Vec<2>(-0.4, -0.4);
+      grid.counts = {8, 8};
+      grid.spacing = spacing;
+      grid.gamma = 1 / (2 * spacing * spacing);
+      grid.cutoff_radius = 3 * spacing;
+      net->SetObjective(
+          MakeFlowObjective<2>(grid, 1.0, 10, 1, RbfFlowNetImpl::kStepLipschitz, kGoalEpsilon));
+    }
+    ImitationTask task(net, p, v, pv, vv, torch::zeros({2}, kDouble));
+    EXPECT_EQ(task.num_train(), 40);
+    const double before = task.ValidationLoss();
+    torch::optim::Adam adam(net->parameters(), torch::optim::AdamOptions(0.05));
+    const torch::Tensor all = torch::arange(40, torch::kInt64);
+    for (int it = 0; it < 60; ++it) {
+      adam.zero_grad();
+      task.BatchLoss(all).backward();
+      adam.step();
+    }
+    const double after = task.ValidationLoss();
+    EXPECT_GT(before, 0.05);
+    EXPECT_LT(after, before / 20) << "before " << before << ", after " << after << ", objective "
+                                  << objective;
   }
-  const double after = task.ValidationLoss();
-  EXPECT_GT(before, 0.05);
-  EXPECT_LT(after, before / 20) << "before " << before << ", after " << after;
 }
 
 TEST(RbfFlowNet, BadArgumentsAreErrors) {

@@ -89,6 +89,9 @@ struct FlowConfig {
   double tube_sigma = 0;
   int tube_copies = 4;
   double tube_gain = 0;
+  /// Train through LibTorch autograd instead of the hand-written sparse objective
+  /// (models/imitation/flow_objective.h: the same loss and gradient to rounding, faster).
+  bool autograd = false;
 
   template <class A>
   void Serialize(A* a) {
@@ -113,6 +116,9 @@ struct FlowConfig {
     a->Visit("tube_copies", &tube_copies, Range::Closed(1, 100), "tube samples per training pair");
     a->Visit("tube_gain", &tube_gain, Range::NonNegative(),
              "tube samples' velocity v - gain * offset (1/s; 0: parallel to the demo)");
+    a->Visit("autograd", &autograd, Range::Any(),
+             "train by LibTorch autograd through the integration instead of the hand-written "
+             "sparse loss and gradient (the same to rounding; slower; a cross-check)");
   }
 };
 

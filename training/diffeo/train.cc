@@ -120,11 +120,19 @@ ShapeData WithTube(const ExperimentConfig& c, ShapeData s) {
   return s;
 }
 
+template <int D>
 RbfFlowNet MakeFlowNet(const ExperimentConfig& c, const ShapeData& s) {
-  const torch::Tensor centres = s.dimension == 2 ? Centres<2>(ShapeGrid<2>(c, s.positions))
-                                                 : Centres<3>(ShapeGrid<3>(c, s.positions));
-  return RbfFlowNet(centres, c.flow.gamma, c.flow.cutoff_radius, c.flow.time, c.flow.steps,
-                    s.initial_speed, c.flow.segments);
+  const RbfGridSpec<D> grid = ShapeGrid<D>(c, s.positions);
+  RbfFlowNet net(Centres<D>(grid), c.flow.gamma, c.flow.cutoff_radius, c.flow.time, c.flow.steps,
+                 s.initial_speed, c.flow.segments);
+  if (!c.flow.autograd)
+    net->SetObjective(MakeFlowObjective<D>(grid, c.flow.time, c.flow.steps, c.flow.segments,
+                                           RbfFlowNetImpl::kStepLipschitz, kGoalEpsilon));
+  return net;
+}
+
+RbfFlowNet MakeFlowNet(const ExperimentConfig& c, const ShapeData& s) {
+  return s.dimension == 2 ? MakeFlowNet<2>(c, s) : MakeFlowNet<3>(c, s);
 }
 
 EFlowNet MakeEflowNet(const ExperimentConfig& c, const ShapeData& s) {
