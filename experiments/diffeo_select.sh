@@ -5,14 +5,16 @@
 # One run per setting, ours only (no baseline, no obstacle), the shipped settings first with the
 # Euclideanizing-Flows baseline beside them as the reference. The choice rule, fixed in advance: the
 # lowest mean validation Frechet distance over the shapes; a setting within 0.002 of it with fewer
-# Euler steps (a cheaper rollout step) wins. Writes runs/diffeo_select/ and results/diffeo_select.md
+# Euler steps (a cheaper rollout step) wins; a setting that fails to train or export a shape (e.g. a
+# flow the export's invertibility check refuses) is listed as failed and not eligible. Writes runs/diffeo_select/ and results/diffeo_select.md
 # (RESULT=file.md writes that file instead).
 #   experiments/diffeo_select.sh "flow.steps=20+flow.time=2" ...
 #     (each argument is one setting: key.path=value overrides joined by '+', as select_lib.sh)
 #   SHAPES="[Angle, GShape]" experiments/diffeo_select.sh ...   (a subset, for a quick look)
 #   PARALLEL=1 experiments/diffeo_select.sh ...   (all settings at once, one thread each)
 #   RESUME=1 experiments/diffeo_select.sh ...     (keeps the finished runs of the same settings)
-# About 20 minutes per setting on 2 threads (40 per setting with PARALLEL=1 and two settings).
+#   EFLOW=0 experiments/diffeo_select.sh ...      (no EFlow reference beside the shipped settings)
+# About 2 minutes per setting on 2 threads, plus about 15 for the EFlow reference.
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BIN="${FORESIGHT_BIN:-$ROOT/build/bin/foresight}"
@@ -36,11 +38,16 @@ run_setting() {  # INDEX SETTING
   fi
   mapfile -t setting_overrides < <(overrides "$2")
   rm -rf "$run" "$run.out"
-  [ "$1" != 0 ] || eflow=eflow.enabled=true
+  [ "$1" != 0 ] || [ "${EFLOW:-1}" = 0 ] || eflow=eflow.enabled=true
   start=$(date +%s)
   "$BIN" train configs/diffeo/lasa.yaml "${validation[@]}" "$eflow" "${threads[@]}" \
     "${setting_overrides[@]}" --run-dir "$run" > "$run.out" 2>&1 ||
-    { tail -n 20 "$run.out" >&2; echo "failed: see $run.out" >&2; return 1; }
+    {  # a setting that cannot train or export every shape is a result (disqualified), not an abort
+      tail -n 5 "$run.out" >&2
+      echo "setting $1 failed: see $run.out" >&2
+      mkdir -p "$run"
+      grep -m1 'error:' "$run.out" | sed 's/^foresight: error: //' > "$run/failed.txt" || true
+    }
   printf '%s\n%s\n%s\n' "$label" "$(($(date +%s) - start))" "$SHAPES" > "$run/setting.txt"
 }
 pids=()
@@ -56,11 +63,14 @@ for setting in "${settings[@]}"; do
 done
 [ ${#pids[@]} = 0 ] || wait_all "${pids[@]}"
 python3 - "$OUT" "$index" > "$RESULT.tmp" <<'PY'
-import json, sys
+import json, os, sys
 out, count = sys.argv[1], int(sys.argv[2])
-rows = []
+rows, failed = [], []
 for i in range(count):
     setting, seconds = open(f"{out}/{i}/setting.txt").read().split("\n")[:2]
+    if os.path.exists(f"{out}/{i}/failed.txt"):
+        failed.append((setting, open(f"{out}/{i}/failed.txt").read().strip()))
+        continue
     lines = open(f"{out}/{i}/config.yaml").read().splitlines()
     flow = lines.index("flow:")  # the resolved config: top-level keys, their fields indented
     steps = int(next(l.split(":")[1] for l in lines[flow + 1:] if l.startswith("  steps:")))
@@ -84,6 +94,8 @@ for row in rows:
     mark = " **chosen**" if row is chosen else ""
     print(f"| {setting}{mark} | {steps} | {m['frechet_heldout']:.4f} | {m['frechet']:.4f} | "
           f"{m['grid_reach_rate']:.3f} | {worst} {ev['shapes'][worst]['frechet_heldout']:.3f} | {seconds} |")
+for setting, reason in failed:
+    print(f"| {setting} (failed, not eligible: {reason}) | | | | | | |")
 m = rows[0][3]["mean"]
 if "eflow_frechet_heldout" in m:
     print(f"| Euclideanizing Flows (reference, shipped run) | - | {m['eflow_frechet_heldout']:.4f} | "

@@ -93,7 +93,11 @@ if push or lift:
                        f"({s.get('obstacle_flow_steps', 0):.0f} Euler steps), cleared on the map from the "
                        f"training starts: {'yes' if s.get('obstacle_cleared_on_map') else 'no'}; EFlow "
                        f"repulsor gain {s.get('eflow_repulsor_gain', 0):g}, cleared: "
-                       f"{'yes' if s.get('eflow_repulsor_cleared_on_map') else 'no'}.")
+                       f"{'yes' if s.get('eflow_repulsor_cleared_on_map') else 'no'}."
+                       + (f" One composed C-space step with this obstacle flow, on the configurations "
+                          f"its rollouts pass (one thread, median of 3 passes): "
+                          f"{s['avoid_step_us']:.0f} us (target <= 100 us)."
+                          if "avoid_step_us" in s else ""))
     out.append("")
 if bench:
     arts = ", ".join(bench.get(p, {}).get("artifact", "-") for p in ("planar", "cspace"))

@@ -8,6 +8,7 @@
 #include <functional>
 #include <optional>
 
+#include "core/bench.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "datasets/data_root.h"
@@ -286,6 +287,22 @@ Scores EvaluateTaskSpaceShape(const ExperimentConfig& c, const PreparedDemos& de
     s.push_back({"obstacle_cleared_on_map", cleared ? 1.0 : 0.0});
     AddPathScores("avoid_", Normalised(ar, tn), demos, c.eval.resample, &s, {}, metres);
     s.push_back({"avoid_mcd", BodyDepth(chain, ar, cyl)});
+    // One step of the composed system with the selected obstacle flow, on the configurations its
+    // rollouts pass (every 10th; one thread; the median of 3 passes): the shipped flow's cost,
+    // which `foresight bench` (a short synthetic obstacle flow) does not show.
+    {
+      std::vector<ArmVector> qs;
+      for (const ArmPath& p : ar)
+        for (Eigen::Index k = 0; k < p.joints.cols(); k += 10) qs.push_back(p.joints.col(k));
+      auto ws = avoid.MakeWorkspace();
+      ArmVector sink = ArmVector::Zero();
+      const double seconds = bench::MedianSeconds(3, [&] {
+        for (const ArmVector& q : qs) sink += avoid.Velocity(q, &ws);
+      });
+      (void)sink;
+      s.push_back({"avoid_step_us",
+                   1e6 * seconds / static_cast<double>(std::max<std::size_t>(1, qs.size()))});
+    }
 
     if (eflow) {  // EFlow + a repulsor on every body point: q_dot = J^+ f - beta V_q(q)
       auto fws = field.MakeWorkspace();
