@@ -92,6 +92,9 @@ struct FlowConfig {
   /// Train through LibTorch autograd instead of the hand-written sparse objective
   /// (models/imitation/flow_objective.h: the same loss and gradient to rounding, faster).
   bool autograd = false;
+  /// Flows trained per shape (each with its own seed: tube samples, validation split, batch
+  /// order); the one exported is chosen on the training demonstrations (train.h, ExportShape).
+  int restarts = 1;
 
   template <class A>
   void Serialize(A* a) {
@@ -119,6 +122,9 @@ struct FlowConfig {
     a->Visit("autograd", &autograd, Range::Any(),
              "train by LibTorch autograd through the integration instead of the hand-written "
              "sparse loss and gradient (the same to rounding; slower; a cross-check)");
+    a->Visit("restarts", &restarts, Range::Closed(1, 100),
+             "flows trained per shape with seeds seed + 1000 r; exported: the invertible one whose "
+             "rollouts from the training starts follow the training demos best (mean Frechet)");
   }
 };
 

@@ -2,13 +2,17 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <limits>
 #include <numeric>
 #include <random>
+#include <sstream>
 
 #include "core/config.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "inference/imitation/metrics.h"
 #include "inference/imitation/template_artifact.h"
+#include "inference/imitation/transforms.h"
 #include "models/imitation/eflow_net.h"
 #include "models/imitation/flow_net.h"
 #include "training/trainer.h"
@@ -164,22 +168,95 @@ bool TrainModel(std::shared_ptr<VelocityModel> model, const ShapeData& s, const 
   return summary.reason != TerminationReason::kInterrupted;
 }
 
+/// Restart r's config: the run's with seed + 1000 r (r = 0: the run's own).
+ExperimentConfig RestartConfig(const ExperimentConfig& c, int r) {
+  ExperimentConfig rc = c;
+  rc.seed = c.seed + 1000 * r;
+  return rc;
+}
+
 template <int D>
-void ExportFlow(const ExperimentConfig& c, const PreparedDemos& d, const ShapeData& s,
-                RbfFlowNet& net, const std::string& path) {
+RbfFlow<D> EngineFlow(const ExperimentConfig& c, const PreparedDemos& d, const ShapeData& s,
+                      RbfFlowNet& net) {
   const RbfGrid<D> grid(ShapeGrid<D>(c, s.positions), d.name + ": flow grid");
   FlowSettings<D> settings;
   settings.time = c.flow.time;
   settings.steps = c.flow.steps;
   settings.segments = c.flow.segments;
-  const RbfFlow<D> flow(grid, net->WeightsAsEigen(), settings, d.name);
-  // Invertible where it is used: on the grid's box and at every training sample.
-  const Eigen::Matrix<double, D, Eigen::Dynamic> box = InvertibilityCheckPoints<D>(grid);
+  return RbfFlow<D>(grid, net->WeightsAsEigen(), settings, d.name);
+}
+
+/// Invertible where it is used: on the grid's box and at every training sample, to
+/// flow.inverse_tolerance plus the loader's allowance (RbfFlow::TruncationAllowance), so an
+/// exported flow always loads.
+template <int D>
+InvertibilityReport Invertibility(const ExperimentConfig& c, const ShapeData& s,
+                                  const RbfFlow<D>& flow) {
+  const Eigen::Matrix<double, D, Eigen::Dynamic> box = InvertibilityCheckPoints<D>(flow.grid());
   Eigen::Matrix<double, D, Eigen::Dynamic> points(D, box.cols() + s.positions.cols());
   points << box, s.positions;
-  // The loader's allowance on top (RbfFlow::TruncationAllowance), so an exported flow always loads.
-  const double tolerance = c.flow.inverse_tolerance + flow.TruncationAllowance();
-  const InvertibilityReport report = CheckInvertible<D>(flow, points, tolerance);
+  return CheckInvertible<D>(flow, points, c.flow.inverse_tolerance + flow.TruncationAllowance());
+}
+
+/// The restart to export (train.h, ExportShape): rollouts of each invertible restart's system
+/// from the training demonstrations' starts, scored by the mean discrete Frechet distance to
+/// those demonstrations (arc-length resampled as the evaluation does).
+template <int D>
+int ChooseRestart(const ExperimentConfig& c, const PreparedDemos& d, const ShapePaths& paths) {
+  if (c.flow.restarts == 1) return 0;
+  RolloutSettings roll;
+  roll.dt = c.eval.dt;
+  roll.max_steps = c.eval.max_steps;
+  roll.goal_tolerance = c.eval.goal_tolerance;
+  roll.max_step_length = c.eval.max_step_length;
+  int best = -1;
+  double best_score = std::numeric_limits<double>::infinity();
+  std::ostringstream scores;
+  for (int r = 0; r < c.flow.restarts; ++r) {
+    const ExperimentConfig rc = RestartConfig(c, r);
+    const ShapeData s = Prepare(rc, d);
+    RbfFlowNet net = MakeFlowNet(rc, s);
+    const std::string checkpoint = RunPaths{paths.FlowDir(r)}.BestCheckpoint();
+    FS_THROW_UNLESS(fs::exists(checkpoint), d.name, ": ", checkpoint,
+                    " is missing; train the run first");
+    LoadCheckpointModel(checkpoint, net.get());
+    const RbfFlow<D> flow = EngineFlow<D>(c, d, s, net);
+    scores << (r ? ", " : "") << r << ": ";
+    if (!Invertibility<D>(c, s, flow).ok) {
+      scores << "not invertible";
+      continue;
+    }
+    const ImitationSystem<D> system(flow, Vec<D>::Zero(), net->speed());
+    FlowWorkspace<D> ws = system.flow().MakeWorkspace();
+    const auto velocity = [&](const Vec<D>& x) { return system.Velocity(x, &ws); };
+    double sum = 0;
+    for (const int i : d.train) {
+      const Eigen::MatrixXd& demo = d.demos.demos[static_cast<std::size_t>(i)].position;
+      const Rollout<D> path = RollOut<D>(velocity, demo.col(0), Vec<D>::Zero(), roll);
+      sum += path.finite ? DiscreteFrechet(ResampleByArcLength(path.path, c.eval.resample),
+                                           ResampleByArcLength(demo, c.eval.resample))
+                         : std::numeric_limits<double>::infinity();
+    }
+    const double score = sum / static_cast<double>(d.train.size());
+    scores << score;
+    if (score < best_score) {
+      best_score = score;
+      best = r;
+    }
+  }
+  FS_THROW_UNLESS(best >= 0, d.name, ": none of the ", c.flow.restarts,
+                  " restarts' flows is invertible with flow.time ", c.flow.time, " and flow.steps ",
+                  c.flow.steps, "; use more flow.steps or a shorter flow.time");
+  log::Info(d.name, ": flow restarts, mean Frechet from the training starts {", scores.str(),
+            "}: exporting restart ", best);
+  return best;
+}
+
+template <int D>
+void ExportFlow(const ExperimentConfig& c, const PreparedDemos& d, const ShapeData& s,
+                RbfFlowNet& net, const std::string& path) {
+  const RbfFlow<D> flow = EngineFlow<D>(c, d, s, net);
+  const InvertibilityReport report = Invertibility<D>(c, s, flow);
   FS_THROW_UNLESS(report.ok, d.name, ": the trained flow is not invertible with flow.time ",
                   c.flow.time, " and flow.steps ", c.flow.steps, " (", report.Describe(),
                   "); use more flow.steps or a shorter flow.time");
@@ -198,30 +275,39 @@ bool ShapeExported(const ExperimentConfig& c, const ShapePaths& paths) {
 
 bool TrainShape(const ExperimentConfig& c, const PreparedDemos& demos, const ShapePaths& paths,
                 bool resume, const std::atomic<bool>* interrupt) {
+  for (int r = 0; r < c.flow.restarts; ++r) {
+    const ExperimentConfig rc = RestartConfig(c, r);
+    const ShapeData rs = Prepare(rc, demos);
+    RbfFlowNet flow = MakeFlowNet(rc, rs);
+    if (!TrainModel(flow.ptr(), WithTube(rc, rs), c.train, c.flow.invertibility_weight,
+                    paths.FlowDir(r), static_cast<std::uint64_t>(rc.seed), resume, interrupt,
+                    demos.name + " flow" + (r > 0 ? " restart " + std::to_string(r) : "")))
+      return false;
+  }
+  if (!c.eflow.enabled) return true;
   const ShapeData s = Prepare(c, demos);
   const auto seed = static_cast<std::uint64_t>(c.seed);
-  RbfFlowNet flow = MakeFlowNet(c, s);
-  if (!TrainModel(flow.ptr(), WithTube(c, s), c.train, c.flow.invertibility_weight, paths.FlowDir(),
-                  seed, resume, interrupt, demos.name + " flow"))
-    return false;
-  if (!c.eflow.enabled) return true;
   EFlowNet eflow = MakeEflowNet(c, s);
   return TrainModel(eflow.ptr(), s, c.eflow.train, 0.0, paths.EflowDir(), seed + 1, resume,
                     interrupt, demos.name + " eflow");
 }
 
 void ExportShape(const ExperimentConfig& c, const PreparedDemos& demos, const ShapePaths& paths) {
-  const ShapeData s = Prepare(c, demos);
+  const int restart = demos.demos.dimension == 2 ? ChooseRestart<2>(c, demos, paths)
+                                                 : ChooseRestart<3>(c, demos, paths);
+  const ExperimentConfig rc = RestartConfig(c, restart);
+  const ShapeData rs = Prepare(rc, demos);
   fs::create_directories(fs::path(paths.Template()).parent_path());
-  RbfFlowNet flow = MakeFlowNet(c, s);
-  const std::string best = RunPaths{paths.FlowDir()}.BestCheckpoint();
+  RbfFlowNet flow = MakeFlowNet(rc, rs);
+  const std::string best = RunPaths{paths.FlowDir(restart)}.BestCheckpoint();
   FS_THROW_UNLESS(fs::exists(best), demos.name, ": ", best, " is missing; train the run first");
   LoadCheckpointModel(best, flow.get());
-  if (s.dimension == 2)
-    ExportFlow<2>(c, demos, s, flow, paths.Template());
+  if (rs.dimension == 2)
+    ExportFlow<2>(c, demos, rs, flow, paths.Template());
   else
-    ExportFlow<3>(c, demos, s, flow, paths.Template());
+    ExportFlow<3>(c, demos, rs, flow, paths.Template());
   if (!c.eflow.enabled) return;
+  const ShapeData s = Prepare(c, demos);
   EFlowNet eflow = MakeEflowNet(c, s);
   const std::string ebest = RunPaths{paths.EflowDir()}.BestCheckpoint();
   FS_THROW_UNLESS(fs::exists(ebest), demos.name, ": ", ebest, " is missing; train the run first");
