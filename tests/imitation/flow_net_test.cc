@@ -117,6 +117,15 @@ TEST(RbfFlowNet, LossGradientMatchesFiniteDifferences) {
   EXPECT_NEAR(grad_speed, central(net->log_speed), 1e-6);
 }
 
+/// The inducing states of a grid as RbfFlowNet's centres [m, D] (RbfGrid order).
+template <int D>
+torch::Tensor CentresOf(const RbfGrid<D>& grid) {
+  torch::Tensor centres = torch::empty({grid.size(), D}, kDouble);
+  for (int t = 0; t < grid.size(); ++t)
+    for (int a = 0; a < D; ++a) centres[t][a] = grid.Centre(t)[a];
+  return centres;
+}
+
 /// The grid RandomNet's centres come from (6 x 6 over [-1, 1]^2), as an RbfGridSpec.
 RbfGridSpec<2> RandomNetGrid() {
   RbfGridSpec<2> g;
@@ -190,10 +199,7 @@ TEST(RbfFlowNet, ObjectiveMatchesAutogradIn3d) {
   grid.spacing = 2.0 / 3;
   grid.gamma = 3.0;
   grid.cutoff_radius = 1.5;
-  torch::Tensor centres = torch::empty({64, 3}, kDouble);
-  const RbfGrid<3> g(grid);
-  for (int t = 0; t < 64; ++t)
-    for (int a = 0; a < 3; ++a) centres[t][a] = g.Centre(t)[a];
+  const torch::Tensor centres = CentresOf(RbfGrid<3>(grid));
   const auto make = [&] {
     auto net =
         std::make_shared<RbfFlowNetImpl>(centres, grid.gamma, grid.cutoff_radius, 0.8, 6, 0.9, 2);
@@ -383,12 +389,7 @@ void CheckEngineParity(int segments) {
   spec.gamma = 8;
   spec.cutoff_radius = 0.6;
   const RbfGrid<2> grid(spec);
-  torch::Tensor centres = torch::empty({grid.size(), 2}, kDouble);
-  for (int t = 0; t < grid.size(); ++t) {
-    centres[t][0] = grid.Centre(t)[0];
-    centres[t][1] = grid.Centre(t)[1];
-  }
-  RbfFlowNet net(centres, spec.gamma, spec.cutoff_radius, 0.8, 7, 1.4, segments);
+  RbfFlowNet net(CentresOf(grid), spec.gamma, spec.cutoff_radius, 0.8, 7, 1.4, segments);
   torch::manual_seed(11);
   {
     torch::NoGradGuard no_grad;
