@@ -5,8 +5,8 @@
 # One run per setting, ours only (no baseline, no obstacle), the shipped settings first with the
 # Euclideanizing-Flows baseline beside them as the reference. The choice rule, fixed in advance: the
 # lowest mean validation Frechet distance over the shapes; a setting within 0.002 of it with fewer
-# Euler steps (a cheaper rollout step) wins; a setting that fails to train or export a shape (e.g. a
-# flow the export's invertibility check refuses) is listed as failed and not eligible. Writes runs/diffeo_select/ and results/diffeo_select.md
+# Euler steps (a cheaper rollout step) wins; a setting whose flow the export refuses (not invertible)
+# or whose loss becomes non-finite on some shape is listed as not eligible; any other failure aborts. Writes runs/diffeo_select/ and results/diffeo_select.md
 # (RESULT=file.md writes that file instead).
 #   experiments/diffeo_select.sh "flow.steps=20+flow.time=2" ...
 #     (each argument is one setting: key.path=value overrides joined by '+', as select_lib.sh)
@@ -42,11 +42,16 @@ run_setting() {  # INDEX SETTING
   start=$(date +%s)
   "$BIN" train configs/diffeo/lasa.yaml "${validation[@]}" "$eflow" "${threads[@]}" \
     "${setting_overrides[@]}" --run-dir "$run" > "$run.out" 2>&1 ||
-    {  # a setting that cannot train or export every shape is a result (disqualified), not an abort
+    {
       tail -n 5 "$run.out" >&2
-      echo "setting $1 failed: see $run.out" >&2
+      # A flow the export refuses (not invertible) or a loss that became non-finite is a result of
+      # the setting (disqualified); anything else (an interruption, a crash) aborts, and RESUME=1
+      # retries the setting.
+      grep -q -E 'error: .*(invertible|became non-finite)' "$run.out" ||
+        { echo "setting $1 failed: see $run.out" >&2; return 1; }
+      echo "setting $1 is not eligible: see $run.out" >&2
       mkdir -p "$run"
-      grep -m1 'error:' "$run.out" | sed 's/^foresight: error: //' > "$run/failed.txt" || true
+      grep -m1 'error:' "$run.out" | sed 's/^foresight: error: //' > "$run/failed.txt"
     }
   printf '%s\n%s\n%s\n' "$label" "$(($(date +%s) - start))" "$SHAPES" > "$run/setting.txt"
 }
@@ -76,6 +81,8 @@ for i in range(count):
     steps = int(next(l.split(":")[1] for l in lines[flow + 1:] if l.startswith("  steps:")))
     ev = json.load(open(f"{out}/{i}/eval.json"))
     rows.append((setting, int(seconds), steps, ev))
+if not rows:
+    sys.exit("every setting failed: see the .out files")
 best = min(r[3]["mean"]["frechet_heldout"] for r in rows)
 chosen = min((r for r in rows if r[3]["mean"]["frechet_heldout"] <= best + 0.002),
              key=lambda r: (r[2], r[3]["mean"]["frechet_heldout"]))

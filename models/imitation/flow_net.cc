@@ -1,6 +1,7 @@
 #include "models/imitation/flow_net.h"
 
 #include <cmath>
+#include <vector>
 
 #include "core/error.h"
 
@@ -174,6 +175,22 @@ void RbfFlowNetImpl::SetObjective(std::shared_ptr<const FlowObjective> objective
         "RbfFlowNet: the objective is for ", objective->num_centres(), " centres in ",
         objective->dimension(), "-D with ", objective->segments(), " segment(s), the net has ",
         num_centres(), " in ", dimension(), "-D with ", segments_);
+    FS_THROW_UNLESS(
+        objective->steps() == steps_ && std::abs(objective->time() - time_) <= 1e-12 * time_ &&
+            objective->gamma() == gamma_ && objective->cutoff_radius() == cutoff_radius_,
+        "RbfFlowNet: the objective's time ", objective->time(), ", steps ", objective->steps(),
+        ", gamma ", objective->gamma(), " and cut-off ", objective->cutoff_radius(),
+        " differ from the net's ", time_, ", ", steps_, ", ", gamma_, ", ", cutoff_radius_);
+    const torch::Tensor c = centres_.contiguous();
+    const double* cp = c.data_ptr<double>();
+    std::vector<double> centre(static_cast<std::size_t>(dimension()));
+    for (int t = 0; t < num_centres(); ++t) {
+      objective->Centre(t, centre.data());
+      for (int a = 0; a < dimension(); ++a)
+        FS_THROW_UNLESS(
+            std::abs(centre[static_cast<std::size_t>(a)] - cp[t * dimension() + a]) <= 1e-9,
+            "RbfFlowNet: the objective's inducing state ", t, " is not the net's");
+    }
   }
   objective_ = std::move(objective);
 }

@@ -96,8 +96,8 @@ class RbfFlowNetImpl : public VelocityModel {
 
   /// Trains through `objective` (MakeFlowObjective on this net's grid, time, steps, segments,
   /// kStepLipschitz and kGoalEpsilon: the same loss to rounding, sparse in the cut-off, no graph)
-  /// instead of autograd; null = autograd. A mismatched dimension, centre or segment count is an
-  /// Error.
+  /// instead of autograd; null = autograd. An objective for another grid, time, step or segment
+  /// count is an Error.
   void SetObjective(std::shared_ptr<const FlowObjective> objective);
   bool has_objective() const { return objective_ != nullptr; }
   torch::Tensor ObjectiveLoss(const torch::Tensor& x, const torch::Tensor& v,

@@ -60,6 +60,14 @@ class RbfFlowObjective final : public FlowObjective {
   int dimension() const override { return D; }
   int num_centres() const override { return grid_.size(); }
   int segments() const override { return segments_; }
+  int steps() const override { return steps_; }
+  double time() const override { return h_ * steps_; }
+  double gamma() const override { return grid_.gamma(); }
+  double cutoff_radius() const override { return grid_.spec().cutoff_radius; }
+  void Centre(int t, double* out) const override {
+    const V c = grid_.Centre(t);
+    for (int a = 0; a < D; ++a) out[a] = c[a];
+  }
 
   double Evaluate(const double* weights, double log_speed, const FlowObjectiveBatch& b, int threads,
                   double* grad_weights, double* grad_log_speed) const override;

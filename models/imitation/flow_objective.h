@@ -13,8 +13,9 @@
 /// and G_A = dL/dA_k (from J_{k+1} = (I + h A_k) J_k and from the penalty at s_k):
 ///   G_A = h G_J J_k' + (penalty) 2 w_P/(K N) max(0, e) h A_k / ||A_k||_F,  e = h ||A_k||_F - kappa
 ///   dL/dW_t += h phi_t G_s + G_A dphi_t          (t within the cut-off of s_k)
-///   dL/ds_k  = G_s + h A_k' G_s + sum_t H_t (W_t' G_A)' ,  H_t = phi_t (4 gamma^2 r_t r_t' - 2
-///   gamma I) dL/dJ_k  = (I + h A_k)' G_J,
+///   dL/ds_k  = G_s + h A_k' G_s + sum_t H_t (G_A' W_t),
+///   dL/dJ_k  = (I + h A_k)' G_J,
+/// H_t = phi_t (4 gamma^2 r_t r_t' - 2 gamma I) the Hessian of phi_t,
 /// r_t = s_k - c_t, dphi_t = -2 gamma phi_t r_t, W_t the t-th row of the step's segment weights.
 /// Samples are processed in fixed chunks whose gradients are summed in chunk order, so the result
 /// does not depend on the number of threads.
@@ -49,6 +50,12 @@ class FlowObjective {
   /// Inducing states m (the weights have S m rows).
   virtual int num_centres() const = 0;
   virtual int segments() const = 0;
+  virtual int steps() const = 0;
+  virtual double time() const = 0;
+  virtual double gamma() const = 0;
+  virtual double cutoff_radius() const = 0;
+  /// Inducing state t in [0, m) (RbfGrid order), `dimension()` coordinates into `out`.
+  virtual void Centre(int t, double* out) const = 0;
   /// L (file comment) at weights W [S m, d] row-major and log_speed. When grad_weights is not null
   /// it receives dL/dW (row-major [S m, d], overwritten) and *grad_log_speed dL/dlog_speed.
   /// `threads` >= 1 share the samples. Bad shapes or counts are an Error.

@@ -266,6 +266,18 @@ TEST(RbfFlowNet, ObjectiveIsThreadCountIndependent) {
   ExpectErrorContains(
       [&] { net->SetObjective(MakeFlowObjective<2>(other, 1.0, 8, 1, 0.7, kGoalEpsilon)); },
       {"30 centres", "36"});
+  ExpectErrorContains(  // the same count, another grid / another step count
+      [&] {
+        RbfGridSpec<2> shifted = RandomNetGrid();
+        shifted.lower = Vec<2>(-0.9, -1);
+        net->SetObjective(MakeFlowObjective<2>(shifted, 1.0, 8, 1, 0.7, kGoalEpsilon));
+      },
+      {"inducing state 0"});
+  ExpectErrorContains(
+      [&] {
+        net->SetObjective(MakeFlowObjective<2>(RandomNetGrid(), 1.0, 4, 1, 0.7, kGoalEpsilon));
+      },
+      {"steps 4"});
 }
 
 TEST(RbfFlowNet, VelocityAtTheGoalIsZeroWithFiniteGradients) {

@@ -209,7 +209,7 @@ int ChooseRestart(const ExperimentConfig& c, const PreparedDemos& d, const Shape
   roll.max_steps = c.eval.max_steps;
   roll.goal_tolerance = c.eval.goal_tolerance;
   roll.max_step_length = c.eval.max_step_length;
-  int best = -1;
+  int best = -1, first_invertible = -1;
   double best_score = std::numeric_limits<double>::infinity();
   std::ostringstream scores;
   for (int r = 0; r < c.flow.restarts; ++r) {
@@ -226,6 +226,7 @@ int ChooseRestart(const ExperimentConfig& c, const PreparedDemos& d, const Shape
       scores << "not invertible";
       continue;
     }
+    if (first_invertible < 0) first_invertible = r;
     const ImitationSystem<D> system(flow, Vec<D>::Zero(), net->speed());
     FlowWorkspace<D> ws = system.flow().MakeWorkspace();
     const auto velocity = [&](const Vec<D>& x) { return system.Velocity(x, &ws); };
@@ -244,9 +245,14 @@ int ChooseRestart(const ExperimentConfig& c, const PreparedDemos& d, const Shape
       best = r;
     }
   }
-  FS_THROW_UNLESS(best >= 0, d.name, ": none of the ", c.flow.restarts,
+  FS_THROW_UNLESS(first_invertible >= 0, d.name, ": none of the ", c.flow.restarts,
                   " restarts' flows is invertible with flow.time ", c.flow.time, " and flow.steps ",
                   c.flow.steps, "; use more flow.steps or a shorter flow.time");
+  if (best <
+      0) {  // every invertible restart's rollouts diverged: as a single run would, export one
+    best = first_invertible;
+    log::Warn(d.name, ": every invertible restart's rollout from a training start diverged");
+  }
   log::Info(d.name, ": flow restarts, mean Frechet from the training starts {", scores.str(),
             "}: exporting restart ", best);
   return best;
