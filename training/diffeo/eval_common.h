@@ -21,6 +21,17 @@
 
 namespace foresight::imitation {
 
+/// The rollouts of a template in its normalised coordinates (eval.dt, max_steps, goal_tolerance,
+/// max_step_length): the evaluation's and the flow restarts' choice's.
+inline RolloutSettings ModelRollouts(const ExperimentConfig& c) {
+  RolloutSettings r;
+  r.dt = c.eval.dt;
+  r.max_steps = c.eval.max_steps;
+  r.goal_tolerance = c.eval.goal_tolerance;
+  r.max_step_length = c.eval.max_step_length;
+  return r;
+}
+
 /// Rolled-out paths [d x n_k] with whether each reached the goal.
 struct PathSet {
   std::vector<Eigen::MatrixXd> paths;

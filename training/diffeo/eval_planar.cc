@@ -22,15 +22,6 @@ namespace {
 
 using V2 = Vec<2>;
 
-RolloutSettings Rollouts(const ExperimentConfig& c) {
-  RolloutSettings r;
-  r.dt = c.eval.dt;
-  r.max_steps = c.eval.max_steps;
-  r.goal_tolerance = c.eval.goal_tolerance;
-  r.max_step_length = c.eval.max_step_length;
-  return r;
-}
-
 /// Rollouts of `velocity` from every demo start (or the given starts).
 std::vector<Rollout<2>> RollAll(const std::function<V2(const V2&)>& velocity,
                                 const std::vector<V2>& starts, const V2& goal,
@@ -66,7 +57,7 @@ Scores EvaluatePlanarShape(const ExperimentConfig& c, const PreparedDemos& demos
   const TemplateArtifact<2> art = LoadTemplate<2>(template_path);
   const ImitationSystem<2>& system = art.system;
   const V2 goal = system.goal();
-  const RolloutSettings roll = Rollouts(c);
+  const RolloutSettings roll = ModelRollouts(c);
   const int n = static_cast<int>(demos.demos.demos.size());
   std::vector<V2> starts;
   for (const Demonstration& d : demos.demos.demos) starts.push_back(d.position.col(0));

@@ -15,6 +15,7 @@
 #include "inference/imitation/transforms.h"
 #include "models/imitation/eflow_net.h"
 #include "models/imitation/flow_net.h"
+#include "training/diffeo/eval_common.h"
 #include "training/trainer.h"
 
 namespace foresight::imitation {
@@ -204,11 +205,7 @@ InvertibilityReport Invertibility(const ExperimentConfig& c, const ShapeData& s,
 template <int D>
 int ChooseRestart(const ExperimentConfig& c, const PreparedDemos& d, const ShapePaths& paths) {
   if (c.flow.restarts == 1) return 0;
-  RolloutSettings roll;
-  roll.dt = c.eval.dt;
-  roll.max_steps = c.eval.max_steps;
-  roll.goal_tolerance = c.eval.goal_tolerance;
-  roll.max_step_length = c.eval.max_step_length;
+  const RolloutSettings roll = ModelRollouts(c);
   int best = -1, first_invertible = -1;
   double best_score = std::numeric_limits<double>::infinity();
   std::ostringstream scores;
