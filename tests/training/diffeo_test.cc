@@ -16,6 +16,7 @@
 #include "tests/test_util.h"
 #include "training/diffeo/config.h"
 #include "training/diffeo/demos.h"
+#include "training/diffeo/eval_common.h"
 #include "training/diffeo/pipeline.h"
 #include "training/run_dir.h"
 
@@ -103,6 +104,20 @@ TEST(DiffeoRun, RestartsExportTheFlowThatFollowsTheTrainingDemosBest) {
   const auto best = imitation::LoadTemplate<2>(restarts + "/models/s_curve.h5");
   // Here restart 1 wins (0.186 against restart 0's 0.204): strictly better than the single run.
   EXPECT_LT(TrainingStartFrechet(best, demos, c3), TrainingStartFrechet(one, demos, c1) - 0.01);
+}
+
+TEST(DiffeoSelection, TakesTheFirstTrainingClearSettingWithTheFewestGridCrossings) {
+  using imitation::ChooseClearance;
+  using C = imitation::Clearance;
+  // Training starts clear from index 1; crossings 3, 1, 1, 2: the first of the two 1s.
+  EXPECT_EQ(ChooseClearance({C{false, 0}, C{true, 3}, C{true, 1}, C{true, 1}, C{true, 2}}), 2u);
+  // A setting whose training starts are not clear never wins, however few its crossings.
+  EXPECT_EQ(ChooseClearance({C{true, 4}, C{false, 0}, C{true, 4}}), 0u);
+  // The first training-clear setting with none crossing (the search stops there).
+  EXPECT_EQ(ChooseClearance({C{false, 2}, C{true, 0}}), 1u);
+  // No setting clears the training starts: the last one tried (the strongest), as before the grid.
+  EXPECT_EQ(ChooseClearance({C{false, 0}, C{false, 5}, C{false, 1}}), 2u);
+  EXPECT_EQ(ChooseClearance({C{false, 0}}), 0u);
 }
 
 TEST(DiffeoRun, AnObstacleOnTheGoalIsRefused) {

@@ -175,13 +175,20 @@ struct ObstacleConfig {
   double map_inflate = 0.01;     ///< samples within this distance of the obstacle are occupied
   double sample_spacing = 0.01;  ///< occupancy samples on a lattice around the obstacle
   double sample_margin = 0.1;    ///< lattice margin around the obstacle
-  /// Obstacle-flow times tried, smallest first: the first whose Euler map is invertible (checked on
-  /// the sample lattice or along the rollouts) and whose rollouts from the training starts keep
-  /// the map's p(occupied) below `clear_probability` is used (selection on the map, not on the
-  /// exact obstacle the metrics use).
+  /// Obstacle-flow times tried, smallest first, up to the first whose Euler map is not invertible
+  /// (checked on the sample lattice or along the rollouts): the first whose rollouts from the
+  /// training starts keep the map's p(occupied) below `clear_probability` is used (2-D with
+  /// `select_on_grid`: of those, the first with the fewest grid crossings). Selection on the map,
+  /// not on the exact obstacle the metrics use.
   std::vector<double> times{0.002, 0.004, 0.008, 0.016, 0.032, 0.064};
   double step = 0.0005;  ///< Euler step of the obstacle flow (steps = ceil(time / step))
   double clear_probability = 0.5;
+  /// 2-D: the selection also rolls out from the stability grid's starts (`eval.grid`, those the map
+  /// calls free): among the settings whose training starts are clear, the first with the fewest
+  /// grid rollouts crossing the map (p >= clear_probability) is used, so the setting clears as much
+  /// of the space around the demonstrations as it can, not only the training starts. No test
+  /// start enters. (Task space does not read it.)
+  bool select_on_grid = true;
   /// Largest round-trip error psi_o^-1(psi_o(y)) - y accepted when checking a flow time
   /// (normalised units in 2-D, rad in C-space); every inverse must also converge.
   double inverse_tolerance = 1e-8;
@@ -211,6 +218,9 @@ struct ObstacleConfig {
     a->Visit("step", &step, Range::Positive(), "obstacle-flow Euler step (steps = time / step)");
     a->Visit("clear_probability", &clear_probability, Range::Closed(0.01, 0.99),
              "rollouts must keep the map's p(occupied) below this");
+    a->Visit("select_on_grid", &select_on_grid, Range::Any(),
+             "2-D: among obstacle-flow times (and EFlow repulsor gains) whose training starts are "
+             "clear, take the first with the fewest stability-grid rollouts crossing the map");
     a->Visit("inverse_tolerance", &inverse_tolerance, Range::Positive(),
              "largest obstacle-flow round-trip error accepted (2-D normalised units; C-space rad)");
     a->Visit("goal_gate", &goal_gate, Range::NonNegative(),

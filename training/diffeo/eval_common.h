@@ -32,6 +32,26 @@ inline RolloutSettings ModelRollouts(const ExperimentConfig& c) {
   return r;
 }
 
+/// How well one obstacle setting (flow time, repulsor gain) keeps rollouts off the map's obstacle.
+struct Clearance {
+  bool training_clear = false;  ///< every training start reaches the goal with p < clear
+  int grid_crossing = 0;        ///< grid starts whose rollout reaches p >= clear
+};
+
+/// The selection among obstacle settings tried in order (docs/diffeo.md "Selection"): the first
+/// whose training starts are clear and whose grid crossings are the fewest of those; with no
+/// training-clear setting, the last one tried. Returns its index; `tried` must not be empty.
+inline std::size_t ChooseClearance(const std::vector<Clearance>& tried) {
+  std::size_t best = tried.size() - 1;
+  bool found = false;
+  for (std::size_t i = 0; i < tried.size(); ++i)
+    if (tried[i].training_clear && (!found || tried[i].grid_crossing < tried[best].grid_crossing)) {
+      best = i;
+      found = true;
+    }
+  return best;
+}
+
 /// Rolled-out paths [d x n_k] with whether each reached the goal.
 struct PathSet {
   std::vector<Eigen::MatrixXd> paths;

@@ -120,10 +120,31 @@ Scores EvaluatePlanarShape(const ExperimentConfig& c, const PreparedDemos& demos
     s.push_back({"mcd", MaxDepth(ToPaths(imit), disc)});
     if (eflow) s.push_back({"eflow_mcd", MaxDepth(pic.eflow, disc)});
 
-    // Our composed system: the smallest obstacle-flow time whose rollouts from the training starts
-    // keep the map clear (selected on the map, scored on the exact disc).
+    // Our composed system. Selected on the map, scored on the exact disc from every demo start:
+    // the training starts must reach the goal and keep the map clear; among the times that do,
+    // the first with the fewest rollouts from the stability grid's free starts crossing the map
+    // (obstacle.select_on_grid). A path into the core that the flow compresses the obstacle to
+    // cannot be bent away at any finite time, so "none crosses" is not always reachable.
     std::vector<V2> train_starts;
     for (int k : train_free) train_starts.push_back(free_starts[static_cast<std::size_t>(k)]);
+    std::vector<V2> clear_grid;
+    if (c.obstacle.select_on_grid) {
+      auto ws = field.MakeWorkspace();
+      for (const V2& p : grid)
+        if (field.Probability(p, ws.get()) < c.obstacle.clear_probability) clear_grid.push_back(p);
+    }
+    const auto clearance = [&](const std::function<V2(const V2&)>& velocity) {
+      Clearance out;
+      const auto rs = RollAll(velocity, train_starts, goal, roll);
+      out.training_clear =
+          AllReached(rs) && MaxMapProbability(field, rs) < c.obstacle.clear_probability;
+      if (!out.training_clear) return out;
+      for (const V2& p : clear_grid)
+        if (MaxMapProbability(field, {RollOut<2>(velocity, p, goal, roll)}) >=
+            c.obstacle.clear_probability)
+          ++out.grid_crossing;
+      return out;
+    };
     const V2 box_lo = disc.centre.array() - disc.radius - c.obstacle.sample_margin;
     const V2 box_hi = disc.centre.array() + disc.radius + c.obstacle.sample_margin;
     const auto [max_grad, max_hess] =
@@ -131,27 +152,26 @@ Scores EvaluatePlanarShape(const ExperimentConfig& c, const PreparedDemos& demos
     const double h = ObstacleStep(c.obstacle, max_hess);
     log::Info(demos.name, ": obstacle map max |grad p| ", max_grad, ", max |Hess p| ", max_hess,
               ", obstacle-flow step ", h);
-    double chosen = -1;
-    bool cleared = false;
+    std::vector<double> times;
+    std::vector<Clearance> tried;
     for (double t : c.obstacle.times) {
       const OuterTransform<2> outer = ObstacleOuter<2>(field, t, h);
       // Larger times only bend the map further: stop at the first non-invertible one.
       if (!ObstacleInvertible<2>(outer.obstacle, box_lo, box_hi, c.obstacle.sample_spacing * 2,
                                  c.obstacle.inverse_tolerance))
         break;
-      chosen = t;
       const ComposedSystem<2> sys(system, {outer});
       auto ws = sys.MakeWorkspace();
-      const auto vel = [&](const V2& y) { return sys.Velocity(y, &ws); };
-      const auto rs = RollAll(vel, train_starts, goal, roll);
-      if (AllReached(rs) && MaxMapProbability(field, rs) < c.obstacle.clear_probability) {
-        cleared = true;
-        break;
-      }
+      times.push_back(t);
+      tried.push_back(clearance([&](const V2& y) { return sys.Velocity(y, &ws); }));
+      if (tried.back().training_clear && tried.back().grid_crossing == 0) break;
     }
-    FS_THROW_UNLESS(chosen > 0, demos.name, ": obstacle.times[0] = ", c.obstacle.times[0],
+    FS_THROW_UNLESS(!times.empty(), demos.name, ": obstacle.times[0] = ", c.obstacle.times[0],
                     " with obstacle.step ", c.obstacle.step,
                     " already makes the obstacle flow non-invertible; lower both");
+    const std::size_t pick = ChooseClearance(tried);
+    const double chosen = times[pick];
+    const bool cleared = tried[pick].training_clear;
     const ComposedSystem<2> avoid(system, {ObstacleOuter<2>(field, chosen, h)});
     auto aws = avoid.MakeWorkspace();
     const auto f_o = [&](const V2& y) { return avoid.Velocity(y, &aws); };
@@ -159,6 +179,7 @@ Scores EvaluatePlanarShape(const ExperimentConfig& c, const PreparedDemos& demos
     s.push_back({"obstacle_flow_time", chosen});
     s.push_back({"obstacle_flow_steps", static_cast<double>(ObstacleSteps(chosen, h))});
     s.push_back({"obstacle_cleared_on_map", cleared ? 1.0 : 0.0});
+    s.push_back({"obstacle_grid_crossing", static_cast<double>(tried[pick].grid_crossing)});
     AddPathScores("avoid_", ToPaths(ar), demos, c.eval.resample, &s, free_ids);
     s.push_back({"avoid_mcd", MaxDepth(ToPaths(ar), disc)});
     s.push_back({"avoid_grid_reach_rate", ReachRate(RollAll(f_o, FreeOf(grid, disc), goal, roll))});
@@ -166,10 +187,8 @@ Scores EvaluatePlanarShape(const ExperimentConfig& c, const PreparedDemos& demos
     pic.obstacle_radius = disc.radius;
     pic.avoid = ToPaths(ar);
 
-    if (eflow) {  // EFlow + repulsor, gain selected on the map the same way
+    if (eflow) {  // EFlow + repulsor, gain selected on the map by the same rule
       auto ws = field.MakeWorkspace();
-      double gain = c.obstacle.repulsor_gains.back();
-      bool rep_cleared = false;
       const auto rep = [&](double beta) {
         return [&, beta](const V2& x) -> V2 {
           OccupancyValue<2> v;
@@ -177,17 +196,19 @@ Scores EvaluatePlanarShape(const ExperimentConfig& c, const PreparedDemos& demos
           return eflow->VelocityWithRepulsor(x, v.gradient, beta);
         };
       };
+      std::vector<Clearance> rep_tried;
       for (double beta : c.obstacle.repulsor_gains) {
-        const auto rs = RollAll(rep(beta), train_starts, goal, roll);
-        if (AllReached(rs) && MaxMapProbability(field, rs) < c.obstacle.clear_probability) {
-          gain = beta;
-          rep_cleared = true;
-          break;
-        }
+        rep_tried.push_back(clearance(rep(beta)));
+        if (rep_tried.back().training_clear && rep_tried.back().grid_crossing == 0) break;
       }
+      const std::size_t rep_pick = ChooseClearance(rep_tried);
+      const double gain = c.obstacle.repulsor_gains[rep_pick];
+      const bool rep_cleared = rep_tried[rep_pick].training_clear;
       const std::vector<Rollout<2>> rr = RollAll(rep(gain), free_starts, goal, roll);
       s.push_back({"eflow_repulsor_gain", gain});
       s.push_back({"eflow_repulsor_cleared_on_map", rep_cleared ? 1.0 : 0.0});
+      s.push_back(
+          {"eflow_repulsor_grid_crossing", static_cast<double>(rep_tried[rep_pick].grid_crossing)});
       AddPathScores("eflow_repulsor_", ToPaths(rr), demos, c.eval.resample, &s, free_ids);
       s.push_back({"eflow_repulsor_mcd", MaxDepth(ToPaths(rr), disc)});
       pic.eflow_repulsor = ToPaths(rr);
