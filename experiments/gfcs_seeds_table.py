@@ -29,7 +29,7 @@ def main():
     for b in BATCHES:
         print(f"## {b}\n")
         print("| family | " + " | ".join(f"seed {s}" for s, _ in runs) +
-              " | learned - uniform, min / max over seeds |")
+              " | learned - uniform: min / max over seeds, sum |")
         print("|---|" + "---|" * len(runs) + "---|")
         totals = [[0, 0, 0] for _ in runs]
         for f in families:
@@ -47,12 +47,14 @@ def main():
                 totals[i][1] += lr[0]
                 totals[i][2] += u[1]
                 cells.append(f"{u[0]} / {lr[0]} ({d:+d})")
-            span = f"{min(diffs):+d} / {max(diffs):+d}" if diffs else "-"
+            span = f"{min(diffs):+d} / {max(diffs):+d}, {sum(diffs):+d}" if diffs else "-"
             print(f"| {f} | " + " | ".join(cells) + f" | {span} |")
         cells = [f"{u} / {lr} of {n} ({lr - u:+d})" for u, lr, n in totals]
         diffs = [lr - u for u, lr, _ in totals]
-        print("| all | " + " | ".join(cells) + f" | {min(diffs):+d} / {max(diffs):+d} |\n")
+        print("| all | " + " | ".join(cells) + f" | {min(diffs):+d} / {max(diffs):+d}, {sum(diffs):+d} |\n")
     print("## The loops\n")
+    print("Loop time: the wall time the run recorded; comparable only between runs on an idle "
+          "machine.\n")
     print("| seed | training solves solved | training rounds | last InfoNCE | loop time (s) |")
     print("|---|---|---|---|---|")
     for s, j in runs:
