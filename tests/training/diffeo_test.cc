@@ -106,6 +106,49 @@ TEST(DiffeoRun, RestartsExportTheFlowThatFollowsTheTrainingDemosBest) {
   EXPECT_LT(TrainingStartFrechet(best, demos, c3), TrainingStartFrechet(one, demos, c1) - 0.01);
 }
 
+// flow.alternatives: each (time, steps) is trained with the run's seeds as a separate run with
+// those settings would be, and the export is the one of them that follows the training demos
+// best, with its own time and steps in the artifact.
+TEST(DiffeoRun, AlternativesExportTheFlowLengthThatFollowsTheTrainingDemosBest) {
+  const testing::TempDir dir;
+  const std::vector<std::string> common = {"eflow.enabled=false", "obstacle.enabled=false",
+                                           "train.epochs=10",     "flow.tube_sigma=0.05",
+                                           "flow.tube_gain=2",    "eval.resample=50"};
+  std::vector<std::string> longer = common, both = common;
+  longer.insert(longer.end(), {"flow.time=2", "flow.steps=8"});
+  both.push_back("flow.alternatives=[{time: 2, steps: 8}]");
+  const imitation::ExperimentConfig c_short = Tiny(common), c_long = Tiny(longer),
+                                    c_both = Tiny(both);
+  ASSERT_EQ(c_both.flow.TotalRestarts(), 2);
+  const std::string short_run = dir.File("short"), long_run = dir.File("long"),
+                    both_run = dir.File("both");
+  ASSERT_TRUE(imitation::TrainRun(c_short, short_run, false, nullptr));
+  ASSERT_TRUE(imitation::TrainRun(c_long, long_run, false, nullptr));
+  ASSERT_TRUE(imitation::TrainRun(c_both, both_run, false, nullptr));
+  EXPECT_TRUE(fs::exists(both_run + "/shapes/s_curve/flow_1/checkpoints/best.pt"));
+  const imitation::PreparedDemos demos = imitation::LoadDemos(c_short).front();
+  const auto a = imitation::LoadTemplate<2>(short_run + "/models/s_curve.h5");
+  const auto b = imitation::LoadTemplate<2>(long_run + "/models/s_curve.h5");
+  const auto chosen = imitation::LoadTemplate<2>(both_run + "/models/s_curve.h5");
+  EXPECT_EQ(a.system.flow().settings().steps, 4);
+  EXPECT_EQ(b.system.flow().settings().steps, 8);
+  const double fa = TrainingStartFrechet(a, demos, c_short);
+  const double fb = TrainingStartFrechet(b, demos, c_long);
+  ASSERT_NE(fa, fb);
+  const auto& winner = fa <= fb ? a : b;
+  EXPECT_EQ(chosen.system.flow().settings().steps, winner.system.flow().settings().steps);
+  EXPECT_EQ(chosen.system.flow().settings().time, winner.system.flow().settings().time);
+  EXPECT_EQ(chosen.system.flow().weights(), winner.system.flow().weights());
+}
+
+TEST(DiffeoConfig, AnAlternativeWithFewerStepsThanSegmentsIsRefused) {
+  testing::ExpectErrorContains(
+      [] {
+        Tiny({"flow.segments=3", "flow.alternatives=[{time: 1, steps: 2}]"});
+      },
+      {"flow.alternatives[0].steps", "flow.segments"});
+}
+
 TEST(DiffeoSelection, TakesTheFirstTrainingClearSettingWithTheFewestGridCrossings) {
   using imitation::ChooseClearance;
   using C = imitation::Clearance;

@@ -44,6 +44,12 @@ void ExperimentConfig::Validate(const std::string& source) const {
                   "): most states would have no feature");
   FS_THROW_UNLESS(flow.segments <= flow.steps, source, ": flow.segments (", flow.segments,
                   ") exceeds flow.steps (", flow.steps, "): each segment needs an Euler step");
+  for (std::size_t i = 0; i < flow.alternatives.size(); ++i)
+    FS_THROW_UNLESS(flow.segments <= flow.alternatives[i].steps, source, ": flow.segments (",
+                    flow.segments, ") exceeds flow.alternatives[", i, "].steps (",
+                    flow.alternatives[i].steps, "): each segment needs an Euler step");
+  FS_THROW_UNLESS(flow.TotalRestarts() <= 1000, source, ": flow.restarts x (1 + ",
+                  "flow.alternatives) = ", flow.TotalRestarts(), " flows per shape; at most 1000");
   if (bias.enabled) {
     const std::size_t d = data.source == DemoSource::kTaskSpace ? 3 : 2;
     FS_THROW_UNLESS(bias.target.size() == d, source, ": bias.target: ", bias.target.size(),

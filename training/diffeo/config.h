@@ -65,6 +65,19 @@ struct DataConfig {
   }
 };
 
+/// Another flow time and Euler step count a shape's flow may be trained with (flow.alternatives).
+struct FlowAlternative {
+  double time = 2.0;  ///< flow time T
+  int steps = 20;     ///< Euler steps K
+
+  template <class A>
+  void Serialize(A* a) {
+    using config::Range;
+    a->Visit("time", &time, Range::Positive(), "flow time T of this alternative");
+    a->Visit("steps", &steps, Range::Closed(1, 10000), "Euler steps K of this alternative");
+  }
+};
+
 /// The imitation transform psi_i: RBF field on a grid of inducing states, integrated by Euler.
 struct FlowConfig {
   // Defaults: 19 x 19 = 361 states over [-0.65, 0.65]^2 (thesis: 720; wider kernels gave lower
@@ -95,6 +108,13 @@ struct FlowConfig {
   /// Flows trained per shape (each with its own seed: tube samples, validation split, batch
   /// order); the one exported is chosen on the training demonstrations (train.h, ExportShape).
   int restarts = 1;
+  /// Other (time, steps) settings, each trained with the same `restarts` seeds; the restart
+  /// exported is chosen among all of them by the same training-demo criterion, so each shape gets
+  /// the flow length that follows its training demos best. Empty: `time` and `steps` only.
+  std::vector<FlowAlternative> alternatives;
+
+  /// Flows trained per shape: restarts x (1 + alternatives).
+  int TotalRestarts() const { return restarts * (1 + static_cast<int>(alternatives.size())); }
 
   template <class A>
   void Serialize(A* a) {
@@ -125,6 +145,9 @@ struct FlowConfig {
     a->Visit("restarts", &restarts, Range::Closed(1, 100),
              "flows trained per shape with seeds seed + 1000 r; exported: the invertible one whose "
              "rollouts from the training starts follow the training demos best (mean Frechet)");
+    a->Visit("alternatives", &alternatives, Range::Any(),
+             "other {time, steps} of the flow, each trained with the same restarts; the export "
+             "chooses among all of them by the same training-demo criterion (empty: none)");
   }
 };
 

@@ -169,11 +169,28 @@ bool TrainModel(std::shared_ptr<VelocityModel> model, const ShapeData& s, const 
   return summary.reason != TerminationReason::kInterrupted;
 }
 
-/// Restart r's config: the run's with seed + 1000 r (r = 0: the run's own).
+/// Restart r's config (0 <= r < flow.TotalRestarts()): setting v = r / restarts (0: flow.time and
+/// flow.steps, v > 0: flow.alternatives[v - 1]) with seed + 1000 (r % restarts); r = 0 is the
+/// run's own config.
 ExperimentConfig RestartConfig(const ExperimentConfig& c, int r) {
   ExperimentConfig rc = c;
-  rc.seed = c.seed + 1000 * r;
+  const int v = r / c.flow.restarts;
+  rc.seed = c.seed + 1000 * (r % c.flow.restarts);
+  if (v > 0) {
+    rc.flow.time = c.flow.alternatives[static_cast<std::size_t>(v - 1)].time;
+    rc.flow.steps = c.flow.alternatives[static_cast<std::size_t>(v - 1)].steps;
+  }
   return rc;
+}
+
+/// "restart r" for logs and errors, with its flow time and steps when alternatives are trained.
+std::string RestartName(const ExperimentConfig& c, int r) {
+  std::string out = "restart " + std::to_string(r);
+  if (c.flow.alternatives.empty()) return out;
+  const ExperimentConfig rc = RestartConfig(c, r);
+  std::ostringstream s;
+  s << out << " (T " << rc.flow.time << ", K " << rc.flow.steps << ")";
+  return s.str();
 }
 
 template <int D>
@@ -204,12 +221,12 @@ InvertibilityReport Invertibility(const ExperimentConfig& c, const ShapeData& s,
 /// those demonstrations (arc-length resampled as the evaluation does).
 template <int D>
 int ChooseRestart(const ExperimentConfig& c, const PreparedDemos& d, const ShapePaths& paths) {
-  if (c.flow.restarts == 1) return 0;
+  if (c.flow.TotalRestarts() == 1) return 0;
   const RolloutSettings roll = ModelRollouts(c);
   int best = -1, first_invertible = -1;
   double best_score = std::numeric_limits<double>::infinity();
   std::ostringstream scores;
-  for (int r = 0; r < c.flow.restarts; ++r) {
+  for (int r = 0; r < c.flow.TotalRestarts(); ++r) {
     const ExperimentConfig rc = RestartConfig(c, r);
     const ShapeData s = Prepare(rc, d);
     RbfFlowNet net = MakeFlowNet(rc, s);
@@ -217,7 +234,7 @@ int ChooseRestart(const ExperimentConfig& c, const PreparedDemos& d, const Shape
     FS_THROW_UNLESS(fs::exists(checkpoint), d.name, ": ", checkpoint,
                     " is missing; train the run first");
     LoadCheckpointModel(checkpoint, net.get());
-    const RbfFlow<D> flow = EngineFlow<D>(c, d, s, net);
+    const RbfFlow<D> flow = EngineFlow<D>(rc, d, s, net);
     scores << (r ? ", " : "") << r << ": ";
     if (!Invertibility<D>(c, s, flow).ok) {
       scores << "not invertible";
@@ -242,26 +259,28 @@ int ChooseRestart(const ExperimentConfig& c, const PreparedDemos& d, const Shape
       best = r;
     }
   }
-  FS_THROW_UNLESS(first_invertible >= 0, d.name, ": none of the ", c.flow.restarts,
-                  " restarts' flows is invertible with flow.time ", c.flow.time, " and flow.steps ",
-                  c.flow.steps, "; use more flow.steps or a shorter flow.time");
+  FS_THROW_UNLESS(first_invertible >= 0, d.name, ": none of the ", c.flow.TotalRestarts(),
+                  " restarts' flows is invertible (flow.time ", c.flow.time, ", flow.steps ",
+                  c.flow.steps, c.flow.alternatives.empty() ? "" : " and flow.alternatives",
+                  "); use more flow.steps or a shorter flow.time");
   if (best <
       0) {  // every invertible restart's rollouts diverged: as a single run would, export one
     best = first_invertible;
     log::Warn(d.name, ": every invertible restart's rollout from a training start diverged");
   }
   log::Info(d.name, ": flow restarts, mean Frechet from the training starts {", scores.str(),
-            "}: exporting restart ", best);
+            "}: exporting ", RestartName(c, best));
   return best;
 }
 
+/// Exports restart config `rc`'s trained flow; the artifact keeps the run's config `c`.
 template <int D>
-void ExportFlow(const ExperimentConfig& c, const PreparedDemos& d, const ShapeData& s,
-                RbfFlowNet& net, const std::string& path) {
-  const RbfFlow<D> flow = EngineFlow<D>(c, d, s, net);
-  const InvertibilityReport report = Invertibility<D>(c, s, flow);
+void ExportFlow(const ExperimentConfig& c, const ExperimentConfig& rc, const PreparedDemos& d,
+                const ShapeData& s, RbfFlowNet& net, const std::string& path) {
+  const RbfFlow<D> flow = EngineFlow<D>(rc, d, s, net);
+  const InvertibilityReport report = Invertibility<D>(rc, s, flow);
   FS_THROW_UNLESS(report.ok, d.name, ": the trained flow is not invertible with flow.time ",
-                  c.flow.time, " and flow.steps ", c.flow.steps, " (", report.Describe(),
+                  rc.flow.time, " and flow.steps ", rc.flow.steps, " (", report.Describe(),
                   "); use more flow.steps or a shorter flow.time");
   const ImitationSystem<D> system(flow, Vec<D>::Zero(), net->speed());
   TemplateNormalisation norm;
@@ -278,13 +297,13 @@ bool ShapeExported(const ExperimentConfig& c, const ShapePaths& paths) {
 
 bool TrainShape(const ExperimentConfig& c, const PreparedDemos& demos, const ShapePaths& paths,
                 bool resume, const std::atomic<bool>* interrupt) {
-  for (int r = 0; r < c.flow.restarts; ++r) {
+  for (int r = 0; r < c.flow.TotalRestarts(); ++r) {
     const ExperimentConfig rc = RestartConfig(c, r);
     const ShapeData rs = Prepare(rc, demos);
     RbfFlowNet flow = MakeFlowNet(rc, rs);
     if (!TrainModel(flow.ptr(), WithTube(rc, rs), c.train, c.flow.invertibility_weight,
                     paths.FlowDir(r), static_cast<std::uint64_t>(rc.seed), resume, interrupt,
-                    demos.name + " flow" + (r > 0 ? " restart " + std::to_string(r) : "")))
+                    demos.name + " flow" + (r > 0 ? " " + RestartName(c, r) : "")))
       return false;
   }
   if (!c.eflow.enabled) return true;
@@ -306,9 +325,9 @@ void ExportShape(const ExperimentConfig& c, const PreparedDemos& demos, const Sh
   FS_THROW_UNLESS(fs::exists(best), demos.name, ": ", best, " is missing; train the run first");
   LoadCheckpointModel(best, flow.get());
   if (rs.dimension == 2)
-    ExportFlow<2>(c, demos, rs, flow, paths.Template());
+    ExportFlow<2>(c, rc, demos, rs, flow, paths.Template());
   else
-    ExportFlow<3>(c, demos, rs, flow, paths.Template());
+    ExportFlow<3>(c, rc, demos, rs, flow, paths.Template());
   if (!c.eflow.enabled) return;
   const ShapeData s = Prepare(c, demos);
   EFlowNet eflow = MakeEflowNet(c, s);

@@ -18,7 +18,8 @@ struct ShapePaths {
       : run_dir(std::move(run)), name(std::move(shape)) {}
   std::string run_dir, name;
   std::string FlowDir() const { return run_dir + "/shapes/" + name + "/flow"; }
-  /// Restart r's flow (flow.restarts): FlowDir() for r = 0, FlowDir() + "_<r>" after it.
+  /// Restart r's flow (flow.restarts, flow.alternatives): FlowDir() for r = 0, FlowDir() + "_<r>"
+  /// after it.
   std::string FlowDir(int r) const {
     return r == 0 ? FlowDir() : FlowDir() + "_" + std::to_string(r);
   }
@@ -35,9 +36,10 @@ bool TrainShape(const ExperimentConfig& c, const PreparedDemos& demos, const Sha
                 bool resume, const std::atomic<bool>* interrupt);
 /// Writes the artifacts from the best checkpoints; refuses a flow that is not invertible on the
 /// grid and the demonstrations (CheckInvertible with flow.inverse_tolerance), naming the settings.
-/// With flow.restarts R > 1 the flow exported is the invertible restart whose rollouts from the
-/// training demonstrations' starts follow them best (mean discrete Frechet distance; training
-/// data only), the lowest index on a tie.
+/// With flow.restarts R > 1 (or flow.alternatives) the flow exported is the invertible restart,
+/// of every setting, whose rollouts from the training demonstrations' starts follow them best
+/// (mean discrete Frechet distance; training data only), the lowest index on a tie; the artifact
+/// carries that restart's flow time and steps.
 void ExportShape(const ExperimentConfig& c, const PreparedDemos& demos, const ShapePaths& paths);
 
 }  // namespace foresight::imitation
