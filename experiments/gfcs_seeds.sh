@@ -6,6 +6,7 @@
 # run (results/gfcs_eval.json, from experiments/gfcs.sh). About 16 min per seed on 2 cores.
 #   experiments/gfcs_seeds.sh                 (seeds 1 and 2)
 #   SEEDS="1 2 3" experiments/gfcs_seeds.sh   (others; RESUME=1 continues killed runs)
+# A seed whose run finished (runs/gfcs_seed_<s>/eval.json) is kept; delete the folder to redo it.
 # Writes runs/gfcs_seed_<s>/ and results/gfcs_seeds.md.
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -14,9 +15,12 @@ cd "$ROOT"
 mkdir -p results runs
 args=("results/gfcs_eval.json=0")
 for s in ${SEEDS:-1 2}; do
+  [[ "$s" =~ ^[1-9][0-9]*$ ]] || { echo "SEEDS: '$s' is not a positive integer (seed 0 is experiments/gfcs.sh's run)" >&2; exit 1; }
   run="runs/gfcs_seed_$s"
-  if [[ "${RESUME:-0}" == 1 && -f "$run/config.yaml" ]]; then
-    [[ -f "$run/eval.json" ]] || "$BIN" train configs/gfcs/all_families.yaml --run-dir "$run" --resume "seed=$s"
+  if [[ -f "$run/eval.json" ]]; then
+    echo "seed $s: $run finished before, kept"
+  elif [[ "${RESUME:-0}" == 1 && -f "$run/config.yaml" ]]; then
+    "$BIN" train configs/gfcs/all_families.yaml --run-dir "$run" --resume "seed=$s"
   else
     rm -rf "$run"
     "$BIN" train configs/gfcs/all_families.yaml --run-dir "$run" "seed=$s"

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
 #include <vector>
 
 #include "core/config.h"
@@ -114,18 +115,38 @@ TEST(DiffeoRun, AlternativesExportTheFlowLengthThatFollowsTheTrainingDemosBest) 
   const std::vector<std::string> common = {"eflow.enabled=false", "obstacle.enabled=false",
                                            "train.epochs=10",     "flow.tube_sigma=0.05",
                                            "flow.tube_gain=2",    "eval.resample=50"};
-  std::vector<std::string> longer = common, both = common;
-  longer.insert(longer.end(), {"flow.time=2", "flow.steps=8"});
-  both.push_back("flow.alternatives=[{time: 2, steps: 8}]");
-  const imitation::ExperimentConfig c_short = Tiny(common), c_long = Tiny(longer),
+  std::vector<std::string> shorter = common, longer = common, both = common;
+  shorter.push_back("flow.restarts=2");
+  longer.insert(longer.end(), {"flow.restarts=2", "flow.time=2", "flow.steps=8"});
+  both.insert(both.end(), {"flow.restarts=2", "flow.alternatives=[{time: 2, steps: 8}]"});
+  const imitation::ExperimentConfig c_short = Tiny(shorter), c_long = Tiny(longer),
                                     c_both = Tiny(both);
-  ASSERT_EQ(c_both.flow.TotalRestarts(), 2);
+  ASSERT_EQ(c_both.flow.TotalRestarts(), 4);
   const std::string short_run = dir.File("short"), long_run = dir.File("long"),
                     both_run = dir.File("both");
   ASSERT_TRUE(imitation::TrainRun(c_short, short_run, false, nullptr));
   ASSERT_TRUE(imitation::TrainRun(c_long, long_run, false, nullptr));
   ASSERT_TRUE(imitation::TrainRun(c_both, both_run, false, nullptr));
-  EXPECT_TRUE(fs::exists(both_run + "/shapes/s_curve/flow_1/checkpoints/best.pt"));
+  // Restart r = v R + k of the combined run is setting v with seed k: it trains exactly as the
+  // single-setting runs' restart k (the same losses epoch by epoch; metrics.csv without timings).
+  const auto losses = [](const std::string& flow_dir) {
+    std::ifstream in(flow_dir + "/metrics.csv");
+    std::string line, out;
+    while (std::getline(in, line)) {
+      std::size_t cut = 0;
+      for (int commas = 0; commas < 3 && cut != std::string::npos; ++commas)
+        cut = line.find(',', cut == 0 ? 0 : cut + 1);
+      out += line.substr(0, cut) + "\n";
+    }
+    return out;
+  };
+  const std::string flow = "/shapes/s_curve/flow";
+  EXPECT_EQ(losses(both_run + flow), losses(short_run + flow));
+  EXPECT_EQ(losses(both_run + flow + "_1"), losses(short_run + flow + "_1"));
+  EXPECT_EQ(losses(both_run + flow + "_2"), losses(long_run + flow));
+  EXPECT_EQ(losses(both_run + flow + "_3"), losses(long_run + flow + "_1"));
+  EXPECT_NE(losses(both_run + flow + "_1"), losses(both_run + flow));  // seeds differ
+  EXPECT_GT(losses(both_run + flow + "_3").size(), 20u);
   const imitation::PreparedDemos demos = imitation::LoadDemos(c_short).front();
   const auto a = imitation::LoadTemplate<2>(short_run + "/models/s_curve.h5");
   const auto b = imitation::LoadTemplate<2>(long_run + "/models/s_curve.h5");
@@ -156,7 +177,7 @@ TEST(DiffeoSelection, TakesTheFirstTrainingClearSettingWithTheFewestGridCrossing
   EXPECT_EQ(ChooseClearance({C{false, 0}, C{true, 3}, C{true, 1}, C{true, 1}, C{true, 2}}), 2u);
   // A setting whose training starts are not clear never wins, however few its crossings.
   EXPECT_EQ(ChooseClearance({C{true, 4}, C{false, 0}, C{true, 4}}), 0u);
-  // The first training-clear setting with none crossing (the search stops there).
+  // The first training-clear setting with none crossing.
   EXPECT_EQ(ChooseClearance({C{false, 2}, C{true, 0}}), 1u);
   // No setting clears the training starts: the last one tried (the strongest), as before the grid.
   EXPECT_EQ(ChooseClearance({C{false, 0}, C{false, 5}, C{false, 1}}), 2u);

@@ -143,8 +143,9 @@ struct FlowConfig {
              "train by LibTorch autograd through the integration instead of the hand-written "
              "sparse loss and gradient (the same to rounding; slower; a cross-check)");
     a->Visit("restarts", &restarts, Range::Closed(1, 100),
-             "flows trained per shape with seeds seed + 1000 r; exported: the invertible one whose "
-             "rollouts from the training starts follow the training demos best (mean Frechet)");
+             "flows trained per shape (per setting, with flow.alternatives) with seeds seed + "
+             "1000 k, k < restarts; exported: the invertible one whose rollouts from the training "
+             "starts follow the training demos best (mean Frechet)");
     a->Visit("alternatives", &alternatives, Range::Any(),
              "other {time, steps} of the flow, each trained with the same restarts; the export "
              "chooses among all of them by the same training-demo criterion (empty: none)");
@@ -206,11 +207,11 @@ struct ObstacleConfig {
   std::vector<double> times{0.002, 0.004, 0.008, 0.016, 0.032, 0.064};
   double step = 0.0005;  ///< Euler step of the obstacle flow (steps = ceil(time / step))
   double clear_probability = 0.5;
-  /// 2-D: the selection also rolls out from the stability grid's starts (`eval.grid`, those the map
-  /// calls free): among the settings whose training starts are clear, the first with the fewest
-  /// grid rollouts crossing the map (p >= clear_probability) is used, so the setting clears as much
-  /// of the space around the demonstrations as it can, not only the training starts. No test
-  /// start enters. (Task space does not read it.)
+  /// 2-D: the selection also rolls out from a grid of starts (`eval.grid` per axis over the
+  /// training demos' box, those the map calls free): among the settings whose training starts are
+  /// clear, the first with the fewest grid rollouts crossing the map (p >= clear_probability) is
+  /// used, so the setting clears as much of the space around the demonstrations as it can, not
+  /// only the training starts. No held-out demonstration enters. (Task space does not read it.)
   bool select_on_grid = true;
   /// Largest round-trip error psi_o^-1(psi_o(y)) - y accepted when checking a flow time
   /// (normalised units in 2-D, rad in C-space); every inverse must also converge.

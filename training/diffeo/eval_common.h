@@ -35,7 +35,7 @@ inline RolloutSettings ModelRollouts(const ExperimentConfig& c) {
 /// How well one obstacle setting (flow time, repulsor gain) keeps rollouts off the map's obstacle.
 struct Clearance {
   bool training_clear = false;  ///< every training start reaches the goal with p < clear
-  int grid_crossing = 0;        ///< grid starts whose rollout reaches p >= clear
+  int grid_crossing = 0;  ///< grid starts whose rollout reaches p >= clear (0 when not counted)
 };
 
 /// The selection among obstacle settings tried in order (docs/diffeo.md "Selection"): the first

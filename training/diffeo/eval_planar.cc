@@ -127,22 +127,33 @@ Scores EvaluatePlanarShape(const ExperimentConfig& c, const PreparedDemos& demos
     // cannot be bent away at any finite time, so "none crosses" is not always reachable.
     std::vector<V2> train_starts;
     for (int k : train_free) train_starts.push_back(free_starts[static_cast<std::size_t>(k)]);
+    // The selection's grid spans the training demonstrations only (the stability metric's grid
+    // above spans every demonstration, held-out ones too).
     std::vector<V2> clear_grid;
     if (c.obstacle.select_on_grid) {
+      DemoSet training_set{demos.demos.name, demos.demos.dimension, {}};
+      for (int i : demos.train)
+        training_set.demos.push_back(demos.demos.demos[static_cast<std::size_t>(i)]);
       auto ws = field.MakeWorkspace();
-      for (const V2& p : grid)
+      for (const V2& p : GridStarts<2>(training_set, c.eval.grid, 0.1))
         if (field.Probability(p, ws.get()) < c.obstacle.clear_probability) clear_grid.push_back(p);
     }
+    const auto grid_crossings = [&](const std::function<V2(const V2&)>& velocity) {
+      int crossing = 0;
+      for (const V2& p : clear_grid)
+        if (MaxMapProbability(field, {RollOut<2>(velocity, p, goal, roll)}) >=
+            c.obstacle.clear_probability)
+          ++crossing;
+      return crossing;
+    };
+    // The grid is counted only for settings that clear the training starts (the others cannot be
+    // chosen unless none clears; then the fallback's count is taken afterwards).
     const auto clearance = [&](const std::function<V2(const V2&)>& velocity) {
       Clearance out;
       const auto rs = RollAll(velocity, train_starts, goal, roll);
       out.training_clear =
           AllReached(rs) && MaxMapProbability(field, rs) < c.obstacle.clear_probability;
-      if (!out.training_clear) return out;
-      for (const V2& p : clear_grid)
-        if (MaxMapProbability(field, {RollOut<2>(velocity, p, goal, roll)}) >=
-            c.obstacle.clear_probability)
-          ++out.grid_crossing;
+      if (out.training_clear) out.grid_crossing = grid_crossings(velocity);
       return out;
     };
     const V2 box_lo = disc.centre.array() - disc.radius - c.obstacle.sample_margin;
@@ -175,11 +186,12 @@ Scores EvaluatePlanarShape(const ExperimentConfig& c, const PreparedDemos& demos
     const ComposedSystem<2> avoid(system, {ObstacleOuter<2>(field, chosen, h)});
     auto aws = avoid.MakeWorkspace();
     const auto f_o = [&](const V2& y) { return avoid.Velocity(y, &aws); };
+    const int crossing = cleared ? tried[pick].grid_crossing : grid_crossings(f_o);
     const std::vector<Rollout<2>> ar = RollAll(f_o, free_starts, goal, roll);
     s.push_back({"obstacle_flow_time", chosen});
     s.push_back({"obstacle_flow_steps", static_cast<double>(ObstacleSteps(chosen, h))});
     s.push_back({"obstacle_cleared_on_map", cleared ? 1.0 : 0.0});
-    s.push_back({"obstacle_grid_crossing", static_cast<double>(tried[pick].grid_crossing)});
+    s.push_back({"obstacle_grid_crossing", static_cast<double>(crossing)});
     AddPathScores("avoid_", ToPaths(ar), demos, c.eval.resample, &s, free_ids);
     s.push_back({"avoid_mcd", MaxDepth(ToPaths(ar), disc)});
     s.push_back({"avoid_grid_reach_rate", ReachRate(RollAll(f_o, FreeOf(grid, disc), goal, roll))});
@@ -204,11 +216,12 @@ Scores EvaluatePlanarShape(const ExperimentConfig& c, const PreparedDemos& demos
       const std::size_t rep_pick = ChooseClearance(rep_tried);
       const double gain = c.obstacle.repulsor_gains[rep_pick];
       const bool rep_cleared = rep_tried[rep_pick].training_clear;
+      const int rep_crossing =
+          rep_cleared ? rep_tried[rep_pick].grid_crossing : grid_crossings(rep(gain));
       const std::vector<Rollout<2>> rr = RollAll(rep(gain), free_starts, goal, roll);
       s.push_back({"eflow_repulsor_gain", gain});
       s.push_back({"eflow_repulsor_cleared_on_map", rep_cleared ? 1.0 : 0.0});
-      s.push_back(
-          {"eflow_repulsor_grid_crossing", static_cast<double>(rep_tried[rep_pick].grid_crossing)});
+      s.push_back({"eflow_repulsor_grid_crossing", static_cast<double>(rep_crossing)});
       AddPathScores("eflow_repulsor_", ToPaths(rr), demos, c.eval.resample, &s, free_ids);
       s.push_back({"eflow_repulsor_mcd", MaxDepth(ToPaths(rr), disc)});
       pic.eflow_repulsor = ToPaths(rr);

@@ -235,8 +235,9 @@ int ChooseRestart(const ExperimentConfig& c, const PreparedDemos& d, const Shape
                     " is missing; train the run first");
     LoadCheckpointModel(checkpoint, net.get());
     const RbfFlow<D> flow = EngineFlow<D>(rc, d, s, net);
-    scores << (r ? ", " : "") << r << ": ";
-    if (!Invertibility<D>(c, s, flow).ok) {
+    scores << (r ? ", " : "")
+           << (c.flow.alternatives.empty() ? std::to_string(r) : RestartName(c, r)) << ": ";
+    if (!Invertibility<D>(rc, s, flow).ok) {
       scores << "not invertible";
       continue;
     }
@@ -301,9 +302,10 @@ bool TrainShape(const ExperimentConfig& c, const PreparedDemos& demos, const Sha
     const ExperimentConfig rc = RestartConfig(c, r);
     const ShapeData rs = Prepare(rc, demos);
     RbfFlowNet flow = MakeFlowNet(rc, rs);
-    if (!TrainModel(flow.ptr(), WithTube(rc, rs), c.train, c.flow.invertibility_weight,
-                    paths.FlowDir(r), static_cast<std::uint64_t>(rc.seed), resume, interrupt,
-                    demos.name + " flow" + (r > 0 ? " " + RestartName(c, r) : "")))
+    if (!TrainModel(
+            flow.ptr(), WithTube(rc, rs), c.train, c.flow.invertibility_weight, paths.FlowDir(r),
+            static_cast<std::uint64_t>(rc.seed), resume, interrupt,
+            demos.name + " flow" + (c.flow.TotalRestarts() > 1 ? " " + RestartName(c, r) : "")))
       return false;
   }
   if (!c.eflow.enabled) return true;
