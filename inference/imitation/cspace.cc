@@ -64,6 +64,9 @@ ArmVector CSpaceObstacleTransform::Forward(const ArmVector& p, CSpaceTransformWo
   ArmMatrix dV, step;
   for (int k = 0; k < settings_.steps; ++k) {
     const ArmVector V = Field(q, ws, jacobian != nullptr ? &dV : nullptr);
+    // No body point within the map's support: V_q and dV_q are exactly zero, so q and J_o would
+    // stay as they are for every remaining step (V_q is autonomous): the same result bit for bit.
+    if (V.isZero(0) && (jacobian == nullptr || dV.isZero(0))) break;
     if (jacobian != nullptr) {
       step = h * dV;
       step.diagonal().array() += 1;

@@ -11,18 +11,19 @@
 /// - CSpaceObstacleTransform psi_o^q: the time-T flow of V_q by K explicit Euler steps of h = T/K,
 ///     q_0 = p,  q_{k+1} = q_k + h V_q(q_k),  psi_o^q(p) = q_K,
 ///   with the exact Jacobian of the Euler map J_0 = I, J_{k+1} = (I + h dV_q(q_k)) J_k (as
-///   ObstacleTransform, transforms.h). Inverse: the exact inverse of the Euler map, each step
-///   q_k = q_{k+1} - h V_q(q_k) by fixed-point iteration from q_{k+1} - h V_q(q_{k+1}); false
-///   when a step does not converge (h Lip(V_q) >= 1 there: the settings are not invertible).
-///   The outer configurations p = psi_o^-1(q) are the inner ones flowed down the occupancy of the
-///   body points, so the outer system keeps the arm away from the obstacle.
-///   Goal gate (optional, length l > 0): V_q is multiplied by w(q) = 1 - exp(-r^2 / (2 l^2)),
-///   r = ||x_ee(q) - x_goal||, so the field vanishes on every configuration whose end effector is
-///   at the goal; dV = w dV_q + V_q grad w',  grad w = exp(-r^2 / (2 l^2)) J_ee' (x_ee - x_goal) /
-///   l^2. Without it a map that is not negligible at the goal moves the composed system's
-///   equilibrium: psi_o fixes those configurations only where V_q = 0, and the outer arm then
-///   stops short of the goal. With it psi_o fixes the goal set pointwise, so x_ee(psi_o(p)) is the
-///   goal exactly when x_ee(p) is (an addition to the thesis's V^o_q, which assumes p(o) = 0
+///   ObstacleTransform, transforms.h; Forward stops once V_q and dV_q are exactly zero, i.e. no
+///   body point within the map's support: the remaining steps would change nothing). Inverse: the
+///   exact inverse of the Euler map, each step q_k = q_{k+1} - h V_q(q_k) by fixed-point iteration
+///   from q_{k+1} - h V_q(q_{k+1}); false when a step does not converge (h Lip(V_q) >= 1 there: the
+///   settings are not invertible). The outer configurations p = psi_o^-1(q) are the inner ones
+///   flowed down the occupancy of the body points, so the outer system keeps the arm away from the
+///   obstacle. Goal gate (optional, length l > 0): V_q is multiplied by w(q) = 1 - exp(-r^2 / (2
+///   l^2)), r = ||x_ee(q) - x_goal||, so the field vanishes on every configuration whose end
+///   effector is at the goal; dV = w dV_q + V_q grad w',  grad w = exp(-r^2 / (2 l^2)) J_ee' (x_ee
+///   - x_goal) / l^2. Without it a map that is not negligible at the goal moves the composed
+///   system's equilibrium: psi_o fixes those configurations only where V_q = 0, and the outer arm
+///   then stops short of the goal. With it psi_o fixes the goal set pointwise, so x_ee(psi_o(p)) is
+///   the goal exactly when x_ee(p) is (an addition to the thesis's V^o_q, which assumes p(o) = 0
 ///   there).
 /// - CSpaceSystem: thesis eq. CspaceNG with the errata's pull-back (never form G^-1):
 ///     q = psi_o^q(p),  q_dot = J_ee(q)^+ f_world(x_ee(q)),  p_dot = J_o(p)^-1 q_dot,

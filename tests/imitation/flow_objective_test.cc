@@ -85,9 +85,10 @@ void CheckAgainstCentralDifferences(int segments, double expansion) {
   // The penalty is active at these weights: the loss with it exceeds the loss without.
   FlowObjectiveBatch plain = batch;
   plain.penalty_weight = 0;
-  if (expansion >= 1)
+  if (expansion >= 1) {
     EXPECT_GT(loss(log_speed),
               objective->Evaluate(w.data(), log_speed, plain, 1, nullptr, nullptr) + 1e-6);
+  }
 }
 
 TEST(FlowObjective, GradientMatchesCentralDifferences2d) {

@@ -111,6 +111,42 @@ TEST(ObstacleTransform, JacobianAndInverse) {
   }
 }
 
+// Forward stops once the field is exactly zero (no feature within the cut-off): the result must
+// equal every Euler step taken, bit for bit, inside and outside the map's support.
+TEST(ObstacleTransform, StoppingOutsideTheSupportGivesTheFullFlowExactly) {
+  RbfGridSpec<2> spec;  // the map covers [-0.3, 0.3]^2; support ends 0.4 beyond
+  spec.lower = Vec<2>(-0.3, -0.3);
+  spec.counts = {7, 7};
+  spec.spacing = 0.1;
+  spec.gamma = 120;
+  spec.cutoff_radius = 0.4;
+  const ObstacleTransform<2> psi(RandomField(RbfGrid<2>(spec), 0.5, 3), {0.05, 25});
+  auto ws = psi.MakeWorkspace();
+  const double h = 0.05 / 25;
+  std::mt19937_64 rng(4);
+  int outside = 0, inside = 0;
+  for (int n = 0; n < 200; ++n) {
+    const Vec<2> y = RandomPoint<2>(&rng, -1.2, 1.2);
+    Vec<2> s = y;  // every step
+    Mat<2> j = Mat<2>::Identity();
+    OccupancyValue<2> v;
+    for (int k = 0; k < 25; ++k) {
+      psi.field().Evaluate(s, ws.get(), true, &v);
+      j = (Mat<2>::Identity() + h * v.hessian) * j;
+      s += h * v.gradient;
+    }
+    Mat<2> jacobian;
+    const Vec<2> x = psi.Forward(y, ws.get(), &jacobian);
+    EXPECT_TRUE(testing::MatricesNear(x, s, 0)) << y.transpose();
+    EXPECT_TRUE(testing::MatricesNear(jacobian, j, 0)) << y.transpose();
+    EXPECT_TRUE(testing::MatricesNear(psi.Forward(y, ws.get()), s, 0)) << y.transpose();
+    psi.field().Evaluate(y, ws.get(), false, &v);
+    (v.gradient.isZero(0) ? outside : inside) += 1;
+  }
+  EXPECT_GT(outside, 20);
+  EXPECT_GT(inside, 20);
+}
+
 ImitationSystem<2> RandomImitation(double scale, std::uint64_t seed, const Vec<2>& goal) {
   const RbfGrid<2> grid = Grid2();
   return ImitationSystem<2>(RbfFlow<2>(grid, RandomWeights(grid.size(), 2, scale, seed), {1.0, 10}),

@@ -7,6 +7,8 @@
 
 #include <filesystem>
 #include <fstream>
+#include <regex>
+#include <string>
 #include <vector>
 
 #include "core/config.h"
@@ -35,6 +37,12 @@ imitation::ExperimentConfig Tiny(const std::vector<std::string>& overrides = {})
       "<tiny diffeo>", overrides);
 }
 
+/// eval.json without its timings (keys ending in _us: one rollout step, measured).
+std::string WithoutTimings(const std::string& json) {
+  static const std::regex timing(R"re(("[a-z_]*_us"\s*:\s*)[-+0-9.eE]+)re");
+  return std::regex_replace(json, timing, "$1<us>");
+}
+
 TEST(DiffeoRun, ResumeAfterLosingTheLastArtifactsGivesTheSameModelsAndFigures) {
   const testing::TempDir dir;
   // Time segments and tube samples end to end.
@@ -50,7 +58,7 @@ TEST(DiffeoRun, ResumeAfterLosingTheLastArtifactsGivesTheSameModelsAndFigures) {
   fs::remove_all(run + "/shapes/s_curve/eflow");
   fs::remove(run + "/eval.json");
   ASSERT_TRUE(imitation::TrainRun(c, run, true, nullptr));
-  EXPECT_EQ(imitation::EvaluateRun(c, run), eval);
+  EXPECT_EQ(WithoutTimings(imitation::EvaluateRun(c, run)), WithoutTimings(eval));
   const auto shape2 = imitation::LoadTemplate<2>(run + "/models/s_curve.h5");
   const auto eflow2 = imitation::EFlowModel::Load(run + "/models/s_curve.eflow.h5");
   EXPECT_EQ(shape2.system.flow().weights(), shape.system.flow().weights());
@@ -182,6 +190,52 @@ TEST(DiffeoSelection, TakesTheFirstTrainingClearSettingWithTheFewestGridCrossing
   // No setting clears the training starts: the last one tried (the strongest), as before the grid.
   EXPECT_EQ(ChooseClearance({C{false, 0}, C{false, 5}, C{false, 1}}), 2u);
   EXPECT_EQ(ChooseClearance({C{false, 0}}), 0u);
+}
+
+TEST(DiffeoSelection, TaskSpaceFlowTimeTakesTheCoarsestStepThatInverts) {
+  using imitation::ChooseFlowTime;
+  using imitation::FlowTrial;
+  const std::vector<double> times{0.1, 0.2, 0.4, 0.8};
+  std::vector<std::pair<double, double>> tried;
+  // A map inverts when time x step <= 4e-4 (the longer the flow, the finer the step it needs), and
+  // clears from time 0.4 on.
+  const auto trial = [&](double t, double step) {
+    tried.emplace_back(t, step);
+    FlowTrial f;
+    f.inverts = t * step <= 4e-4 * (1 + 1e-9);
+    f.clear = f.inverts && t >= 0.4;
+    return f;
+  };
+  // Step 0.002: 0.1 and 0.2 invert, 0.4 needs one halving (0.001), and clears there.
+  auto pick = ChooseFlowTime(times, 0.002, 3, trial);
+  EXPECT_EQ(pick.index, 2);
+  EXPECT_DOUBLE_EQ(pick.step, 0.001);
+  EXPECT_TRUE(pick.cleared);
+  ASSERT_EQ(tried.size(), 4u);  // 0.1, 0.2 at 0.002; 0.4 at 0.002 then 0.001
+  EXPECT_DOUBLE_EQ(tried[2].second, 0.002);
+  EXPECT_DOUBLE_EQ(tried[3].second, 0.001);
+  // No halvings: 0.4 does not invert, so 0.2 is kept at the first step, not cleared.
+  tried.clear();
+  pick = ChooseFlowTime(times, 0.002, 0, trial);
+  EXPECT_EQ(pick.index, 1);
+  EXPECT_DOUBLE_EQ(pick.step, 0.002);
+  EXPECT_FALSE(pick.cleared);
+  // The halvings are counted over all times: with one left after 0.4, a map that never clears
+  // stops at the first time that does not invert with none left.
+  const auto never_clear = [&](double t, double step) {
+    FlowTrial f = trial(t, step);
+    f.clear = false;
+    return f;
+  };
+  pick = ChooseFlowTime(times, 0.002, 2, never_clear);
+  EXPECT_EQ(pick.index, 3);  // 0.4 at 0.001, 0.8 at 0.0005 (two halvings)
+  EXPECT_DOUBLE_EQ(pick.step, 0.0005);
+  pick = ChooseFlowTime(times, 0.002, 1, never_clear);
+  EXPECT_EQ(pick.index, 2);
+  EXPECT_DOUBLE_EQ(pick.step, 0.001);
+  // The first time does not invert at any step: nothing chosen.
+  pick = ChooseFlowTime({5.0}, 0.002, 2, trial);
+  EXPECT_EQ(pick.index, -1);
 }
 
 TEST(DiffeoRun, AnObstacleOnTheGoalIsRefused) {

@@ -52,6 +52,41 @@ inline std::size_t ChooseClearance(const std::vector<Clearance>& tried) {
   return best;
 }
 
+/// One obstacle-flow time tried at one Euler step: whether its map inverts (along the rollouts)
+/// and whether its rollouts from the training starts are clear of the map.
+struct FlowTrial {
+  bool inverts = false;
+  bool clear = false;
+};
+
+/// The time (and step) a task-space obstacle flow runs with.
+struct FlowTimeChoice {
+  int index = -1;        ///< into `times`; -1: the first time does not invert at any step tried
+  double step = 0;       ///< its Euler step
+  bool cleared = false;  ///< its training rollouts are clear
+};
+
+/// Task-space obstacle-flow selection: the times in order, each at the current step and, while its
+/// map does not invert, at the step halved (at most `halvings` halvings in all; a halved step is
+/// kept for the larger times); stops at the first time that clears (chosen) or that does not
+/// invert at any step left (the previous one is chosen).
+inline FlowTimeChoice ChooseFlowTime(const std::vector<double>& times, double step, int halvings,
+                                     const std::function<FlowTrial(double, double)>& trial) {
+  FlowTimeChoice out;
+  for (std::size_t i = 0; i < times.size(); ++i) {
+    FlowTrial t = trial(times[i], step);
+    while (!t.inverts && halvings > 0) {
+      step /= 2;
+      --halvings;
+      t = trial(times[i], step);
+    }
+    if (!t.inverts) break;  // larger times only bend the map further
+    out = {static_cast<int>(i), step, t.clear};
+    if (t.clear) break;
+  }
+  return out;
+}
+
 /// Rolled-out paths [d x n_k] with whether each reached the goal.
 struct PathSet {
   std::vector<Eigen::MatrixXd> paths;

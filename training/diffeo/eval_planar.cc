@@ -6,6 +6,7 @@
 #include <functional>
 #include <limits>
 
+#include "core/bench.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "inference/imitation/eflow.h"
@@ -195,6 +196,21 @@ Scores EvaluatePlanarShape(const ExperimentConfig& c, const PreparedDemos& demos
     AddPathScores("avoid_", ToPaths(ar), demos, c.eval.resample, &s, free_ids);
     s.push_back({"avoid_mcd", MaxDepth(ToPaths(ar), disc)});
     s.push_back({"avoid_grid_reach_rate", ReachRate(RollAll(f_o, FreeOf(grid, disc), goal, roll))});
+    // One step of the composed system with the selected obstacle flow, on the points its rollouts
+    // pass (every 10th; one thread; the median of 3 passes): the shipped flow's cost, which
+    // `foresight bench` (a short synthetic obstacle flow) does not show.
+    {
+      std::vector<V2> ys;
+      for (const Rollout<2>& r : ar)
+        for (Eigen::Index k = 0; k < r.path.cols(); k += 10) ys.push_back(r.path.col(k));
+      V2 sink = V2::Zero();
+      const double seconds = bench::MedianSeconds(3, [&] {
+        for (const V2& y : ys) sink += f_o(y);
+      });
+      (void)sink;
+      s.push_back({"avoid_step_us",
+                   1e6 * seconds / static_cast<double>(std::max<std::size_t>(1, ys.size()))});
+    }
     pic.obstacle_centre = disc.centre;
     pic.obstacle_radius = disc.radius;
     pic.avoid = ToPaths(ar);

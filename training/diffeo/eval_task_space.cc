@@ -216,7 +216,8 @@ Scores EvaluateTaskSpaceShape(const ExperimentConfig& c, const PreparedDemos& de
     for (int i : demos.train) train_starts.push_back(starts[static_cast<std::size_t>(i)]);
 
     // The Euler step: obstacle.step, or less where the C-space field is steeper along the plain
-    // rollouts (which cross the obstacle), so that h ||dV_q|| <= 0.5 there.
+    // rollouts (which cross the obstacle), so that h ||dV_q|| <= 0.5 there; halved below when a
+    // flow time's map does not invert (obstacle.step_halvings).
     double max_dv = 0;
     {
       FlowSettings<kArmDof> unit;
@@ -231,10 +232,10 @@ Scores EvaluateTaskSpaceShape(const ExperimentConfig& c, const PreparedDemos& de
     }
     const double h = std::min(c.obstacle.step, 0.5 / std::max(max_dv, 1e-12));
     log::Info(demos.name, ": C-space obstacle field max |dV_q| ", max_dv, ", flow step ", h);
-    const auto system_with = [&](double t) {
+    const auto system_with = [&](double t, double step) {
       FlowSettings<kArmDof> fs;
       fs.time = t;
-      fs.steps = ObstacleSteps(t, h);
+      fs.steps = ObstacleSteps(t, step);
       GoalGate gate;
       gate.goal = goal;
       gate.length = c.obstacle.goal_gate;
@@ -262,28 +263,30 @@ Scores EvaluateTaskSpaceShape(const ExperimentConfig& c, const PreparedDemos& de
                 " inverses did not converge, worst round trip ", worst, " rad");
       return failed == 0 && worst <= c.obstacle.inverse_tolerance;
     };
-    double chosen = -1;
-    bool cleared = false;
-    for (double t : c.obstacle.times) {
-      const CSpaceSystem sys = system_with(t);
-      std::vector<ArmPath> rs;
-      for (const ArmVector& q : train_starts)
-        rs.push_back(FromRollout(RollOutCSpace(sys, q, roll)));
-      if (!invertible(sys, rs)) break;  // larger times only bend the map further
-      chosen = t;
-      if (AllReached(rs) && BodyMapProbability(chain, field, rs) < c.obstacle.clear_probability) {
-        cleared = true;
-        break;
-      }
-    }
-    FS_THROW_UNLESS(chosen > 0, demos.name, ": obstacle.times[0] = ", c.obstacle.times[0],
-                    " with obstacle.step ", c.obstacle.step,
-                    " already makes the C-space obstacle flow non-invertible; lower both");
-    const CSpaceSystem avoid = system_with(chosen);
+    // Each time with the coarsest step (h, h / 2, ... obstacle.step_halvings times) whose Euler
+    // map inverts along its rollouts from the training starts.
+    const FlowTimeChoice pick =
+        ChooseFlowTime(c.obstacle.times, h, c.obstacle.step_halvings, [&](double t, double step) {
+          const CSpaceSystem sys = system_with(t, step);
+          std::vector<ArmPath> rs;
+          for (const ArmVector& q : train_starts)
+            rs.push_back(FromRollout(RollOutCSpace(sys, q, roll)));
+          FlowTrial trial;
+          trial.inverts = invertible(sys, rs);
+          trial.clear = trial.inverts && AllReached(rs) &&
+                        BodyMapProbability(chain, field, rs) < c.obstacle.clear_probability;
+          return trial;
+        });
+    FS_THROW_UNLESS(pick.index >= 0, demos.name, ": obstacle.times[0] = ", c.obstacle.times[0],
+                    " with obstacle.step ", c.obstacle.step, " and ", c.obstacle.step_halvings,
+                    " halvings already makes the C-space obstacle flow non-invertible; lower both");
+    const double chosen = c.obstacle.times[static_cast<std::size_t>(pick.index)];
+    const bool cleared = pick.cleared;
+    const CSpaceSystem avoid = system_with(chosen, pick.step);
     std::vector<ArmPath> ar;
     for (const ArmVector& q : starts) ar.push_back(FromRollout(RollOutCSpace(avoid, q, roll)));
     s.push_back({"obstacle_flow_time", chosen});
-    s.push_back({"obstacle_flow_steps", static_cast<double>(ObstacleSteps(chosen, h))});
+    s.push_back({"obstacle_flow_steps", static_cast<double>(ObstacleSteps(chosen, pick.step))});
     s.push_back({"obstacle_cleared_on_map", cleared ? 1.0 : 0.0});
     AddPathScores("avoid_", Normalised(ar, tn), demos, c.eval.resample, &s, {}, metres);
     s.push_back({"avoid_mcd", BodyDepth(chain, ar, cyl)});
