@@ -14,6 +14,7 @@
 #include "core/bench.h"
 #include "inference/imitation/rbf_grid.h"
 #include "models/imitation/flow_net.h"
+#include "training/diffeo/imitation_task.h"
 
 using namespace foresight;
 using namespace foresight::imitation;

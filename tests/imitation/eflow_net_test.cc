@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "tests/test_util.h"
+#include "training/diffeo/imitation_task.h"
 #include "training/trainer.h"
 
 namespace foresight::imitation {

@@ -11,6 +11,7 @@
 #include "inference/imitation/rbf_grid.h"
 #include "models/imitation/flow_objective.h"
 #include "tests/test_util.h"
+#include "training/diffeo/imitation_task.h"
 #ifdef FORESIGHT_HAVE_RBF_FLOW_ENGINE
 #include "inference/imitation/rbf_flow.h"
 #endif

@@ -16,6 +16,7 @@
 #include "models/imitation/eflow_net.h"
 #include "models/imitation/flow_net.h"
 #include "training/diffeo/eval_common.h"
+#include "training/diffeo/imitation_task.h"
 #include "training/trainer.h"
 
 namespace foresight::imitation {
