@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """results/diffeo.md from the eval.json files experiments/diffeo.sh copies into results/."""
 import json
+import statistics
 import os
 import sys
 
@@ -76,7 +77,7 @@ if lasa:
                    f"{f(s.get('avoid_step_us'), 1)} |")
     steps_us = sorted(s["avoid_step_us"] for s in shapes.values() if "avoid_step_us" in s)
     if steps_us:
-        out += ["", f"One composed 2-D step with the selected obstacle flow: median {steps_us[len(steps_us) // 2]:.1f} us, "
+        out += ["", f"One composed 2-D step with the selected obstacle flow: median {statistics.median(steps_us):.1f} us, "
                 f"range {steps_us[0]:.1f}-{steps_us[-1]:.1f} us over {len(steps_us)} shapes; "
                 f"{sum(1 for v in steps_us if v <= 20)} of {len(steps_us)} within the 20 us target."]
     out.append("")

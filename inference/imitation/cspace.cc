@@ -64,8 +64,9 @@ ArmVector CSpaceObstacleTransform::Forward(const ArmVector& p, CSpaceTransformWo
   ArmMatrix dV, step;
   for (int k = 0; k < settings_.steps; ++k) {
     const ArmVector V = Field(q, ws, jacobian != nullptr ? &dV : nullptr);
-    // No body point within the map's support: V_q and dV_q are exactly zero, so q and J_o would
-    // stay as they are for every remaining step (V_q is autonomous): the same result bit for bit.
+    // Where V_q (and, when asked, dV_q) is exactly zero, e.g. no body point within the map's
+    // support or the gate closed, q and J_o would stay as they are for every remaining step (V_q
+    // is autonomous): stopping gives the same values (up to the sign of a zero).
     if (V.isZero(0) && (jacobian == nullptr || dV.isZero(0))) break;
     if (jacobian != nullptr) {
       step = h * dV;

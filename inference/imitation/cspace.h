@@ -11,7 +11,7 @@
 /// - CSpaceObstacleTransform psi_o^q: the time-T flow of V_q by K explicit Euler steps of h = T/K,
 ///     q_0 = p,  q_{k+1} = q_k + h V_q(q_k),  psi_o^q(p) = q_K,
 ///   with the exact Jacobian of the Euler map J_0 = I, J_{k+1} = (I + h dV_q(q_k)) J_k (as
-///   ObstacleTransform, transforms.h; Forward stops once V_q and dV_q are exactly zero, i.e. no
+///   ObstacleTransform, transforms.h; Forward stops once V_q and dV_q are exactly zero, e.g. no
 ///   body point within the map's support: the remaining steps would change nothing). Inverse: the
 ///   exact inverse of the Euler map, each step q_k = q_{k+1} - h V_q(q_k) by fixed-point iteration
 ///   from q_{k+1} - h V_q(q_{k+1}); false when a step does not converge (h Lip(V_q) >= 1 there: the

@@ -33,9 +33,9 @@ Vec<D> ObstacleTransform<D>::Forward(const Vec<D>& y, RbfFeatures<D>* ws, Mat<D>
   OccupancyValue<D> v;
   for (int k = 0; k < settings_.steps; ++k) {
     field_.Evaluate(s, ws, with_jacobian, &v);
-    // Outside the map's support (no feature within the cut-off) the field and its Jacobian are
-    // exactly zero, so s and J would stay as they are for every remaining step (the field is
-    // autonomous): stopping here gives the same result bit for bit.
+    // Where the field (and, when asked, its Jacobian) is exactly zero, e.g. outside the map's
+    // support (no feature within the cut-off), s and J would stay as they are for every remaining
+    // step (the field is autonomous): stopping gives the same values (up to the sign of a zero).
     if (v.gradient.isZero(0) && (!with_jacobian || v.hessian.isZero(0))) break;
     if (with_jacobian) j = (Mat<D>::Identity() + h * v.hessian) * j;
     s += h * v.gradient;

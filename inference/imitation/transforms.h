@@ -9,7 +9,7 @@
 ///   field (eq. map), K Euler steps with the exact Jacobian J_{k+1} = (I + h Hess p(s_k)) J_k.
 ///   Flowing -V_o (psi_o^-1) lowers occupancy, so the outer trajectories bend around the obstacle.
 ///   Outside the map's support (no feature within the cut-off) V_o and its Jacobian are exactly
-///   zero and stay so (the field is autonomous): Forward stops there, with the same result.
+///   zero and stay so (the field is autonomous): Forward stops there, with the same values.
 /// - BiasTransform<D> psi_b: the flow of an RBF field V_b = W' phi fitted by ridge regression to
 ///   unit vectors pointing away from a user point s_tar on samples of a region (thesis
 ///   "Infinitesimal Generators for User-Specified Bias"): the outer system is pulled toward s_tar.

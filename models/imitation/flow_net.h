@@ -43,7 +43,8 @@ inline constexpr double kGoalEpsilon = 1e-9;
 torch::Tensor NaturalGradientVelocity(const torch::Tensor& z, const torch::Tensor& jacobian,
                                       const torch::Tensor& goal_image, const torch::Tensor& speed);
 
-/// A module with a stable velocity field x_dot = f(x; goal), trained by ImitationTask.
+/// A module with a stable velocity field x_dot = f(x; goal), trained by ImitationTask
+/// (training/diffeo/imitation_task.h).
 class VelocityModel : public torch::nn::Module {
  public:
   /// @param x [B, d] positions; @param goal [d]. @return [B, d] velocities (differentiable).

@@ -39,7 +39,8 @@ struct FlowObjectiveBatch {
   const double* goal = nullptr;     ///< [d]
   const double* penalty = nullptr;  ///< [R, d] extra penalty points (may be null when R = 0)
   int penalty_count = 0;            ///< R >= 0
-  double penalty_weight = 0;        ///< w_P >= 0 (0: no penalty, as flow_net.h's ImitationTask)
+  double penalty_weight =
+      0;  ///< w_P >= 0 (0: no penalty, as ImitationTask's, training/diffeo/imitation_task.h)
 };
 
 /// The objective of one flow (grid, time, steps, segments); thread-safe (const).

@@ -275,7 +275,7 @@ TEST(CSpaceObstacleTransform, JacobianMatchesFiniteDifferences) {
 }
 
 // Forward stops once V_q is exactly zero (no body point within the map's support): the result must
-// equal every Euler step taken, bit for bit, with and without the goal gate.
+// equal every Euler step taken, with the same values, with and without the goal gate.
 TEST(CSpaceObstacleTransform, StoppingOutsideTheSupportGivesTheFullFlowExactly) {
   const int steps = 30;
   const double h = 0.2 / steps;
@@ -292,9 +292,20 @@ TEST(CSpaceObstacleTransform, StoppingOutsideTheSupportGivesTheFullFlowExactly) 
   Obstacle aside;
   aside.centre = Eigen::Vector3d(0.8, 0, 0.6);
   const OccupancyField<3> field = FitObstacle(aside, 0.04);
+  // With the gate, its goal is the end effector of the first configuration whose field is not
+  // zero: the gate closes there (V = 0 and dV = 0 with a map under the arm).
+  Eigen::Vector3d gate_goal(0.3, 0.2, 0.5);
+  {
+    const CSpaceObstacleTransform open(Arm(), field, {0.2, steps});
+    CSpaceTransformWorkspace ws = open.MakeWorkspace();
+    for (const ArmVector& q : qs)
+      if (!open.Field(q, &ws).isZero(0)) {
+        gate_goal = ws.chain.p_ee;
+        break;
+      }
+  }
   for (double gate : {0.0, 0.1}) {
-    const CSpaceObstacleTransform transform(Arm(), field, {0.2, steps},
-                                            {Eigen::Vector3d(0.3, 0.2, 0.5), gate});
+    const CSpaceObstacleTransform transform(Arm(), field, {0.2, steps}, {gate_goal, gate});
     CSpaceTransformWorkspace ws = transform.MakeWorkspace();
     int outside = 0;
     for (const ArmVector& p : qs) {
@@ -310,6 +321,15 @@ TEST(CSpaceObstacleTransform, StoppingOutsideTheSupportGivesTheFullFlowExactly) 
       EXPECT_TRUE(MatricesNear(jacobian, J, 0)) << p.transpose();
       EXPECT_TRUE(MatricesNear(transform.Forward(p, &ws), q, 0)) << p.transpose();
       outside += transform.Field(p, &ws).isZero(0) ? 1 : 0;
+    }
+    if (gate > 0) {  // the configuration at the gate's goal: the field is closed there
+      ArmMatrix dV;
+      bool closed = false;
+      for (const ArmVector& p : qs) {
+        const ArmVector V = transform.Field(p, &ws, &dV);
+        if ((ws.chain.p_ee - gate_goal).norm() == 0) closed = V.isZero(0) && dV.isZero(0);
+      }
+      EXPECT_TRUE(closed);
     }
     EXPECT_GE(outside, 5) << "configurations with every body point outside the map's support";
     EXPECT_LE(outside, static_cast<int>(qs.size()) - 5);

@@ -112,7 +112,7 @@ TEST(ObstacleTransform, JacobianAndInverse) {
 }
 
 // Forward stops once the field is exactly zero (no feature within the cut-off): the result must
-// equal every Euler step taken, bit for bit, inside and outside the map's support.
+// equal every Euler step taken, with the same values, inside and outside the map's support.
 TEST(ObstacleTransform, StoppingOutsideTheSupportGivesTheFullFlowExactly) {
   RbfGridSpec<2> spec;  // the map covers [-0.3, 0.3]^2; support ends 0.4 beyond
   spec.lower = Vec<2>(-0.3, -0.3);

@@ -207,7 +207,8 @@ struct ObstacleConfig {
   std::vector<double> times{0.002, 0.004, 0.008, 0.016, 0.032, 0.064};
   double step = 0.0005;  ///< Euler step of the obstacle flow (steps = ceil(time / step))
   /// Task space: a flow time whose Euler map does not invert along the rollouts is tried again
-  /// with the step halved, up to this many times, before it is given up (the coarsest step that
+  /// with the step halved, up to this many times in total over all times (a halved step is kept
+  /// for the larger ones), before it is given up (the coarsest step that
   /// inverts: fewer Euler steps, a cheaper rollout step). 0: one step size (2-D does not read it).
   int step_halvings = 0;
   double clear_probability = 0.5;
@@ -245,8 +246,8 @@ struct ObstacleConfig {
     a->Visit("times", &times, Range::Any(), "obstacle-flow times tried, smallest first");
     a->Visit("step", &step, Range::Positive(), "obstacle-flow Euler step (steps = time / step)");
     a->Visit("step_halvings", &step_halvings, Range::Closed(0, 10),
-             "task space: halve the obstacle-flow step up to this many times when a flow time's "
-             "Euler map does not invert along the rollouts");
+             "task space: halve the obstacle-flow step up to this many times in total when a "
+             "flow time's Euler map does not invert along the rollouts");
     a->Visit("clear_probability", &clear_probability, Range::Closed(0.01, 0.99),
              "rollouts must keep the map's p(occupied) below this");
     a->Visit("select_on_grid", &select_on_grid, Range::Any(),
