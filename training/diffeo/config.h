@@ -206,6 +206,10 @@ struct ObstacleConfig {
   /// not on the exact obstacle the metrics use.
   std::vector<double> times{0.002, 0.004, 0.008, 0.016, 0.032, 0.064};
   double step = 0.0005;  ///< Euler step of the obstacle flow (steps = ceil(time / step))
+  /// The Euler step is also at most step_lipschitz / L, L the largest |Hess p| measured on a
+  /// lattice around the obstacle (2-D) or |dV_q| along the plain rollouts (C-space): h L < 1 keeps
+  /// every step of the map invertible where L bounds the field's slope.
+  double step_lipschitz = 0.5;
   /// Task space: a flow time whose Euler map does not invert along the rollouts is tried again
   /// with the step halved, up to this many times in total over all times (a halved step is kept
   /// for the larger ones), before it is given up (the coarsest step that
@@ -245,6 +249,8 @@ struct ObstacleConfig {
     a->Visit("sample_margin", &sample_margin, Range::NonNegative(), "sample lattice margin");
     a->Visit("times", &times, Range::Any(), "obstacle-flow times tried, smallest first");
     a->Visit("step", &step, Range::Positive(), "obstacle-flow Euler step (steps = time / step)");
+    a->Visit("step_lipschitz", &step_lipschitz, Range::Open(0, 1),
+             "obstacle-flow Euler step at most this over the field's largest measured slope");
     a->Visit("step_halvings", &step_halvings, Range::Closed(0, 10),
              "task space: halve the obstacle-flow step up to this many times in total when a "
              "flow time's Euler map does not invert along the rollouts");

@@ -219,9 +219,9 @@ std::pair<double, double> MapSlopes(const OccupancyField<D>& field, const Vec<D>
 }
 
 /// The Euler step of an obstacle flow: obstacle.step, or less where the map is steeper, so that
-/// h ||Hess p|| <= 0.5 (each step a contraction-perturbed identity: invertible).
+/// h ||Hess p|| <= obstacle.step_lipschitz (< 1: each step a perturbed identity, invertible).
 inline double ObstacleStep(const ObstacleConfig& o, double max_hessian) {
-  return std::min(o.step, 0.5 / std::max(max_hessian, 1e-12));
+  return std::min(o.step, o.step_lipschitz / std::max(max_hessian, 1e-12));
 }
 
 /// Euler steps of an obstacle flow of time `time` with step h: ceil(time / h).

@@ -216,8 +216,8 @@ Scores EvaluateTaskSpaceShape(const ExperimentConfig& c, const PreparedDemos& de
     for (int i : demos.train) train_starts.push_back(starts[static_cast<std::size_t>(i)]);
 
     // The Euler step: obstacle.step, or less where the C-space field is steeper along the plain
-    // rollouts (which cross the obstacle), so that h ||dV_q|| <= 0.5 there; halved below when a
-    // flow time's map does not invert (obstacle.step_halvings).
+    // rollouts (which cross the obstacle), so that h ||dV_q|| <= step_lipschitz there; halved below
+    // when a flow time's map does not invert (obstacle.step_halvings).
     double max_dv = 0;
     {
       FlowSettings<kArmDof> unit;
@@ -230,7 +230,7 @@ Scores EvaluateTaskSpaceShape(const ExperimentConfig& c, const PreparedDemos& de
           max_dv = std::max(max_dv, dv.norm());  // Frobenius >= spectral
         }
     }
-    const double h = std::min(c.obstacle.step, 0.5 / std::max(max_dv, 1e-12));
+    const double h = std::min(c.obstacle.step, c.obstacle.step_lipschitz / std::max(max_dv, 1e-12));
     log::Info(demos.name, ": C-space obstacle field max |dV_q| ", max_dv, ", flow step ", h);
     const auto system_with = [&](double t, double step) {
       FlowSettings<kArmDof> fs;
