@@ -12,8 +12,13 @@ namespace foresight::imitation {
 // ---- obstacle transform ----------------------------------------------------------------------
 
 template <int D>
-ObstacleTransform<D>::ObstacleTransform(OccupancyField<D> field, FlowSettings<D> settings)
-    : field_(std::move(field)), settings_(settings) {
+ObstacleTransform<D>::ObstacleTransform(OccupancyField<D> field, FlowSettings<D> settings,
+                                        ObstacleGate<D> gate)
+    : field_(std::move(field)), settings_(settings), gate_(gate) {
+  FS_THROW_UNLESS(
+      gate_.goal.allFinite() && std::isfinite(gate_.length) && gate_.length >= 0,
+      "obstacle transform: the goal gate needs a finite goal and length >= 0, got goal (",
+      gate_.goal.transpose(), ") length ", gate_.length);
   FS_THROW_UNLESS(std::isfinite(settings_.time) && settings_.time > 0,
                   "obstacle transform: flow time ", settings_.time, " must be positive and finite");
   FS_THROW_UNLESS(settings_.steps >= 1, "obstacle transform: flow steps ", settings_.steps,
@@ -23,22 +28,40 @@ ObstacleTransform<D>::ObstacleTransform(OccupancyField<D> field, FlowSettings<D>
   discontinuity_ = 2 * g.truncation() * max_w * (g.gamma() * g.spec().cutoff_radius + 1);
 }
 
-// s_{k+1} = s_k + h grad p(s_k),  J_{k+1} = (I + h Hess p(s_k)) J_k.
+template <int D>
+Vec<D> ObstacleTransform<D>::Field(const Vec<D>& s, RbfFeatures<D>* ws, Mat<D>* jacobian) const {
+  OccupancyValue<D> v;
+  field_.Evaluate(s, ws, jacobian != nullptr, &v);
+  if (gate_.length <= 0) {
+    if (jacobian != nullptr) *jacobian = v.hessian;
+    return v.gradient;
+  }
+  // w grad p with w = 1 - e, e = exp(-r^2 / (2 l^2)); grad w = e (s - goal) / l^2.
+  const Vec<D> d = s - gate_.goal;
+  const double l2 = gate_.length * gate_.length;
+  const double e = std::exp(-d.squaredNorm() / (2 * l2));
+  if (jacobian != nullptr)
+    *jacobian = (1 - e) * v.hessian + v.gradient * ((e / l2) * d).transpose();
+  return (1 - e) * v.gradient;
+}
+
+// s_{k+1} = s_k + h V_o(s_k),  J_{k+1} = (I + h dV_o(s_k)) J_k  (V_o = grad p without a gate).
 template <int D>
 Vec<D> ObstacleTransform<D>::Forward(const Vec<D>& y, RbfFeatures<D>* ws, Mat<D>* jacobian) const {
   const double h = settings_.time / settings_.steps;
   const bool with_jacobian = jacobian != nullptr;
   Vec<D> s = y;
   Mat<D> j = Mat<D>::Identity();
-  OccupancyValue<D> v;
+  Mat<D> dv = Mat<D>::Zero();
   for (int k = 0; k < settings_.steps; ++k) {
-    field_.Evaluate(s, ws, with_jacobian, &v);
+    const Vec<D> v = Field(s, ws, with_jacobian ? &dv : nullptr);
     // Where the field (and, when asked, its Jacobian) is exactly zero, e.g. outside the map's
-    // support (no feature within the cut-off), s and J would stay as they are for every remaining
-    // step (the field is autonomous): stopping gives the same values (up to the sign of a zero).
-    if (v.gradient.isZero(0) && (!with_jacobian || v.hessian.isZero(0))) break;
-    if (with_jacobian) j = (Mat<D>::Identity() + h * v.hessian) * j;
-    s += h * v.gradient;
+    // support (no feature within the cut-off) or at the gate's goal, s and J would stay as they
+    // are for every remaining step (the field is autonomous): stopping gives the same values (up
+    // to the sign of a zero).
+    if (v.isZero(0) && (!with_jacobian || dv.isZero(0))) break;
+    if (with_jacobian) j = (Mat<D>::Identity() + h * dv) * j;
+    s += h * v;
   }
   if (with_jacobian) *jacobian = j;
   return s;
@@ -48,14 +71,9 @@ template <int D>
 bool ObstacleTransform<D>::Inverse(const Vec<D>& x, RbfFeatures<D>* ws, Vec<D>* y, double tolerance,
                                    int max_iterations) const {
   const double h = settings_.time / settings_.steps;
-  OccupancyValue<D> v;
   return detail::InvertEulerMap<D>(
-      x, settings_.steps, h,
-      [&](const Vec<D>& s, int) {
-        field_.Evaluate(s, ws, false, &v);
-        return v.gradient;
-      },
-      tolerance, h * discontinuity_, max_iterations, y);
+      x, settings_.steps, h, [&](const Vec<D>& s, int) { return Field(s, ws); }, tolerance,
+      h * discontinuity_, max_iterations, y);
 }
 
 // ---- bias transform --------------------------------------------------------------------------

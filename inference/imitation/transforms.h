@@ -9,7 +9,8 @@
 ///   field (eq. map), K Euler steps with the exact Jacobian J_{k+1} = (I + h Hess p(s_k)) J_k.
 ///   Flowing -V_o (psi_o^-1) lowers occupancy, so the outer trajectories bend around the obstacle.
 ///   Outside the map's support (no feature within the cut-off) V_o and its Jacobian are exactly
-///   zero and stay so (the field is autonomous): Forward stops there, with the same values.
+///   zero and stay so (the field is autonomous): Forward stops there, with the same values. An
+///   optional goal gate (ObstacleGate) makes psi_o fix the goal.
 /// - BiasTransform<D> psi_b: the flow of an RBF field V_b = W' phi fitted by ridge regression to
 ///   unit vectors pointing away from a user point s_tar on samples of a region (thesis
 ///   "Infinitesimal Generators for User-Specified Bias"): the outer system is pulled toward s_tar.
@@ -31,13 +32,30 @@
 
 namespace foresight::imitation {
 
+/// Optional goal gate of ObstacleTransform: the field is multiplied by
+/// w(s) = 1 - exp(-||s - goal||^2 / (2 length^2)), so psi_o fixes the goal exactly and the composed
+/// system keeps the imitation system's equilibrium. Without it a map whose gradient is not exactly
+/// zero at the goal (a soft map reaches across the whole region) moves the equilibrium to
+/// psi_o^-1(goal): rollouts then settle a little off the goal (as the C-space gate, cspace.h).
+/// length 0: no gate.
+template <int D>
+struct ObstacleGate {
+  Vec<D> goal = Vec<D>::Zero();
+  double length = 0;
+};
+
 template <int D>
 class ObstacleTransform {
  public:
   ObstacleTransform() = default;
-  ObstacleTransform(OccupancyField<D> field, FlowSettings<D> settings);
+  /// `gate`: finite goal, length >= 0 (an Error naming the value otherwise).
+  ObstacleTransform(OccupancyField<D> field, FlowSettings<D> settings, ObstacleGate<D> gate = {});
   const OccupancyField<D>& field() const { return field_; }
   const FlowSettings<D>& settings() const { return settings_; }
+  const ObstacleGate<D>& gate() const { return gate_; }
+  /// The (gated) field V_o(s) = w(s) grad p(s) and, when `jacobian` is not null, its Jacobian
+  /// w Hess p + grad p grad w'. No allocation.
+  Vec<D> Field(const Vec<D>& s, RbfFeatures<D>* ws, Mat<D>* jacobian = nullptr) const;
   std::unique_ptr<RbfFeatures<D>> MakeWorkspace() const { return field_.MakeWorkspace(); }
   /// psi_o(y) and optionally J = d psi_o / dy. No allocation.
   Vec<D> Forward(const Vec<D>& y, RbfFeatures<D>* ws, Mat<D>* jacobian = nullptr) const;
@@ -51,6 +69,7 @@ class ObstacleTransform {
  private:
   OccupancyField<D> field_;
   FlowSettings<D> settings_;
+  ObstacleGate<D> gate_;
   double discontinuity_ = 0;
 };
 

@@ -111,6 +111,42 @@ TEST(ObstacleTransform, JacobianAndInverse) {
   }
 }
 
+// The goal gate: psi_o fixes the goal exactly, the gated field's Jacobian and the transform's
+// match central differences, and the inverse round-trips.
+TEST(ObstacleTransform, GoalGateFixesTheGoalAndItsJacobiansMatch) {
+  const OccupancyField<2> field = RandomField(Grid2(), 0.5, 6);
+  const Vec<2> goal(0.1, -0.2);
+  const ObstacleTransform<2> psi(field, {0.02, 10}, {goal, 0.15});
+  auto ws = psi.MakeWorkspace();
+  Mat<2> j;
+  EXPECT_TRUE(testing::MatricesNear(psi.Forward(goal, ws.get(), &j), goal, 0));
+  EXPECT_TRUE(testing::MatricesNear(j, Mat<2>::Identity(), 0));
+  const ObstacleTransform<2> open(field, {0.02, 10});
+  EXPECT_GT((open.Forward(goal, ws.get()) - goal).norm(), 1e-4) << "the ungated map moves it";
+  std::mt19937_64 rng(7);
+  for (int n = 0; n < 20; ++n) {
+    const Vec<2> y = RandomPoint<2>(&rng, -0.5, 0.5);
+    Mat<2> dv;
+    psi.Field(y, ws.get(), &dv);
+    const Mat<2> dv_fd =
+        FiniteDifferenceJacobian<2>([&](const Vec<2>& s) { return psi.Field(s, ws.get()); }, y);
+    EXPECT_TRUE(testing::MatricesNear(dv, dv_fd, 1e-6 * (1 + dv.norm())));
+    const Vec<2> x = psi.Forward(y, ws.get(), &j);
+    // A step of 1e-7: this random map curves sharply (1e-6 leaves a 2e-5 difference error).
+    const Mat<2> fd = FiniteDifferenceJacobian<2>(
+        [&](const Vec<2>& s) { return psi.Forward(s, ws.get()); }, y, 1e-7);
+    EXPECT_TRUE(testing::MatricesNear(j, fd, 1e-6 * (1 + j.norm()))) << y.transpose();
+    Vec<2> back;
+    ASSERT_TRUE(psi.Inverse(x, ws.get(), &back));
+    EXPECT_LE((back - y).norm(), 1e-10);
+  }
+  testing::ExpectErrorContains(
+      [&] {
+        ObstacleTransform<2>(field, {0.02, 10}, {goal, -1});
+      },
+      {"goal gate", "-1"});
+}
+
 // Forward stops once the field is exactly zero (no feature within the cut-off): the result must
 // equal every Euler step taken, with the same values, inside and outside the map's support.
 TEST(ObstacleTransform, StoppingOutsideTheSupportGivesTheFullFlowExactly) {

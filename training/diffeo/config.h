@@ -225,8 +225,9 @@ struct ObstacleConfig {
   /// Largest round-trip error psi_o^-1(psi_o(y)) - y accepted when checking a flow time
   /// (normalised units in 2-D, rad in C-space); every inverse must also converge.
   double inverse_tolerance = 1e-8;
-  /// Task space: the C-space obstacle field fades out within about this distance (m) of the goal
-  /// (inference/imitation/cspace.h, goal gate), so the arm still reaches it; 0 = no gate.
+  /// The obstacle field fades out within about this distance of the goal (2-D: normalised units,
+  /// ObstacleGate in transforms.h; task space: m, the C-space goal gate in cspace.h), so psi_o
+  /// fixes the goal and the rollouts still reach it; 0 = no gate.
   double goal_gate = 0;
   std::vector<double> repulsor_gains{0.01, 0.03, 0.1, 0.3, 1, 3};  ///< EFlow + repulsor, likewise
 
@@ -262,8 +263,8 @@ struct ObstacleConfig {
     a->Visit("inverse_tolerance", &inverse_tolerance, Range::Positive(),
              "largest obstacle-flow round-trip error accepted (2-D normalised units; C-space rad)");
     a->Visit("goal_gate", &goal_gate, Range::NonNegative(),
-             "task space: length (m) within which the C-space obstacle field fades out at the "
-             "goal (0: no gate)");
+             "length within which the obstacle field fades out at the goal (2-D normalised "
+             "units; task space m; 0: no gate)");
     a->Visit("repulsor_gains", &repulsor_gains, Range::Any(), "EFlow repulsor gains tried");
   }
 };

@@ -230,13 +230,14 @@ inline int ObstacleSteps(double time, double h) {
 }
 
 template <int D>
-OuterTransform<D> ObstacleOuter(const OccupancyField<D>& field, double time, double h) {
+OuterTransform<D> ObstacleOuter(const OccupancyField<D>& field, double time, double h,
+                                ObstacleGate<D> gate = {}) {
   OuterTransform<D> t;
   t.type = OuterTransform<D>::Type::kObstacle;
   FlowSettings<D> fs;
   fs.time = time;
   fs.steps = ObstacleSteps(time, h);
-  t.obstacle = ObstacleTransform<D>(field, fs);
+  t.obstacle = ObstacleTransform<D>(field, fs, gate);
   return t;
 }
 

@@ -164,10 +164,13 @@ Scores EvaluatePlanarShape(const ExperimentConfig& c, const PreparedDemos& demos
     const double h = ObstacleStep(c.obstacle, max_hess);
     log::Info(demos.name, ": obstacle map max |grad p| ", max_grad, ", max |Hess p| ", max_hess,
               ", obstacle-flow step ", h);
+    ObstacleGate<2> gate;  // obstacle.goal_gate: psi_o fixes the goal (transforms.h)
+    gate.goal = goal;
+    gate.length = c.obstacle.goal_gate;
     std::vector<double> times;
     std::vector<Clearance> tried;
     for (double t : c.obstacle.times) {
-      const OuterTransform<2> outer = ObstacleOuter<2>(field, t, h);
+      const OuterTransform<2> outer = ObstacleOuter<2>(field, t, h, gate);
       // Larger times only bend the map further: stop at the first non-invertible one.
       if (!ObstacleInvertible<2>(outer.obstacle, box_lo, box_hi, c.obstacle.sample_spacing * 2,
                                  c.obstacle.inverse_tolerance))
@@ -184,7 +187,7 @@ Scores EvaluatePlanarShape(const ExperimentConfig& c, const PreparedDemos& demos
     const std::size_t pick = ChooseClearance(tried);
     const double chosen = times[pick];
     const bool cleared = tried[pick].training_clear;
-    const ComposedSystem<2> avoid(system, {ObstacleOuter<2>(field, chosen, h)});
+    const ComposedSystem<2> avoid(system, {ObstacleOuter<2>(field, chosen, h, gate)});
     auto aws = avoid.MakeWorkspace();
     const auto f_o = [&](const V2& y) { return avoid.Velocity(y, &aws); };
     const int crossing = cleared ? tried[pick].grid_crossing : grid_crossings(f_o);
@@ -195,7 +198,24 @@ Scores EvaluatePlanarShape(const ExperimentConfig& c, const PreparedDemos& demos
     s.push_back({"obstacle_grid_crossing", static_cast<double>(crossing)});
     AddPathScores("avoid_", ToPaths(ar), demos, c.eval.resample, &s, free_ids);
     s.push_back({"avoid_mcd", MaxDepth(ToPaths(ar), disc)});
-    s.push_back({"avoid_grid_reach_rate", ReachRate(RollAll(f_o, FreeOf(grid, disc), goal, roll))});
+    {
+      const std::vector<Rollout<2>> gr = RollAll(f_o, FreeOf(grid, disc), goal, roll);
+      s.push_back({"avoid_grid_reach_rate", ReachRate(gr)});
+      // Why grid rollouts fail: a non-finite velocity, or the step limit (with where they ended).
+      int non_finite = 0, stalled = 0;
+      double far = 0;
+      for (const Rollout<2>& r : gr) {
+        if (!r.finite) ++non_finite;
+        if (r.finite && !r.reached) {
+          ++stalled;
+          far = std::max(far, (r.path.col(r.path.cols() - 1) - goal).norm());
+        }
+      }
+      if (non_finite + stalled > 0)
+        log::Info(demos.name, ": with avoidance, ", non_finite, " of ", gr.size(),
+                  " grid rollouts hit a non-finite velocity and ", stalled,
+                  " ran out of steps (ending up to ", far, " from the goal)");
+    }
     // One step of the composed system with the selected obstacle flow, on the points its rollouts
     // pass (every 10th; one thread; the median of 3 passes): the shipped flow's cost, which
     // `foresight bench` (a short synthetic obstacle flow) does not show.
