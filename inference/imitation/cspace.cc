@@ -43,15 +43,14 @@ ArmVector CSpaceObstacleTransform::Field(const ArmVector& q, CSpaceTransformWork
   ArmVector V;
   const double total = CSpacePotentialField(chain_, q, at_point, &ws->chain, &V, jacobian);
   if (occupancy != nullptr) *occupancy = total;
-  if (gate_.length > 0) {  // w V_q, d(w V_q) = w dV_q + V_q grad w' (file comment)
-    const Eigen::Vector3d d = ws->chain.p_ee - gate_.goal;
-    const double l2 = gate_.length * gate_.length;
-    const double e = std::exp(-d.squaredNorm() / (2 * l2));
+  if (gate_.length > 0) {    // w V_q, d(w V_q) = w dV_q + V_q grad_q w' (file comment)
+    Eigen::Vector3d grad_x;  // dw / dx_ee; grad_q w = J_ee' grad_x
+    const double w = gate_.Weight(ws->chain.p_ee, &grad_x);
     if (jacobian != nullptr) {
-      const ArmVector grad_w = (e / l2) * (ws->chain.J_ee.transpose() * d);
-      *jacobian = (1 - e) * *jacobian + V * grad_w.transpose();
+      const ArmVector grad_w = ws->chain.J_ee.transpose() * grad_x;
+      *jacobian = w * *jacobian + V * grad_w.transpose();
     }
-    V *= 1 - e;
+    V *= w;
   }
   return V;
 }

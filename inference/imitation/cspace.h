@@ -72,11 +72,9 @@ struct CSpaceTransformWorkspace {
   std::unique_ptr<RbfFeatures<3>> features;
 };
 
-/// The goal gate of CSpaceObstacleTransform (file comment); length 0 = no gate.
-struct GoalGate {
-  Eigen::Vector3d goal = Eigen::Vector3d::Zero();  ///< end-effector goal in the world (m)
-  double length = 0;                               ///< l (m), >= 0
-};
+/// The goal gate of CSpaceObstacleTransform (file comment): the end-effector goal in the world
+/// and l (m); length 0 = no gate.
+using GoalGate = ObstacleGate<3>;
 
 /// psi_o^q (see the file comment).
 class CSpaceObstacleTransform {

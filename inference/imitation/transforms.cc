@@ -36,13 +36,11 @@ Vec<D> ObstacleTransform<D>::Field(const Vec<D>& s, RbfFeatures<D>* ws, Mat<D>* 
     if (jacobian != nullptr) *jacobian = v.hessian;
     return v.gradient;
   }
-  // w grad p with w = 1 - e, e = exp(-r^2 / (2 l^2)); grad w = e (s - goal) / l^2.
-  const Vec<D> d = s - gate_.goal;
-  const double l2 = gate_.length * gate_.length;
-  const double e = std::exp(-d.squaredNorm() / (2 * l2));
-  if (jacobian != nullptr)
-    *jacobian = (1 - e) * v.hessian + v.gradient * ((e / l2) * d).transpose();
-  return (1 - e) * v.gradient;
+  // w grad p and its Jacobian w Hess p + grad p grad w'.
+  Vec<D> grad_w;
+  const double w = gate_.Weight(s, &grad_w);
+  if (jacobian != nullptr) *jacobian = w * v.hessian + v.gradient * grad_w.transpose();
+  return w * v.gradient;
 }
 
 // s_{k+1} = s_k + h V_o(s_k),  J_{k+1} = (I + h dV_o(s_k)) J_k  (V_o = grad p without a gate).

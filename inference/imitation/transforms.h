@@ -23,6 +23,7 @@
 /// non-finite velocities stop the rollout (reported, never returned as a path).
 
 #include <Eigen/Core>
+#include <cmath>
 #include <functional>
 #include <string>
 #include <vector>
@@ -40,8 +41,17 @@ namespace foresight::imitation {
 /// length 0: no gate.
 template <int D>
 struct ObstacleGate {
-  Vec<D> goal = Vec<D>::Zero();
-  double length = 0;
+  Vec<D> goal = Vec<D>::Zero();  ///< the point the gate closes at
+  double length = 0;             ///< l, >= 0
+  /// w(x) = 1 - e with e = exp(-||x - goal||^2 / (2 l^2)), and dw/dx = e (x - goal) / l^2 into
+  /// `gradient` (not null). Only for length > 0.
+  double Weight(const Vec<D>& x, Vec<D>* gradient) const {
+    const Vec<D> d = x - goal;
+    const double l2 = length * length;
+    const double e = std::exp(-d.squaredNorm() / (2 * l2));
+    *gradient = (e / l2) * d;
+    return 1 - e;
+  }
 };
 
 template <int D>
