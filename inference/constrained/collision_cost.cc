@@ -8,7 +8,8 @@
 namespace foresight::constrained {
 
 namespace {
-constexpr double kMinWeight = 1e-12;
+/// The Gauss-Hermite points dropped from every operator's rule weigh at most this much together.
+constexpr double kMaxDroppedMass = 1e-6;
 }  // namespace
 
 Eigen::VectorXd RuleTimes(TimeRule rule, double horizon, int k) {
@@ -35,9 +36,10 @@ CollisionCost::CollisionCost(const occupancy::Map* map, const TimeBasis& basis,
                   "CollisionCost: order (Gauss-Hermite points per axis) must be in [1, 64], got ",
                   order_);
   phi_ = basis_.Design(times_);
-  // Points of weight below 1e-12 dropped: C (an expectation of p in [0, 1]) changes by at most
-  // order^2 1e-12 (4e-10 at order 20), while order 20 evaluates 276 points instead of 400.
-  rule_ = PrunedRule(StandardNormalRule(order_), kMinWeight);
+  // The smallest weights dropped, at most 1e-6 of mass together: C (an expectation of p in [0, 1])
+  // changes by at most 1e-6 (a thousandth of the 1e-3 asked of it), while order 24 evaluates 202
+  // points instead of 576 (336 when only weights below 1e-12 were dropped).
+  rule_ = PrunedRuleByMass(StandardNormalRule(order_), kMaxDroppedMass);
 }
 
 CollisionCost::Workspace CollisionCost::MakeWorkspace() const {

@@ -1,7 +1,10 @@
 #include "inference/constrained/gauss_hermite.h"
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
+#include <numeric>
+#include <vector>
 
 #include "core/error.h"
 
@@ -81,17 +84,29 @@ StandardNormalRule2 StandardNormalRule(int order) {
   return rule;
 }
 
-StandardNormalRule2 PrunedRule(const StandardNormalRule2& rule, double min_weight) {
-  FS_THROW_UNLESS(std::isfinite(min_weight) && min_weight >= 0 && min_weight < 1,
-                  "PrunedRule: min_weight must be in [0, 1), got ", min_weight);
-  int kept = 0;
-  for (int q = 0; q < rule.size(); ++q) kept += rule.weights[q] >= min_weight;
+StandardNormalRule2 PrunedRuleByMass(const StandardNormalRule2& rule, double max_dropped_mass) {
+  FS_THROW_UNLESS(std::isfinite(max_dropped_mass) && max_dropped_mass >= 0 && max_dropped_mass < 1,
+                  "PrunedRuleByMass: max_dropped_mass must be in [0, 1), got ", max_dropped_mass);
+  // Smallest weights first (ties by index, so the result does not depend on the sort).
+  std::vector<int> order(static_cast<std::size_t>(rule.size()));
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](int a, int b) {
+    return rule.weights[a] < rule.weights[b] || (rule.weights[a] == rule.weights[b] && a < b);
+  });
+  std::vector<char> keep(order.size(), 1);
+  double dropped = 0;
+  for (int q : order) {
+    if (dropped + rule.weights[q] > max_dropped_mass) break;
+    dropped += rule.weights[q];
+    keep[static_cast<std::size_t>(q)] = 0;
+  }
+  const int kept = static_cast<int>(std::count(keep.begin(), keep.end(), 1));
   StandardNormalRule2 out;
   out.points.resize(2, kept);
   out.weights.resize(kept);
   int k = 0;
   for (int q = 0; q < rule.size(); ++q) {
-    if (rule.weights[q] < min_weight) continue;
+    if (!keep[static_cast<std::size_t>(q)]) continue;
     out.points.col(k) = rule.points.col(q);
     out.weights[k++] = rule.weights[q];
   }
