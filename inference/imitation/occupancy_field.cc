@@ -48,30 +48,107 @@ double Sigmoid(double f) {
 }
 }  // namespace
 
-// With a_t = w_t phi_t:  f = b + sum a_t,  grad f = -2 g sum a_t r_t,
-// Hess f = 4 g^2 sum a_t r_t r_t' - 2 g (f - b) I.
+namespace {
+
+// The sums over features of a_t = w_t phi_t, a_t r_t and a_t r_t r_t' (r_t = s - c_t), row by row
+// of the separable window: along axis 0 a row's features share every factor but e_0, so
+//   sum_i a = e_rest sum_i w_i e_0i,  sum_i a r_0 = e_rest sum_i w_i e_0i d_0i, ...
+// three running sums per row instead of a feature list. The features are those RbfGrid::Evaluate
+// lists (the same cut-off test); only the order of the additions differs.
 template <int D>
-void OccupancyField<D>::Evaluate(const Vec<D>& s, RbfFeatures<D>* ws, bool with_hessian,
-                                 OccupancyValue<D>* out) const {
-  grid_.Evaluate(s, ws);
-  const double g = grid_.gamma();
-  double sum = 0;
-  Vec<D> first = Vec<D>::Zero();
-  Mat<D> second = Mat<D>::Zero();
-  for (int i = 0; i < ws->count; ++i) {
-    const double a = weights_[ws->index[i]] * ws->phi[i];
-    const Vec<D>& r = ws->offset[i];
-    sum += a;
-    first += a * r;
-    if (with_hessian) second.noalias() += (a * r) * r.transpose();
+struct FeatureSums {
+  double sum = 0;                  // sum a
+  Vec<D> first = Vec<D>::Zero();   // sum a r
+  Mat<D> second = Mat<D>::Zero();  // sum a r r' (only when asked)
+};
+
+template <int D>
+void SumFeatures(const RbfGrid<D>& grid, const Eigen::VectorXd& weights, const Vec<D>& s,
+                 bool with_second, FeatureSums<D>* out) {
+  typename RbfGrid<D>::AxisWindows w;
+  if (!grid.Windows(s, &w)) return;
+  const double cut2 = grid.spec().cutoff_radius * grid.spec().cutoff_radius;
+  const auto& counts = grid.spec().counts;
+  // One row: the states first[0] .. first[0] + n[0] - 1 along axis 0 at fixed other offsets
+  // `rest` (squared norm rest2, factor e_rest), starting at weight index `base`.
+  const auto row = [&](int base, double rest2, double e_rest, const Vec<D>& rest) {
+    const double* wt = weights.data() + base;
+    const double* d = w.d[0];
+    const double* e = w.e[0];
+    // The states of the row within the cut-off form one run of i (d falls with i, so d^2 first
+    // falls, then rises): trim both ends by the same test RbfGrid::Evaluate applies per state.
+    int lo = 0, hi = w.n[0] - 1;
+    while (lo <= hi && d[lo] * d[lo] + rest2 > cut2) ++lo;
+    while (hi >= lo && d[hi] * d[hi] + rest2 > cut2) --hi;
+    double a0 = 0, a1 = 0, a2 = 0;  // sum w e, sum w e d, sum w e d^2 along the row
+    if (with_second) {
+      for (int i = lo; i <= hi; ++i) {
+        const double a = wt[i] * e[i];
+        a0 += a;
+        a1 += a * d[i];
+        a2 += a * d[i] * d[i];
+      }
+    } else {
+      for (int i = lo; i <= hi; ++i) {
+        const double a = wt[i] * e[i];
+        a0 += a;
+        a1 += a * d[i];
+      }
+    }
+    a0 *= e_rest;
+    a1 *= e_rest;
+    out->sum += a0;
+    out->first[0] += a1;
+    for (int b = 1; b < D; ++b) out->first[b] += a0 * rest[b];
+    if (with_second) {
+      out->second(0, 0) += a2 * e_rest;
+      for (int b = 1; b < D; ++b) {
+        out->second(0, b) += a1 * rest[b];
+        for (int c = b; c < D; ++c) out->second(b, c) += a0 * rest[b] * rest[c];
+      }
+    }
+  };
+  if constexpr (D == 2) {
+    for (int j = 0; j < w.n[1]; ++j) {
+      const double dy = w.d[1][j];
+      if (dy * dy > cut2) continue;
+      row((w.first[1] + j) * counts[0] + w.first[0], dy * dy, w.e[1][j], Vec<2>(0, dy));
+    }
+  } else {
+    for (int l = 0; l < w.n[2]; ++l) {
+      const double dz = w.d[2][l];
+      if (dz * dz > cut2) continue;
+      for (int j = 0; j < w.n[1]; ++j) {
+        const double dy = w.d[1][j];
+        const double dyz2 = dy * dy + dz * dz;
+        if (dyz2 > cut2) continue;
+        row(((w.first[2] + l) * counts[1] + w.first[1] + j) * counts[0] + w.first[0], dyz2,
+            w.e[1][j] * w.e[2][l], Vec<3>(0, dy, dz));
+      }
+    }
   }
-  const double p = Sigmoid(bias_ + sum);
+  if (with_second)
+    for (int b = 0; b < D; ++b)
+      for (int c = b + 1; c < D; ++c) out->second(c, b) = out->second(b, c);
+}
+
+}  // namespace
+
+// f = b + sum a_t,  grad f = -2 g sum a_t r_t,  Hess f = 4 g^2 sum a_t r_t r_t' - 2 g (f - b) I.
+// The workspace is not used: the sums are taken row by row (SumFeatures).
+template <int D>
+void OccupancyField<D>::Evaluate(const Vec<D>& s, RbfFeatures<D>* /*ws*/, bool with_hessian,
+                                 OccupancyValue<D>* out) const {
+  FeatureSums<D> f;
+  SumFeatures(grid_, weights_, s, with_hessian, &f);
+  const double g = grid_.gamma();
+  const double p = Sigmoid(bias_ + f.sum);
   const double dp = p * (1 - p);
-  const Vec<D> grad_f = (-2 * g) * first;
+  const Vec<D> grad_f = (-2 * g) * f.first;
   out->p = p;
   out->gradient = dp * grad_f;
   if (with_hessian) {
-    const Mat<D> hess_f = (4 * g * g) * second - (2 * g * sum) * Mat<D>::Identity();
+    const Mat<D> hess_f = (4 * g * g) * f.second - (2 * g * f.sum) * Mat<D>::Identity();
     out->hessian = dp * ((1 - 2 * p) * grad_f * grad_f.transpose() + hess_f);
   } else {
     out->hessian.setZero();
@@ -79,11 +156,10 @@ void OccupancyField<D>::Evaluate(const Vec<D>& s, RbfFeatures<D>* ws, bool with_
 }
 
 template <int D>
-double OccupancyField<D>::Probability(const Vec<D>& s, RbfFeatures<D>* ws) const {
-  grid_.Evaluate(s, ws);
-  double sum = 0;  // summed as Evaluate does: the same p to the bit
-  for (int i = 0; i < ws->count; ++i) sum += weights_[ws->index[i]] * ws->phi[i];
-  return Sigmoid(bias_ + sum);
+double OccupancyField<D>::Probability(const Vec<D>& s, RbfFeatures<D>* /*ws*/) const {
+  FeatureSums<D> f;  // summed as Evaluate does: the same p to the bit
+  SumFeatures(grid_, weights_, s, false, &f);
+  return Sigmoid(bias_ + f.sum);
 }
 
 template class OccupancyField<2>;

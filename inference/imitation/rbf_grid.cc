@@ -8,8 +8,6 @@ namespace foresight::imitation {
 namespace {
 
 constexpr long kMaxStates = 1L << 22;
-// Inducing states per axis inside the cut-off window (the separable factors' buffer).
-constexpr int kMaxWindow = 64;
 
 }  // namespace
 
@@ -31,6 +29,11 @@ RbfGrid<D>::RbfGrid(const RbfGridSpec<D>& spec, const std::string& source) : spe
     FS_THROW_UNLESS(size <= kMaxStates, source, ": grid has more than ", kMaxStates,
                     " inducing states");
   }
+  // The factors' recurrence (Windows) steps by exp(-gamma spacing^2): keep it far from underflow.
+  FS_THROW_UNLESS(spec.gamma * spec.spacing * spec.spacing <= 300, source,
+                  ": gamma spacing^2 = ", spec.gamma * spec.spacing * spec.spacing,
+                  " exceeds 300 (neighbouring features differ by more than exp(-300)); use a "
+                  "smaller gamma or spacing");
   const double ratio = spec.cutoff_radius / spec.spacing;
   FS_THROW_UNLESS(ratio < kMaxWindow / 2, source, ": cutoff_radius / spacing = ", ratio,
                   " is too large (window of more than ", kMaxWindow, " states per axis)");
@@ -43,6 +46,8 @@ RbfGrid<D>::RbfGrid(const RbfGridSpec<D>& spec, const std::string& source) : spe
                   " are supported");
   size_ = static_cast<int>(size);
   truncation_ = std::exp(-spec.gamma * spec.cutoff_radius * spec.cutoff_radius);
+  step_factor_ = std::exp(-spec.gamma * spec.spacing * spec.spacing);
+  step_factor_2_ = step_factor_ * step_factor_;
 }
 
 template <int D>
@@ -80,27 +85,55 @@ Vec<D> RbfGrid<D>::Centre(int t) const {
 }
 
 template <int D>
-void RbfGrid<D>::Evaluate(const Vec<D>& s, RbfFeatures<D>* out) const {
-  out->count = 0;
+bool RbfGrid<D>::Windows(const Vec<D>& s, AxisWindows* out) const {
   const double h = spec_.spacing, ratio = spec_.cutoff_radius / spec_.spacing;
-  const double g = spec_.gamma, cut2 = spec_.cutoff_radius * spec_.cutoff_radius;
-  // Per axis: the window of states within the cut-off, their offsets and Gaussian factors.
-  int first[D], n[D];
-  double d[D][kMaxWindow], e[D][kMaxWindow];
+  const double g = spec_.gamma;
   for (int a = 0; a < D; ++a) {
     // Not finite or absurdly far: no features (also keeps the casts below defined).
-    if (!(std::abs(s[a]) < 1e12)) return;
+    if (!(std::abs(s[a]) < 1e12)) return false;
     const double f = (s[a] - spec_.lower[a]) / h;
     const double lo = std::max(0.0, std::ceil(f - ratio));
     const double hi = std::min(static_cast<double>(spec_.counts[a] - 1), std::floor(f + ratio));
-    if (!(hi >= lo)) return;
-    first[a] = static_cast<int>(lo);
-    n[a] = static_cast<int>(hi) - first[a] + 1;
-    for (int i = 0; i < n[a]; ++i) {
-      d[a][i] = s[a] - (spec_.lower[a] + h * (first[a] + i));
-      e[a][i] = std::exp(-g * d[a][i] * d[a][i]);
+    if (!(hi >= lo)) return false;
+    const int first = static_cast<int>(lo), n = static_cast<int>(hi) - first + 1;
+    out->first[a] = first;
+    out->n[a] = n;
+    double* d = out->d[a];
+    double* e = out->e[a];
+    for (int i = 0; i < n; ++i) d[i] = s[a] - (spec_.lower[a] + h * (first + i));
+    // d falls with i; from the state nearest s (|d_c| <= h / 2 inside the grid) outward.
+    int c = 0;
+    for (int i = 1; i < n; ++i)
+      if (std::abs(d[i]) < std::abs(d[c])) c = i;
+    e[c] = std::exp(-g * d[c] * d[c]);
+    // Upward d_{i} = d_{i-1} - h: e_i = e_{i-1} exp(-g h^2) exp(2 g h d_{i-1}); downward the sign
+    // of the last factor's exponent flips.
+    const double up0 = std::exp(2 * g * h * d[c]);
+    double q = up0;
+    for (int i = c + 1; i < n; ++i) {
+      e[i] = e[i - 1] * (step_factor_ * q);
+      q *= step_factor_2_;
+    }
+    q = 1 / up0;
+    for (int i = c - 1; i >= 0; --i) {
+      e[i] = e[i + 1] * (step_factor_ * q);
+      q *= step_factor_2_;
     }
   }
+  return true;
+}
+
+template <int D>
+void RbfGrid<D>::Evaluate(const Vec<D>& s, RbfFeatures<D>* out) const {
+  out->count = 0;
+  const double cut2 = spec_.cutoff_radius * spec_.cutoff_radius;
+  // Per axis: the window of states within the cut-off, their offsets and Gaussian factors.
+  AxisWindows w;
+  if (!Windows(s, &w)) return;
+  const auto& first = w.first;
+  const auto& n = w.n;
+  const auto& d = w.d;
+  const auto& e = w.e;
   int k = 0;
   if constexpr (D == 2) {
     for (int j = 0; j < n[1]; ++j) {

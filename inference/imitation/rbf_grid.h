@@ -68,11 +68,31 @@ class RbfGrid {
   /// Non-zero features at s into `out` (no allocation). Non-finite s gives no features.
   void Evaluate(const Vec<D>& s, RbfFeatures<D>* out) const;
 
+  /// Most inducing states per axis inside the cut-off window (checked by the constructor).
+  static constexpr int kMaxWindow = 64;
+  /// The separable factors of the features at s, per axis a: the window of states within the
+  /// cut-off radius on that axis, first[a] .. first[a] + n[a] - 1, their offsets d = s_a - c_a and
+  /// factors e = exp(-gamma d^2) (two exponentials per axis: from the state nearest s outward by
+  /// the recurrence e_{k+1} = e_k exp(-gamma h^2) exp(-2 gamma h |d_k|), whose second factor itself
+  /// shrinks by exp(-2 gamma h^2) per state; every factor is at most 1, so nothing overflows, and
+  /// the relative error stays below 1e-13 (1 + gamma d^2)). A feature is the product of its axes'
+  /// factors where the offsets' squared norm is within cutoff_radius^2 (as Evaluate selects them);
+  /// callers that sum over features can sum row by row instead of listing them.
+  struct AxisWindows {
+    int first[D], n[D];
+    double d[D][kMaxWindow], e[D][kMaxWindow];
+  };
+  /// False (and `out` unspecified) where s has no features: not finite, or no state within the
+  /// cut-off on some axis. No allocation.
+  bool Windows(const Vec<D>& s, AxisWindows* out) const;
+
  private:
   RbfGridSpec<D> spec_;
   int size_ = 0;
   int window_ = 0;
   double truncation_ = 0;
+  double step_factor_ = 0;    ///< exp(-gamma spacing^2)
+  double step_factor_2_ = 0;  ///< exp(-2 gamma spacing^2)
 };
 
 // Derivatives from RbfFeatures (gamma g, offset r_t = s - c_t):

@@ -81,6 +81,60 @@ void CheckDerivatives(std::uint64_t seed) {
 TEST(OccupancyField, DerivativesMatchFiniteDifferences2D) { CheckDerivatives<2>(1); }
 TEST(OccupancyField, DerivativesMatchFiniteDifferences3D) { CheckDerivatives<3>(2); }
 
+// Evaluate sums over features row by row of the separable window; the same sums over the feature
+// list RbfGrid::Evaluate gives (the definition in the header) must agree to rounding, with the
+// cut-off active (a small radius against the grid) and points near and off the grid's edges.
+template <int D>
+void CheckRowSumsEqualTheFeatureList(std::uint64_t seed) {
+  RbfGridSpec<D> spec;
+  spec.lower = Vec<D>::Constant(-0.5);
+  spec.counts.fill(D == 2 ? 21 : 11);
+  spec.spacing = D == 2 ? 0.05 : 0.1;
+  spec.gamma = 120;
+  spec.cutoff_radius = 0.27;
+  const RbfGrid<D> grid(spec);
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> n01;
+  Eigen::VectorXd w(grid.size());
+  for (auto& x : w) x = 2 * n01(rng);
+  const OccupancyField<D> field(grid, w, -0.3);
+  auto ws = field.MakeWorkspace();
+  RbfFeatures<D> features;
+  int with_features = 0;
+  for (int k = 0; k < 300; ++k) {
+    const Vec<D> s = RandomPoint<D>(&rng, -0.8, 0.8);
+    grid.Evaluate(s, &features);
+    double sum = 0;
+    Vec<D> first = Vec<D>::Zero();
+    Mat<D> second = Mat<D>::Zero();
+    for (int i = 0; i < features.count; ++i) {
+      const double a = w[features.index[i]] * features.phi[i];
+      sum += a;
+      first += a * features.offset[i];
+      second += a * features.offset[i] * features.offset[i].transpose();
+    }
+    with_features += features.count > 0;
+    const double g = spec.gamma, p = 1 / (1 + std::exp(0.3 - sum)), dp = p * (1 - p);
+    const Vec<D> grad_f = -2 * g * first;
+    const Mat<D> hess_f = 4 * g * g * second - 2 * g * sum * Mat<D>::Identity();
+    OccupancyValue<D> v;
+    field.Evaluate(s, ws.get(), true, &v);
+    EXPECT_NEAR(v.p, p, 1e-14) << s.transpose();
+    EXPECT_TRUE(testing::MatricesNear(v.gradient, dp * grad_f, 1e-11 * (1 + grad_f.norm())));
+    const Mat<D> hess = dp * ((1 - 2 * p) * grad_f * grad_f.transpose() + hess_f);
+    EXPECT_TRUE(testing::MatricesNear(v.hessian, hess, 1e-10 * (1 + hess.norm())));
+    EXPECT_EQ(field.Probability(s, ws.get()), v.p);  // the same sums, to the bit
+    if (features.count == 0) {  // exactly zero outside the support (the flows stop there)
+      EXPECT_TRUE(v.gradient.isZero(0) && v.hessian.isZero(0));
+    }
+  }
+  EXPECT_GT(with_features, 100);
+  EXPECT_LT(with_features, 300);
+}
+
+TEST(OccupancyField, RowSumsEqualTheFeatureList2D) { CheckRowSumsEqualTheFeatureList<2>(5); }
+TEST(OccupancyField, RowSumsEqualTheFeatureList3D) { CheckRowSumsEqualTheFeatureList<3>(6); }
+
 TEST(OccupancyField, FromHingeMapEqualsHingeMapQuery) {
   HingeGridConfig c;
   c.x_min = -1;

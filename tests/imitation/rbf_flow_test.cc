@@ -166,6 +166,43 @@ TEST(RbfGrid, CoveringAndBadSpecs) {
   bad = Grid2();
   bad.gamma = std::nan("");
   testing::ExpectErrorContains([&] { RbfGrid<2> g(bad); }, {"gamma"});
+  bad = Grid2();
+  bad.gamma = 1e5;  // gamma spacing^2 = 1000: the factors' recurrence would underflow
+  testing::ExpectErrorContains([&] { RbfGrid<2> g(bad); }, {"gamma spacing^2", "300"});
+}
+
+// The separable factors come from two exponentials per axis and a recurrence outward from the
+// state nearest the point: each must still be exp(-gamma d^2) to 1e-13 (1 + gamma d^2) relative
+// (the exponent's own rounding moves exp by about 1e-16 gamma d^2), also on a steep kernel
+// (exp(-gamma h^2) = e^-8 per state), far out in the window, and beyond the grid.
+TEST(RbfGrid, WindowFactorsAreTheExponentialsToRounding) {
+  for (double gamma_h2 : {0.49, 8.0}) {
+    RbfGridSpec<3> spec;
+    spec.lower = Vec<3>(-1, -0.5, 0);
+    spec.counts = {21, 11, 6};
+    spec.spacing = 0.1;
+    spec.gamma = gamma_h2 / (spec.spacing * spec.spacing);
+    spec.cutoff_radius = 0.75;
+    const RbfGrid<3> grid(spec);
+    std::mt19937_64 rng(7);
+    typename RbfGrid<3>::AxisWindows w;
+    int checked = 0;
+    for (int n = 0; n < 300; ++n) {
+      const Vec<3> s = RandomPoint<3>(&rng, -1.5, 1.5);
+      if (!grid.Windows(s, &w)) continue;
+      for (int a = 0; a < 3; ++a)
+        for (int i = 0; i < w.n[a]; ++i) {
+          const double d = s[a] - (spec.lower[a] + spec.spacing * (w.first[a] + i));
+          EXPECT_EQ(w.d[a][i], d);
+          const double exact = std::exp(-spec.gamma * d * d);
+          // Relative to the exponent's size: the rounding of gamma d^2 alone moves exp by that.
+          EXPECT_NEAR(w.e[a][i], exact, 1e-13 * (1 + spec.gamma * d * d) * exact)
+              << gamma_h2 << " axis " << a << " d " << d;
+          ++checked;
+        }
+    }
+    EXPECT_GT(checked, 1000);
+  }
 }
 
 // ---- flow -------------------------------------------------------------------------------------
