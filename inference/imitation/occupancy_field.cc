@@ -66,68 +66,40 @@ template <int D>
 void SumFeatures(const RbfGrid<D>& grid, const Eigen::VectorXd& weights, const Vec<D>& s,
                  bool with_second, FeatureSums<D>* out) {
   typename RbfGrid<D>::AxisWindows w;
-  if (!grid.Windows(s, &w)) return;
-  const double cut2 = grid.spec().cutoff_radius * grid.spec().cutoff_radius;
-  const auto& counts = grid.spec().counts;
-  // One row: the states first[0] .. first[0] + n[0] - 1 along axis 0 at fixed other offsets
-  // `rest` (squared norm rest2, factor e_rest), starting at weight index `base`.
-  const auto row = [&](int base, double rest2, double e_rest, const Vec<D>& rest) {
-    const double* wt = weights.data() + base;
-    const double* d = w.d[0];
-    const double* e = w.e[0];
-    // The states of the row within the cut-off form one run of i (d falls with i, so d^2 first
-    // falls, then rises): trim both ends by the same test RbfGrid::Evaluate applies per state.
-    int lo = 0, hi = w.n[0] - 1;
-    while (lo <= hi && d[lo] * d[lo] + rest2 > cut2) ++lo;
-    while (hi >= lo && d[hi] * d[hi] + rest2 > cut2) --hi;
-    double a0 = 0, a1 = 0, a2 = 0;  // sum w e, sum w e d, sum w e d^2 along the row
-    if (with_second) {
-      for (int i = lo; i <= hi; ++i) {
-        const double a = wt[i] * e[i];
-        a0 += a;
-        a1 += a * d[i];
-        a2 += a * d[i] * d[i];
-      }
-    } else {
-      for (int i = lo; i <= hi; ++i) {
-        const double a = wt[i] * e[i];
-        a0 += a;
-        a1 += a * d[i];
-      }
-    }
-    a0 *= e_rest;
-    a1 *= e_rest;
-    out->sum += a0;
-    out->first[0] += a1;
-    for (int b = 1; b < D; ++b) out->first[b] += a0 * rest[b];
-    if (with_second) {
-      out->second(0, 0) += a2 * e_rest;
-      for (int b = 1; b < D; ++b) {
-        out->second(0, b) += a1 * rest[b];
-        for (int c = b; c < D; ++c) out->second(b, c) += a0 * rest[b] * rest[c];
-      }
-    }
-  };
-  if constexpr (D == 2) {
-    for (int j = 0; j < w.n[1]; ++j) {
-      const double dy = w.d[1][j];
-      if (dy * dy > cut2) continue;
-      row((w.first[1] + j) * counts[0] + w.first[0], dy * dy, w.e[1][j], Vec<2>(0, dy));
-    }
-  } else {
-    for (int l = 0; l < w.n[2]; ++l) {
-      const double dz = w.d[2][l];
-      if (dz * dz > cut2) continue;
-      for (int j = 0; j < w.n[1]; ++j) {
-        const double dy = w.d[1][j];
-        const double dyz2 = dy * dy + dz * dz;
-        if (dyz2 > cut2) continue;
-        row(((w.first[2] + l) * counts[1] + w.first[1] + j) * counts[0] + w.first[0], dyz2,
-            w.e[1][j] * w.e[2][l], Vec<3>(0, dy, dz));
-      }
-    }
-  }
-  if (with_second)
+  const double* d = w.d[0];
+  const double* e = w.e[0];
+  const bool any =
+      grid.ForEachRow(s, &w, [&](int start, int lo, int hi, double e_rest, const Vec<D>& rest) {
+        const double* wt = weights.data() + start;
+        double a0 = 0, a1 = 0, a2 = 0;  // sum w e, sum w e d, sum w e d^2 along the row
+        if (with_second) {
+          for (int i = lo; i <= hi; ++i) {
+            const double a = wt[i] * e[i];
+            a0 += a;
+            a1 += a * d[i];
+            a2 += a * d[i] * d[i];
+          }
+        } else {
+          for (int i = lo; i <= hi; ++i) {
+            const double a = wt[i] * e[i];
+            a0 += a;
+            a1 += a * d[i];
+          }
+        }
+        a0 *= e_rest;
+        a1 *= e_rest;
+        out->sum += a0;
+        out->first[0] += a1;
+        for (int b = 1; b < D; ++b) out->first[b] += a0 * rest[b];
+        if (with_second) {
+          out->second(0, 0) += a2 * e_rest;
+          for (int b = 1; b < D; ++b) {
+            out->second(0, b) += a1 * rest[b];
+            for (int c = b; c < D; ++c) out->second(b, c) += a0 * rest[b] * rest[c];
+          }
+        }
+      });
+  if (any && with_second)
     for (int b = 0; b < D; ++b)
       for (int c = b + 1; c < D; ++c) out->second(c, b) = out->second(b, c);
 }

@@ -36,25 +36,37 @@ FlowWorkspace<D> RbfFlow<D>::MakeWorkspace() const {
   return ws;
 }
 
-// V = sum_t W_t phi_t,  DV = sum_t W_t (d phi_t / ds)' = -2 g sum_t (W_t phi_t) r_t'.
+// V = sum_t W_t phi_t,  DV = sum_t W_t (d phi_t / ds)' = -2 g sum_t (W_t phi_t) r_t', summed row
+// by row of the separable window (RbfGrid::ForEachRow): a row shares every factor but e_0, so
+//   sum_i W_i phi_i = e_rest sum_i W_i e_0i,  sum_i W_i phi_i r_i' = e_rest [sum_i W_i e_0i d_0i,
+//   (sum_i W_i e_0i) rest_1, ...].
+// The workspace's feature list is not used.
 template <int D>
-Vec<D> RbfFlow<D>::Field(const Vec<D>& s, FlowWorkspace<D>* ws, Mat<D>* jacobian,
+Vec<D> RbfFlow<D>::Field(const Vec<D>& s, FlowWorkspace<D>* /*ws*/, Mat<D>* jacobian,
                          int segment) const {
-  RbfFeatures<D>& f = *ws->features;
-  grid_.Evaluate(s, &f);
-  const int base = segment * grid_.size();
+  typename RbfGrid<D>::AxisWindows w;
+  const double* d = w.d[0];
+  const double* e = w.e[0];
+  const double* cols = rows_.data() + static_cast<std::ptrdiff_t>(segment) * grid_.size() * D;
   Vec<D> v = Vec<D>::Zero();
-  if (jacobian == nullptr) {
-    for (int i = 0; i < f.count; ++i) v.noalias() += f.phi[i] * rows_.col(base + f.index[i]);
-    return v;
-  }
   Mat<D> dv = Mat<D>::Zero();
-  for (int i = 0; i < f.count; ++i) {
-    const Vec<D> a = f.phi[i] * rows_.col(base + f.index[i]);
-    v += a;
-    dv.noalias() += a * f.offset[i].transpose();
-  }
-  *jacobian = (-2.0 * grid_.gamma()) * dv;
+  const bool with_jacobian = jacobian != nullptr;
+  grid_.ForEachRow(s, &w, [&](int start, int lo, int hi, double e_rest, const Vec<D>& rest) {
+    Vec<D> a0 = Vec<D>::Zero(), a1 = Vec<D>::Zero();  // sum W e, sum W e d along the row
+    for (int i = lo; i <= hi; ++i) {
+      const Eigen::Map<const Vec<D>> wi(cols + static_cast<std::ptrdiff_t>(start + i) * D);
+      const Vec<D> a = e[i] * wi;
+      a0 += a;
+      if (with_jacobian) a1 += d[i] * a;
+    }
+    a0 *= e_rest;
+    v += a0;
+    if (with_jacobian) {
+      dv.col(0) += e_rest * a1;
+      for (int b = 1; b < D; ++b) dv.col(b) += rest[b] * a0;
+    }
+  });
+  if (with_jacobian) *jacobian = (-2.0 * grid_.gamma()) * dv;
   return v;
 }
 

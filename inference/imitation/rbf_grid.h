@@ -85,6 +85,14 @@ class RbfGrid {
   /// False (and `out` unspecified) where s has no features: not finite, or no state within the
   /// cut-off on some axis. No allocation.
   bool Windows(const Vec<D>& s, AxisWindows* out) const;
+  /// Visits the features at s row by row along axis 0, for sums that share a row's other factors:
+  /// row(start, lo, hi, e_rest, rest) for each row holding features, whose states are the grid
+  /// indices start + i for i in [lo, hi] (also the indices into windows->d[0] and ->e[0]), with
+  /// the other axes' factor e_rest and offsets rest (rest[0] = 0). The features are exactly those
+  /// Evaluate lists (the same cut-off test per state). False where s has no features. No
+  /// allocation.
+  template <class Row>
+  bool ForEachRow(const Vec<D>& s, AxisWindows* windows, Row&& row) const;
 
  private:
   RbfGridSpec<D> spec_;
@@ -94,6 +102,44 @@ class RbfGrid {
   double step_factor_ = 0;    ///< exp(-gamma spacing^2)
   double step_factor_2_ = 0;  ///< exp(-2 gamma spacing^2)
 };
+
+template <int D>
+template <class Row>
+bool RbfGrid<D>::ForEachRow(const Vec<D>& s, AxisWindows* windows, Row&& row) const {
+  AxisWindows& w = *windows;
+  if (!Windows(s, &w)) return false;
+  const double cut2 = spec_.cutoff_radius * spec_.cutoff_radius;
+  const auto& counts = spec_.counts;
+  const double* d = w.d[0];
+  // A row's states within the cut-off form one run of i (d falls with i, so d^2 first falls, then
+  // rises): trim both ends by the test Evaluate applies per state.
+  const auto visit = [&](int start, double rest2, double e_rest, const Vec<D>& rest) {
+    int lo = 0, hi = w.n[0] - 1;
+    while (lo <= hi && d[lo] * d[lo] + rest2 > cut2) ++lo;
+    while (hi >= lo && d[hi] * d[hi] + rest2 > cut2) --hi;
+    if (lo <= hi) row(start, lo, hi, e_rest, rest);
+  };
+  if constexpr (D == 2) {
+    for (int j = 0; j < w.n[1]; ++j) {
+      const double dy = w.d[1][j];
+      if (dy * dy > cut2) continue;
+      visit((w.first[1] + j) * counts[0] + w.first[0], dy * dy, w.e[1][j], Vec<2>(0, dy));
+    }
+  } else {
+    for (int l = 0; l < w.n[2]; ++l) {
+      const double dz = w.d[2][l];
+      if (dz * dz > cut2) continue;
+      for (int j = 0; j < w.n[1]; ++j) {
+        const double dy = w.d[1][j];
+        const double dyz2 = dy * dy + dz * dz;
+        if (dyz2 > cut2) continue;
+        visit(((w.first[2] + l) * counts[1] + w.first[1] + j) * counts[0] + w.first[0], dyz2,
+              w.e[1][j] * w.e[2][l], Vec<3>(0, dy, dz));
+      }
+    }
+  }
+  return true;
+}
 
 // Derivatives from RbfFeatures (gamma g, offset r_t = s - c_t):
 //   d phi_t / ds = -2 g phi_t r_t,   d^2 phi_t / ds^2 = phi_t (4 g^2 r_t r_t' - 2 g I).
