@@ -1,5 +1,6 @@
 #include "inference/imitation/rbf_grid.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/error.h"
@@ -102,9 +103,7 @@ bool RbfGrid<D>::Windows(const Vec<D>& s, AxisWindows* out) const {
     double* e = out->e[a];
     for (int i = 0; i < n; ++i) d[i] = s[a] - (spec_.lower[a] + h * (first + i));
     // d falls with i; from the state nearest s (|d_c| <= h / 2 inside the grid) outward.
-    int c = 0;
-    for (int i = 1; i < n; ++i)
-      if (std::abs(d[i]) < std::abs(d[c])) c = i;
+    const int c = std::clamp(static_cast<int>(std::lround(f)) - first, 0, n - 1);
     e[c] = std::exp(-g * d[c] * d[c]);
     // Upward d_{i} = d_{i-1} - h: e_i = e_{i-1} exp(-g h^2) exp(2 g h d_{i-1}); downward the sign
     // of the last factor's exponent flips.
