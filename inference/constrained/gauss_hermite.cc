@@ -84,29 +84,49 @@ StandardNormalRule2 StandardNormalRule(int order) {
   return rule;
 }
 
-StandardNormalRule2 PrunedRuleByMass(const StandardNormalRule2& rule, double max_dropped_mass) {
+StandardNormalRule2 PrunedRuleByMass(int order, double max_dropped_mass) {
   FS_THROW_UNLESS(std::isfinite(max_dropped_mass) && max_dropped_mass >= 0 && max_dropped_mass < 1,
                   "PrunedRuleByMass: max_dropped_mass must be in [0, 1), got ", max_dropped_mass);
-  // Smallest weights first (ties by index, so the result does not depend on the sort).
-  std::vector<int> order(static_cast<std::size_t>(rule.size()));
-  std::iota(order.begin(), order.end(), 0);
-  std::sort(order.begin(), order.end(), [&](int a, int b) {
-    return rule.weights[a] < rule.weights[b] || (rule.weights[a] == rule.weights[b] && a < b);
+  const StandardNormalRule2 rule = StandardNormalRule(order);
+  // Points in orbits of the square's symmetries: (i, j) with i <-> n - 1 - i, j <-> n - 1 - j and
+  // i <-> j share one weight. Orbits go or stay whole, so the kept rule is as symmetric as the
+  // full one (zero mean, isotropic covariance). Orbit key: (a, b) = the sorted folded indices.
+  const int n = order, half = (n + 1) / 2;
+  const auto fold = [n](int i) { return std::min(i, n - 1 - i); };
+  std::vector<double> orbit_mass(static_cast<std::size_t>(half * half), 0.0);
+  std::vector<int> orbit_of(static_cast<std::size_t>(n * n));
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const int a = std::min(fold(i), fold(j)), b = std::max(fold(i), fold(j));
+      const int q = i * n + j, o = a * half + b;
+      orbit_of[static_cast<std::size_t>(q)] = o;
+      orbit_mass[static_cast<std::size_t>(o)] += rule.weights[q];
+    }
+  // Lightest orbits first by their members' weight (the weight of the orbit's point (a, b)); ties
+  // by key, so the result does not depend on the sort.
+  std::vector<int> orbits;
+  for (int a = 0; a < half; ++a)
+    for (int b = a; b < half; ++b) orbits.push_back(a * half + b);
+  const auto member = [&](int o) { return rule.weights[(o / half) * n + o % half]; };
+  std::sort(orbits.begin(), orbits.end(), [&](int x, int y) {
+    return member(x) < member(y) || (member(x) == member(y) && x < y);
   });
-  std::vector<char> keep(order.size(), 1);
-  double dropped = 0;
-  for (int q : order) {
-    if (dropped + rule.weights[q] > max_dropped_mass) break;
-    dropped += rule.weights[q];
-    keep[static_cast<std::size_t>(q)] = 0;
+  std::vector<char> dropped(orbit_mass.size(), 0);
+  double mass = 0;
+  for (int o : orbits) {
+    if (mass + orbit_mass[static_cast<std::size_t>(o)] > max_dropped_mass) break;
+    mass += orbit_mass[static_cast<std::size_t>(o)];
+    dropped[static_cast<std::size_t>(o)] = 1;
   }
-  const int kept = static_cast<int>(std::count(keep.begin(), keep.end(), 1));
+  int kept = 0;
+  for (int q = 0; q < rule.size(); ++q)
+    kept += !dropped[static_cast<std::size_t>(orbit_of[static_cast<std::size_t>(q)])];
   StandardNormalRule2 out;
   out.points.resize(2, kept);
   out.weights.resize(kept);
   int k = 0;
   for (int q = 0; q < rule.size(); ++q) {
-    if (!keep[static_cast<std::size_t>(q)]) continue;
+    if (dropped[static_cast<std::size_t>(orbit_of[static_cast<std::size_t>(q)])]) continue;
     out.points.col(k) = rule.points.col(q);
     out.weights[k++] = rule.weights[q];
   }

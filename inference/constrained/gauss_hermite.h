@@ -25,12 +25,14 @@ struct StandardNormalRule2 {
 };
 StandardNormalRule2 StandardNormalRule(int order);
 
-/// `rule` without its smallest weights, as many as fit in `max_dropped_mass` together (the
-/// tensor product's corners and edges: at 1e-6, 202 of 576 points kept at order 24, 271 of 1024
-/// at order 32, none dropped at order 4). For any function f in [0, 1] (an occupancy probability)
-/// the pruned rule's sum differs from the full rule's by at most the dropped mass, which is at most
-/// `max_dropped_mass`; the weights are not renormalised. The kept points stay in the rule's order.
-/// max_dropped_mass in [0, 1); Error otherwise.
-StandardNormalRule2 PrunedRuleByMass(const StandardNormalRule2& rule, double max_dropped_mass);
+/// StandardNormalRule(order) without its lightest points, as many as fit in `max_dropped_mass`
+/// together, dropped in whole orbits of the square's symmetries (mirror in either axis, swap of
+/// the axes), so the kept rule stays symmetric: zero mean and isotropic covariance, to rounding.
+/// For any function f in [0, 1] (an occupancy probability) the pruned rule's sum differs from the
+/// full rule's by at most the dropped mass (<= max_dropped_mass); the weights are not renormalised,
+/// and the kept points stay in the rule's order. Nothing is dropped at order 4 at 1e-6; most of
+/// the tensor product's corners and edges at high orders. order in [1, 64], max_dropped_mass in
+/// [0, 1); Error otherwise.
+StandardNormalRule2 PrunedRuleByMass(int order, double max_dropped_mass);
 
 }  // namespace foresight::constrained

@@ -43,7 +43,8 @@ class OccupancyField {
   const RbfGrid<D>& grid() const { return grid_; }
   const Eigen::VectorXd& weights() const { return weights_; }
   double bias() const { return bias_; }
-  /// Scratch per caller.
+  /// Scratch per caller. Evaluate and Probability no longer use it (they sum the features row by
+  /// row, RbfGrid::ForEachRow); kept for the interface and for callers listing features.
   std::unique_ptr<RbfFeatures<D>> MakeWorkspace() const;
 
   /// p, grad p and (with_hessian) Hess p at s. No allocation.

@@ -31,9 +31,7 @@ RbfFlow<D>::RbfFlow(RbfGrid<D> grid, Eigen::MatrixXd weights, FlowSettings<D> se
 
 template <int D>
 FlowWorkspace<D> RbfFlow<D>::MakeWorkspace() const {
-  FlowWorkspace<D> ws;
-  ws.features = std::make_unique<RbfFeatures<D>>();
-  return ws;
+  return {};
 }
 
 // V = sum_t W_t phi_t,  DV = sum_t W_t (d phi_t / ds)' = -2 g sum_t (W_t phi_t) r_t', summed row

@@ -52,11 +52,10 @@ int SegmentOfStep(const FlowSettings<D>& s, int step) {
   return static_cast<int>(static_cast<long long>(step) * s.segments / s.steps);
 }
 
-/// Per-caller scratch (features buffer); made by RbfFlow::MakeWorkspace.
+/// Per-caller scratch, made by RbfFlow::MakeWorkspace. Empty since the field is summed row by row
+/// on the stack (RbfGrid::ForEachRow); kept so that callers and the interface stay as they are.
 template <int D>
-struct FlowWorkspace {
-  std::unique_ptr<RbfFeatures<D>> features;
-};
+struct FlowWorkspace {};
 
 template <int D>
 class RbfFlow {

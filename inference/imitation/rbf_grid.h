@@ -4,8 +4,8 @@
 /// (thesis ch 8, eq. vecfieldeqn; errata: the Gaussian k(s, s_hat) = exp(-gamma ||s - s_hat||^2)).
 ///   phi_t(s) = exp(-gamma ||s - c_t||^2) if ||s - c_t|| <= cutoff_radius, else 0,
 ///   c_t = lower + spacing * (i_0, ..., i_{D-1}),  t = i_0 + counts_0 (i_1 + counts_1 i_2).
-/// The separable form exp(-gamma sum_a d_a^2) = prod_a exp(-gamma d_a^2) needs D * window
-/// exponentials per query.
+/// The separable form exp(-gamma sum_a d_a^2) = prod_a exp(-gamma d_a^2) needs two exponentials
+/// per axis and query (Windows).
 ///
 /// The truncation makes phi_t jump by truncation() = exp(-gamma cutoff_radius^2) across the cut-off
 /// sphere, so fields built on it are discontinuous by up to that times their weights: flows are
@@ -74,23 +74,25 @@ class RbfGrid {
   /// cut-off radius on that axis, first[a] .. first[a] + n[a] - 1, their offsets d = s_a - c_a and
   /// factors e = exp(-gamma d^2) (two exponentials per axis: from the state nearest s outward by
   /// the recurrence e_{k+1} = e_k exp(-gamma h^2) exp(-2 gamma h |d_k|), whose second factor itself
-  /// shrinks by exp(-2 gamma h^2) per state; every factor is at most 1, so nothing overflows, and
-  /// the relative error stays below 1e-13 (1 + gamma d^2)). A feature is the product of its axes'
-  /// factors where the offsets' squared norm is within cutoff_radius^2 (as Evaluate selects them);
-  /// callers that sum over features can sum row by row instead of listing them.
+  /// shrinks by exp(-2 gamma h^2) per state; every factor the recurrence multiplies by is at most
+  /// 1, so nothing overflows (the starting exponential of a direction with no states may be inf or
+  /// 0, unused), and the relative error stays below 1e-13 (1 + gamma d^2) where e is a normal
+  /// number, gamma d^2 < 708). A feature is the product of its axes' factors where the offsets'
+  /// squared norm is within cutoff_radius^2 (as Evaluate selects them); callers that sum over
+  /// features can sum row by row instead of listing them.
   struct AxisWindows {
     int first[D], n[D];
     double d[D][kMaxWindow], e[D][kMaxWindow];
   };
-  /// False (and `out` unspecified) where s has no features: not finite, or no state within the
-  /// cut-off on some axis. No allocation.
+  /// False (and `out` unspecified) where s is not finite or has no state within the cut-off on
+  /// some axis (then it has no features; true does not promise one). No allocation.
   bool Windows(const Vec<D>& s, AxisWindows* out) const;
   /// Visits the features at s row by row along axis 0, for sums that share a row's other factors:
   /// row(start, lo, hi, e_rest, rest) for each row holding features, whose states are the grid
   /// indices start + i for i in [lo, hi] (also the indices into windows->d[0] and ->e[0]), with
   /// the other axes' factor e_rest and offsets rest (rest[0] = 0). The features are exactly those
-  /// Evaluate lists (the same cut-off test per state). False where s has no features. No
-  /// allocation.
+  /// Evaluate lists (the same cut-off test per state). False where Windows is (no row visited);
+  /// true may still visit none. No allocation.
   template <class Row>
   bool ForEachRow(const Vec<D>& s, AxisWindows* windows, Row&& row) const;
 
