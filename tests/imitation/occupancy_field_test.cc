@@ -36,14 +36,21 @@ Vec<D> RandomPoint(std::mt19937_64* rng, double lo, double hi) {
   return p;
 }
 
+// Weights N(0, scale^2) on every inducing state, bias -0.3.
+template <int D>
+OccupancyField<D> RandomField(const RbfGrid<D>& grid, double scale, std::mt19937_64* rng) {
+  std::normal_distribution<double> n01;
+  Eigen::VectorXd w(grid.size());
+  for (auto& v : w) v = scale * n01(*rng);
+  return OccupancyField<D>(grid, w, -0.3);
+}
+
 template <int D>
 void CheckDerivatives(std::uint64_t seed) {
   const RbfGrid<D> grid(SmoothGrid<D>());
   std::mt19937_64 rng(seed);
-  std::normal_distribution<double> n01;
-  Eigen::VectorXd w(grid.size());
-  for (auto& v : w) v = 1.5 * n01(rng);
-  const OccupancyField<D> field(grid, w, -0.3);
+  const OccupancyField<D> field = RandomField(grid, 1.5, &rng);
+  const Eigen::VectorXd& w = field.weights();
   auto ws = field.MakeWorkspace();
   const double h = 1e-5;
   for (int n = 0; n < 20; ++n) {
@@ -94,10 +101,8 @@ void CheckRowSumsEqualTheFeatureList(std::uint64_t seed) {
   spec.cutoff_radius = 0.27;
   const RbfGrid<D> grid(spec);
   std::mt19937_64 rng(seed);
-  std::normal_distribution<double> n01;
-  Eigen::VectorXd w(grid.size());
-  for (auto& x : w) x = 2 * n01(rng);
-  const OccupancyField<D> field(grid, w, -0.3);
+  const OccupancyField<D> field = RandomField(grid, 2.0, &rng);
+  const Eigen::VectorXd& w = field.weights();
   auto ws = field.MakeWorkspace();
   RbfFeatures<D> features;
   int with_features = 0;
