@@ -4,7 +4,7 @@
 #   experiments/span_eth_ucy.sh [key.path=value ...]      (overrides apply to every scene)
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-BIN="$ROOT/build/bin/foresight"
+BIN="${FORESIGHT_BIN:-$ROOT/build/bin/foresight}"
 OUT="$ROOT/results"
 mkdir -p "$OUT" "$ROOT/runs"
 cd "$ROOT"
