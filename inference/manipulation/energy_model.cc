@@ -464,8 +464,22 @@ void LearnedSampler::Sample(const GfcsQuery& query, int intermediate_commands, i
     }
     model_.Context(query, encoding_, &context_);
     last_ = RunSgld(model_, context_, p, rng, &ws_);
-    kept = std::min<int>(learned, static_cast<int>(last_.u.cols()));
-    for (int c = 0; c < kept; ++c) out->col(c) = model_.CommandsToRadians(last_.u.col(c));
+    const int survivors = static_cast<int>(last_.u.cols());
+    kept = std::min<int>(learned, survivors);
+    picked_.resize(static_cast<std::size_t>(survivors));
+    std::iota(picked_.begin(), picked_.end(), 0);
+    if (p.pick == SgldPick::kRandom && kept < survivors) {
+      // A partial Fisher-Yates shuffle: the first `kept` entries are a uniform draw without
+      // replacement; kept in energy order so that the batch's order means the same either way.
+      for (int c = 0; c < kept; ++c) {
+        std::uniform_int_distribution<int> pick(c, survivors - 1);
+        std::swap(picked_[static_cast<std::size_t>(c)],
+                  picked_[static_cast<std::size_t>(pick(*rng))]);
+      }
+      std::sort(picked_.begin(), picked_.begin() + kept);
+    }
+    for (int c = 0; c < kept; ++c)
+      out->col(c) = model_.CommandsToRadians(last_.u.col(picked_[static_cast<std::size_t>(c)]));
   }
   last_filled_ = learned - kept;
   std::uniform_real_distribution<double> uniform(0.0, 1.0);

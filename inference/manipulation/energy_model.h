@@ -118,6 +118,12 @@ class EnergyModel {
 };
 
 // ---------------------------------------------------------------------------------------------
+/// Which SGLD particles LearnedSampler returns when it runs more chains than it needs.
+enum class SgldPick {
+  kLowestEnergy,  ///< the lowest-energy survivors (the shipped sampler)
+  kRandom,        ///< survivors drawn uniformly without replacement: samples of SGLD's distribution
+};
+
 /// Stochastic gradient Langevin dynamics on the energy (errata: descends it).
 struct SgldParams {
   int particles = 200;             ///< chains run in parallel
@@ -136,6 +142,11 @@ struct SgldParams {
   /// for planning (Ichter, Harrison and Pavone, ICRA 2018, keep uniform samples beside learned
   /// ones): where the model's modes miss a problem the uniform part still explores.
   double uniform_share = 0.0;
+  /// LearnedSampler only (like uniform_share, set per method: methods[].sgld_pick): which of the
+  /// survivors fill the learned part of the batch. The lowest-energy ones concentrate on the
+  /// model's modes (where those miss a problem, the whole batch misses it); random ones keep the
+  /// spread of the SGLD distribution.
+  SgldPick pick = SgldPick::kLowestEnergy;
 
   template <class A>
   void Serialize(A* a) {
@@ -188,9 +199,10 @@ class LearnedSampler : public CommandSampler {
   /// Computes the world encoding once (EnergyModel::EncodeWorld).
   void SetWorld(const World& world);
   /// Runs SGLD with max(particles, learned) particles, learned = count - round(uniform_share
-  /// count); `out` [7n x count] holds the `learned` lowest-energy survivors in radians, then
-  /// uniform draws in the joint limits. When fewer than `learned` particles survive (allowed by
-  /// max_dropped_share), uniform draws fill their places too (counted in last_filled(), which
+  /// count); `out` [7n x count] holds `learned` survivors in radians (the lowest-energy ones, or
+  /// with params.pick = kRandom a uniform draw without replacement from `rng`, in energy order),
+  /// then uniform draws in the joint limits. When fewer than `learned` particles survive (allowed
+  /// by max_dropped_share), uniform draws fill their places too (counted in last_filled(), which
   /// does not count the configured uniform share).
   /// Error when intermediate_commands != the model's n or SetWorld was not called.
   void Sample(const GfcsQuery& query, int intermediate_commands, int count, std::mt19937_64* rng,
@@ -208,6 +220,7 @@ class LearnedSampler : public CommandSampler {
   bool has_world_ = false;
   std::vector<EnergyModel::Workspace> ws_;  ///< one per SGLD thread
   SgldResult last_;
+  std::vector<int> picked_;  ///< survivor indices (kRandom), reused between calls
   int last_filled_ = 0;
   double last_seconds_ = 0;
 };

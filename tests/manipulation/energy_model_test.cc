@@ -576,6 +576,50 @@ TEST(LearnedSampler, ReturnsTheLowestEnergyParticlesInRadians) {
   EXPECT_EQ(out1, out2);
 }
 
+// sgld_pick random: the batch is a draw without replacement from the survivors (in their energy
+// order), so over many calls every survivor rank appears, where the lowest-energy pick always
+// returns the first ranks; the draw follows the caller's stream.
+TEST(LearnedSampler, RandomPickDrawsSurvivorsWithoutReplacement) {
+  const EnergyModel m(AbsEnergy(2, -0.5f, 100.0f));
+  SgldParams p;
+  p.particles = 40;
+  p.steps = 5;
+  p.pick = SgldPick::kRandom;
+  LearnedSampler s(m, p);
+  s.SetWorld(SomeWorld());
+  std::vector<int> seen(40, 0);
+  for (int call = 0; call < 30; ++call) {
+    std::mt19937_64 rng(100 + call);
+    Eigen::MatrixXd out;
+    s.Sample(SomeQuery(), 2, 8, &rng, &out);
+    ASSERT_EQ(out.cols(), 8);
+    const Eigen::MatrixXf& u = s.last_result().u;
+    int previous = -1;
+    for (int c = 0; c < 8; ++c) {
+      int rank = -1;  // the survivor this column came from
+      for (int k = 0; k < u.cols() && rank < 0; ++k)
+        if (out.col(c).isApprox(m.CommandsToRadians(u.col(k)), 1e-12)) rank = k;
+      ASSERT_GE(rank, 0) << "column " << c << " is not a survivor";
+      EXPECT_GT(rank, previous) << "distinct, in energy order";
+      previous = rank;
+      ++seen[static_cast<std::size_t>(rank)];
+    }
+  }
+  int ranks_seen = 0, beyond_eighth = 0;
+  for (int k = 0; k < 40; ++k) {
+    ranks_seen += seen[static_cast<std::size_t>(k)] > 0;
+    if (k >= 8) beyond_eighth += seen[static_cast<std::size_t>(k)];
+  }
+  EXPECT_GT(ranks_seen, 30);      // 240 draws of 8 from 40 reach nearly every rank
+  EXPECT_GT(beyond_eighth, 150);  // the lowest-energy pick would have none (expected 192)
+  // The same stream gives the same batch.
+  std::mt19937_64 a(7), b(7);
+  Eigen::MatrixXd out_a, out_b;
+  s.Sample(SomeQuery(), 2, 8, &a, &out_a);
+  s.Sample(SomeQuery(), 2, 8, &b, &out_b);
+  EXPECT_EQ(out_a, out_b);
+}
+
 TEST(LearnedSampler, UniformShareDrawsThatPartOfTheBatchUniformlyInTheLimits) {
   const float target = -0.5f;
   const EnergyModel m(AbsEnergy(2, target, 100.0f));

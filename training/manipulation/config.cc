@@ -40,6 +40,12 @@ void ExperimentConfig::Validate(const std::string& path) const {
                         (m.kind == PlanMethodKind::kGfcs && m.sampler == GfcsSamplerKind::kLearned),
                     path, ": methods: '", m.name, "' sets uniform_share ", m.uniform_share,
                     ", which only a gfcs method with sampler: learned uses");
+  for (const PlanMethodConfig& m : methods)
+    FS_THROW_UNLESS(
+        m.sgld_pick == SgldPick::kLowestEnergy ||
+            (m.kind == PlanMethodKind::kGfcs && m.sampler == GfcsSamplerKind::kLearned),
+        path, ": methods: '", m.name,
+        "' sets sgld_pick: random, which only a gfcs method with sampler: learned uses");
   FS_THROW_UNLESS(fabric.t_max >= fabric.dt, path, ": fabric.t_max (", fabric.t_max,
                   ") is below fabric.dt (", fabric.dt, ")");
 }

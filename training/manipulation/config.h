@@ -64,6 +64,8 @@ struct PlanMethodConfig {
   /// gfcs with the learned sampler: share of the first batch drawn uniformly in the joint limits
   /// (SgldParams::uniform_share; 0 = the thesis).
   double uniform_share = 0;
+  /// gfcs with the learned sampler: which SGLD survivors fill the batch (SgldParams::pick).
+  SgldPick sgld_pick = SgldPick::kLowestEnergy;
 
   template <class A>
   void Serialize(A* a) {
@@ -85,6 +87,11 @@ struct PlanMethodConfig {
     a->Visit("uniform_share", &uniform_share, config::Range::Closed(0, 1),
              "gfcs, sampler learned: share of the first batch drawn uniformly in the joint limits "
              "beside the SGLD samples (0: the thesis)");
+    a->VisitEnum("sgld_pick", &sgld_pick,
+                 config::EnumNames<SgldPick>{{SgldPick::kLowestEnergy, "lowest"},
+                                             {SgldPick::kRandom, "random"}},
+                 "gfcs, sampler learned: the lowest-energy SGLD survivors, or a random draw of "
+                 "them (the spread of the SGLD distribution)");
   }
 };
 

@@ -283,6 +283,7 @@ PlanReport RunPlanExperiment(const ExperimentConfig& c, const std::string& run_d
     }
     SgldParams sgld = c.sgld;
     sgld.uniform_share = method.uniform_share;
+    sgld.pick = method.sgld_pick;
     learned[m].emplace(*energy, sgld);
   }
 
