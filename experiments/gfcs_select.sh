@@ -10,6 +10,8 @@
 #   SHARES="0.25 0.5" experiments/gfcs_select.sh
 #   SHARES= PICKS=random RESULT=results/gfcs_select_pick.md experiments/gfcs_select.sh   (which SGLD
 #     survivors fill the batch: a random draw beside the shipped lowest-energy ones)
+#   SHARES= SGLD="sgld.steps=200" RESULT=... experiments/gfcs_select.sh   (other SGLD settings at test
+#     time for every learned row; the loop and its settings stay)
 #   RUN=runs/gfcs_all FIRST=1 LAST=50 experiments/gfcs_select.sh   (another model, other problems;
 #     on the model's own training problems the comparison favours share 0)
 #   SHARES= RESULT=results/gfcs_select_loop.md experiments/gfcs_select.sh "loop.batches=30+loop.adam_steps=800"
@@ -60,11 +62,17 @@ if seen:
     sys.exit(f"{sys.argv[1]}: the model trained on problems up to {seen[0]['last']} of "
              f"{seen[0]['family']}, not before FIRST={first}")
 PY
-# The sampler's SGLD settings are the loop config's (sampler: particles, steps).
+# The sampler's SGLD settings are the loop config's (sampler: particles, steps; eval.step_scale
+# when set, else sampler.step_scale).
 read -r PARTICLES STEPS SCALE < <(python3 -c "
 import yaml, sys
-s = yaml.safe_load(open('$RUN/config.yaml')).get('sampler', {})
-print(s.get('particles', 200), s.get('steps', 50), s.get('step_scale', 0.01))")
+c = yaml.safe_load(open('$RUN/config.yaml'))
+s = c.get('sampler', {})
+scale = c.get('eval', {}).get('step_scale', 0) or s.get('step_scale', 0.01)  # eval's, when set
+print(s.get('particles', 200), s.get('steps', 50), scale)")
+# SGLD="sgld.steps=100+sgld.step_scale=0.03": the learned rows' SGLD settings instead of the loop's.
+SGLD_ARGS=()
+[ -z "${SGLD:-}" ] || IFS='+' read -r -a SGLD_ARGS <<< "$SGLD"
 methods="{name: uniform, kind: gfcs, batches: 1}, {name: learned, kind: gfcs, batches: 1, sampler: learned}"
 for s in $SHARES; do
   methods+=", {name: \"learned+$s\", kind: gfcs, batches: 1, sampler: learned, uniform_share: $s}"
@@ -77,7 +85,7 @@ for f in $FAMILIES; do
   rm -rf "$OUT/$f"
   "$BIN" plan "configs/manipulation/$f.yaml" --problems "$FIRST-$LAST" "methods=[$methods]" \
     "energy_model=$RUN/model.h5" "sgld.particles=$PARTICLES" "sgld.steps=$STEPS" "sgld.step_scale=$SCALE" \
-    plot_problems=0 --run-dir "$OUT/$f" > "$OUT/$f.out" 2>&1 || fail "$OUT/$f.out"
+    ${SGLD:+"${SGLD_ARGS[@]}"} plot_problems=0 --run-dir "$OUT/$f" > "$OUT/$f.out" 2>&1 || fail "$OUT/$f.out"
   for i in "${!settings[@]}"; do  # each setting's learned sampler, same problems and seeds
     run="$OUT/loop_$((i + 1))/$f"
     mkdir -p "$(dirname "$run")"

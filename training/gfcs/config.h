@@ -121,6 +121,9 @@ struct EvalConfig {
   /// > 0: the learned sampler is also evaluated with this share of its batch drawn uniformly
   /// (methods[].uniform_share of the plan harness), in rows beside the thesis's pure one.
   double uniform_share = 0;
+  /// > 0: the learned sampler's SGLD step scale at evaluation instead of sampler.step_scale (which
+  /// the loop's own solves keep); chosen on validation problems (experiments/gfcs_select.sh SGLD=).
+  double step_scale = 0;
   std::vector<manipulation::PlanMethodConfig> baselines = {
       {"GF", manipulation::PlanMethodKind::kFabric, 1, 1.2}};
   double resolution = 0.05;
@@ -136,6 +139,9 @@ struct EvalConfig {
     a->Visit("uniform_share", &uniform_share, Range::Closed(0, 1),
              "> 0: also evaluate the learned sampler with this share of its batch drawn uniformly "
              "in the joint limits (rows 'GFCS learned + uniform'); chosen on validation problems");
+    a->Visit("step_scale", &step_scale, Range::NonNegative(),
+             "> 0: the learned sampler's SGLD step scale at evaluation instead of "
+             "sampler.step_scale (the loop keeps that); chosen on validation problems");
     a->Visit("baselines", &baselines, Range::Any(), "other methods in the same table");
     a->Visit("resolution", &resolution, Range::Closed(1e-4, 1.0),
              "C-space step of path validity checks (rad)");

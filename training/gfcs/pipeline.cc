@@ -273,6 +273,7 @@ manipulation::ExperimentConfig EvalPlanConfig(const ExperimentConfig& c,
   mc.plot_problems = c.eval.plot_problems;
   mc.energy_model = energy_model;
   mc.sgld = c.sampler;
+  if (c.eval.step_scale > 0) mc.sgld.step_scale = c.eval.step_scale;  // chosen on validation
   return mc;
 }
 
