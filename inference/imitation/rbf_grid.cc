@@ -122,51 +122,21 @@ bool RbfGrid<D>::Windows(const Vec<D>& s, AxisWindows* out) const {
   return true;
 }
 
+// The feature list, row by row as ForEachRow visits them (one definition of which states count).
 template <int D>
 void RbfGrid<D>::Evaluate(const Vec<D>& s, RbfFeatures<D>* out) const {
   out->count = 0;
-  const double cut2 = spec_.cutoff_radius * spec_.cutoff_radius;
-  // Per axis: the window of states within the cut-off, their offsets and Gaussian factors.
   AxisWindows w;
-  if (!Windows(s, &w)) return;
-  const auto& first = w.first;
-  const auto& n = w.n;
-  const auto& d = w.d;
-  const auto& e = w.e;
   int k = 0;
-  if constexpr (D == 2) {
-    for (int j = 0; j < n[1]; ++j) {
-      const double dy2 = d[1][j] * d[1][j];
-      const int row = (first[1] + j) * spec_.counts[0] + first[0];
-      for (int i = 0; i < n[0]; ++i) {
-        if (d[0][i] * d[0][i] + dy2 > cut2) continue;
-        out->index[k] = row + i;
-        out->phi[k] = e[0][i] * e[1][j];
-        out->offset[k] = Vec<D>(d[0][i], d[1][j]);
-        ++k;
-      }
+  ForEachRow(s, &w, [&](int start, int lo, int hi, double e_rest, const Vec<D>& rest) {
+    for (int i = lo; i <= hi; ++i) {
+      out->index[k] = start + i;
+      out->phi[k] = w.e[0][i] * e_rest;
+      out->offset[k] = rest;
+      out->offset[k][0] = w.d[0][i];
+      ++k;
     }
-  } else {
-    static_assert(D == 3, "RbfGrid supports D = 2 and 3");
-    for (int l = 0; l < n[2]; ++l) {
-      const double dz2 = d[2][l] * d[2][l];
-      if (dz2 > cut2) continue;
-      for (int j = 0; j < n[1]; ++j) {
-        const double dyz2 = d[1][j] * d[1][j] + dz2;
-        if (dyz2 > cut2) continue;
-        const double eyz = e[1][j] * e[2][l];
-        const int row =
-            ((first[2] + l) * spec_.counts[1] + first[1] + j) * spec_.counts[0] + first[0];
-        for (int i = 0; i < n[0]; ++i) {
-          if (d[0][i] * d[0][i] + dyz2 > cut2) continue;
-          out->index[k] = row + i;
-          out->phi[k] = e[0][i] * eyz;
-          out->offset[k] = Vec<D>(d[0][i], d[1][j], d[2][l]);
-          ++k;
-        }
-      }
-    }
-  }
+  });
   out->count = k;
 }
 
