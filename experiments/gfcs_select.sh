@@ -93,7 +93,8 @@ for f in $FAMILIES; do
     "$BIN" plan "configs/manipulation/$f.yaml" --problems "$FIRST-$LAST" \
       "methods=[{name: \"learned [loop $((i + 1))]\", kind: gfcs, batches: 1, sampler: learned}]" \
       "energy_model=${RUN}_$((i + 1))/model.h5" "sgld.particles=$PARTICLES" "sgld.steps=$STEPS" \
-      "sgld.step_scale=$SCALE" plot_problems=0 --run-dir "$run" > "$run.out" 2>&1 || fail "$run.out"
+      "sgld.step_scale=$SCALE" ${SGLD:+"${SGLD_ARGS[@]}"} plot_problems=0 --run-dir "$run" \
+      > "$run.out" 2>&1 || fail "$run.out"
   done
 done
 SETTINGS="$(printf '%s\n' "${settings[@]}")" \
@@ -129,7 +130,7 @@ print(f"Problems {first}-{last} of each family, GFCS with 1 batch of 20, energy 
       "not read.\n")
 for i, setting in enumerate(settings, 1):
     print(f"- `learned [loop {i}]`: the same loop trained with `{setting}` "
-          f"(`{run}_{i}/model.h5`), sampled with the shipped loop's SGLD settings")
+          f"(`{run}_{i}/model.h5`), sampled with the same SGLD settings as `learned`")
 if settings:
     print()
 print("| family | " + " | ".join(f"{n}: success / cost" for n in names) + " |")
