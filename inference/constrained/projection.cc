@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <random>
 
 #include "core/error.h"
 #include "inference/constrained/kl.h"
@@ -167,9 +168,84 @@ double Constraint(unsigned n, const double* x, double* grad, void* data) {
   return pb->c - pb->epsilon;
 }
 
+/// The feasibility phase's objective: C alone.
+double CostObjective(unsigned n, const double* x, double* grad, void* data) {
+  auto* pb = static_cast<Problem*>(data);
+  ++pb->evaluations;
+  if (!Evaluate(pb, x, n)) {
+    if (grad != nullptr) Eigen::Map<Eigen::VectorXd>(grad, n).setZero();
+    return HUGE_VAL;
+  }
+  if (grad != nullptr) Eigen::Map<Eigen::VectorXd>(grad, n) = pb->c_grad;
+  return pb->c;
+}
+
 struct OptDeleter {
   void operator()(nlopt_opt o) const { nlopt_destroy(o); }
 };
+
+/// Phase I of a projection (ProjectionOptions::feasibility_phase), run when SLSQP and its restarts
+/// found no feasible point: SLSQP's linearised steps cannot cross a wall the prior's mean runs
+/// into, while a sample of the prior may pass beside it. So weight samples W ~ MN(M, U, V) of the
+/// prior, as means with U shrunk, are evaluated first; when none meets the constraint, L-BFGS
+/// minimises C alone from the lowest-C point until C <= epsilon - tolerance. Every point goes
+/// through pb's bookkeeping. When none is feasible, the points of this phase are forgotten (an
+/// infeasible projection returns what SLSQP found, near the prior, not this phase's lowest C).
+/// True when a feasible point was found (pb->best_feasible).
+bool SeekFeasiblePoint(Problem* pb, const ComponentParams& prior, const Eigen::VectorXd& lower,
+                       const Eigen::VectorXd& upper, const ProjectionOptions& options,
+                       double seconds_left) {
+  const auto start = std::chrono::steady_clock::now();
+  const auto out_of_time = [&] {
+    return seconds_left > 0 &&
+           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() >=
+               seconds_left;
+  };
+  const unsigned n = static_cast<unsigned>(lower.size());
+  const int m = prior.basis();
+  const Eigen::VectorXd fallback = pb->fallback;
+  const double min_cost = pb->min_cost, fallback_cost = pb->fallback_cost;
+  const double fallback_kl = pb->fallback_kl;
+  const bool fallback_moved = pb->fallback_moved;
+
+  std::unique_ptr<nlopt_opt_s, OptDeleter> lbfgs(nlopt_create(NLOPT_LD_LBFGS, n));
+  if (!lbfgs) return false;
+  pb->opt = lbfgs.get();  // a failing callback stops this optimiser
+  std::mt19937_64 rng(options.feasibility_seed);
+  std::normal_distribution<double> normal;
+  const Eigen::VectorXd sd = prior.log_u.array().exp().sqrt();
+  ComponentParams sample = prior;
+  sample.log_u.array() -= options.feasibility_shrink;
+  Eigen::MatrixXd z(m, 2);
+  for (int k = 0; k < options.feasibility_samples && !pb->failed && !out_of_time(); ++k) {
+    for (int i = 0; i < m; ++i)
+      for (int j = 0; j < 2; ++j) z(i, j) = normal(rng);
+    sample.mean = prior.mean + sd.asDiagonal() * z * prior.chol_v.transpose();
+    const Eigen::VectorXd x = sample.ToVector().cwiseMax(lower).cwiseMin(upper);
+    ++pb->evaluations;
+    Evaluate(pb, x.data(), n);
+  }
+  if (!pb->have_feasible && !pb->failed && !out_of_time()) {
+    Eigen::VectorXd theta = pb->fallback;
+    nlopt_result r = nlopt_set_lower_bounds(lbfgs.get(), lower.data());
+    if (r > 0) r = nlopt_set_upper_bounds(lbfgs.get(), upper.data());
+    if (r > 0) r = nlopt_set_min_objective(lbfgs.get(), CostObjective, pb);
+    if (r > 0) r = nlopt_set_stopval(lbfgs.get(), options.epsilon - options.tolerance);
+    if (r > 0) r = nlopt_set_xtol_rel(lbfgs.get(), options.xtol_rel);
+    if (r > 0) r = nlopt_set_maxeval(lbfgs.get(), options.max_evaluations);
+    if (r > 0 && seconds_left > 0) r = nlopt_set_maxtime(lbfgs.get(), seconds_left);
+    double c = 0;
+    if (r > 0) nlopt_optimize(lbfgs.get(), theta.data(), &c);
+  }
+  if (!pb->have_feasible) {
+    pb->fallback = fallback;
+    pb->min_cost = min_cost;
+    pb->fallback_cost = fallback_cost;
+    pb->fallback_kl = fallback_kl;
+    pb->fallback_moved = fallback_moved;
+  }
+  return pb->have_feasible && !pb->failed;
+}
 
 }  // namespace
 
@@ -326,6 +402,22 @@ ProjectionSummary ProjectComponent(const ComponentParams& prior, const Constrain
     r = nlopt_optimize(opt.get(), theta.data(), &final_kl);
     if (pb.failed || r == NLOPT_FORCED_STOP || r == NLOPT_INVALID_ARGS || r == NLOPT_OUT_OF_MEMORY)
       break;
+  }
+  // Phase I, then SLSQP again from the feasible point it found.
+  if (set_up && options.feasibility_phase && !pb.have_feasible && !pb.failed &&
+      r != NLOPT_FORCED_STOP && r != NLOPT_INVALID_ARGS && r != NLOPT_OUT_OF_MEMORY &&
+      !(options.max_seconds > 0 && elapsed() >= options.max_seconds)) {
+    const double seconds_left = options.max_seconds > 0 ? options.max_seconds - elapsed() : 0;
+    const bool found = SeekFeasiblePoint(&pb, prior_copy, lower, upper, options, seconds_left);
+    pb.opt = opt.get();
+    if (found && !(options.max_seconds > 0 && elapsed() >= options.max_seconds)) {
+      theta = pb.best_feasible;
+      r = nlopt_set_maxeval(opt.get(), options.max_evaluations);
+      if (r > 0 && options.max_seconds > 0)
+        r = nlopt_set_maxtime(opt.get(), options.max_seconds - elapsed());
+      if (r > 0) r = nlopt_optimize(opt.get(), theta.data(), &final_kl);
+    }
+    if (pb.failed) r = NLOPT_FORCED_STOP;
   }
   summary.nlopt_result = ResultName(r);
   summary.evaluations = pb.evaluations;

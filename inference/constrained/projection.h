@@ -27,6 +27,15 @@ struct ProjectionOptions {
   double max_seconds = 1.0;   ///< wall-time limit per component (0: none)
   int restarts = 2;  ///< restarts from the lowest-cost point when SLSQP stops without a feasible
                      ///< one (each with max_evaluations)
+  /// When those find no feasible point: minimise C alone (L-BFGS, max_evaluations) until it meets
+  /// the constraint, then SLSQP from there (not in the thesis; only runs where SLSQP failed).
+  bool feasibility_phase = true;
+  /// Starts of that phase: this many weight samples of the prior as means, with the variances of
+  /// U divided by exp(feasibility_shrink); the lowest-KL feasible one (else the lowest-C one)
+  /// starts it. Seeded, so a projection is deterministic.
+  int feasibility_samples = 64;
+  double feasibility_shrink = 4.0;
+  unsigned feasibility_seed = 1;
 };
 
 enum class ProjectionStatus {

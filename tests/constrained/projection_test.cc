@@ -343,9 +343,11 @@ TEST(ProjectComponent, EvaluationLimitKeepsTheBestPoint) {
     ComponentParams out;
     // Each attempt (the first and every restart from the lowest-cost point) has the budget.
     const ProjectionSummary s = ProjectComponent(prior, AsFunction(h), opt, &out);
-    EXPECT_LE(s.evaluations, (opt.restarts + 1) * limit);
+    // ... and the feasibility phase its samples, L-BFGS's budget and one more SLSQP attempt.
+    EXPECT_LE(s.evaluations, (opt.restarts + 3) * limit + opt.feasibility_samples);
     ProjectionOptions once = opt;
     once.restarts = 0;
+    once.feasibility_phase = false;
     ComponentParams out_once;
     EXPECT_LE(ProjectComponent(prior, AsFunction(h), once, &out_once).evaluations, limit);
     ASSERT_TRUE(s.status == ProjectionStatus::kSolved || s.status == ProjectionStatus::kInfeasible)
@@ -359,6 +361,46 @@ TEST(ProjectComponent, EvaluationLimitKeepsTheBestPoint) {
       EXPECT_GT(s.cost, opt.epsilon + opt.tolerance);
     }
   }
+}
+
+// C has a local minimum at the prior (zero gradient, C = 0.2) and meets epsilon only in a narrow
+// well 2 units away along mean(0, 0): SLSQP and its restarts stay at the prior; the feasibility
+// phase's prior samples land in the well, and SLSQP then lowers the KL from there.
+TEST(ProjectComponent, FeasibilityPhaseLeavesALocalMinimum) {
+  const int m = 4;
+  ComponentParams prior = MakePrior(m);
+  prior.log_u.setConstant(std::log(1.5 * 1.5));
+  prior.chol_v.setIdentity();
+  const double x0 = prior.mean(0, 0);
+  const ConstraintFunction cost = [x0](const ComponentParams& p, ComponentGradient* g) {
+    const double x = p.mean(0, 0) - x0;
+    const double bump = 0.1 * std::exp(-x * x / 0.5);
+    const double well = 0.29 * std::exp(-(x - 2) * (x - 2) / 0.1);
+    if (g != nullptr) {
+      g->Resize(p.basis());
+      g->mean(0, 0) = bump * 2 * x / 0.5 + well * 2 * (x - 2) / 0.1;
+    }
+    return 0.3 - bump - well;
+  };
+  ProjectionOptions opt;
+  ComponentParams out;
+  const ProjectionSummary s = ProjectComponent(prior, cost, opt, &out);
+  ASSERT_EQ(s.status, ProjectionStatus::kSolved) << s.nlopt_result;
+  EXPECT_LE(s.cost, opt.epsilon + opt.tolerance);
+  EXPECT_NEAR(cost(out, nullptr), s.cost, 1e-12);
+  EXPECT_NEAR(MatrixNormalKl(out, prior, nullptr), s.kl, 1e-12);
+  EXPECT_NEAR(out.mean(0, 0) - x0, 2.0, 0.3);
+  // Deterministic (seeded samples).
+  ComponentParams again;
+  const ProjectionSummary s2 = ProjectComponent(prior, cost, opt, &again);
+  EXPECT_EQ(s2.kl, s.kl);
+  ExpectSameComponent(again, out);
+  // SLSQP without it ends where it started: infeasible, at the prior.
+  opt.feasibility_phase = false;
+  ComponentParams stuck;
+  const ProjectionSummary s3 = ProjectComponent(prior, cost, opt, &stuck);
+  EXPECT_EQ(s3.status, ProjectionStatus::kInfeasible);
+  EXPECT_NEAR(s3.cost, 0.2, 1e-6);
 }
 
 TEST(ProjectComponent, NonFinitePriorFails) {

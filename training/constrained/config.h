@@ -104,8 +104,9 @@ struct ConstraintConfig {
   int check_substeps = 4;        ///< midpoints per prediction step of the check operator
   int check_rounds = 3;          ///< repeated solves with a lowered target when the check fails
   int restarts = 2;  ///< SLSQP restarts from the lowest-cost point when no feasible one was found
-  int max_evaluations = 300;  ///< SLSQP objective evaluations per component
-  double max_seconds = 1.0;   ///< wall-time limit per component (s)
+  bool feasibility_phase = true;  ///< then minimise C alone and restart SLSQP from a feasible point
+  int max_evaluations = 300;      ///< SLSQP objective evaluations per component
+  double max_seconds = 1.0;       ///< wall-time limit per component (s)
 
   template <class A>
   void Serialize(A* a) {
@@ -142,6 +143,9 @@ struct ConstraintConfig {
              "repeated solves at most when the check finds the result above epsilon");
     a->Visit("restarts", &restarts, Range::Closed(0, 100),
              "SLSQP restarts from the lowest-cost point seen when it stops infeasible");
+    a->Visit("feasibility_phase", &feasibility_phase, Range::Any(),
+             "when SLSQP and its restarts find no feasible point: minimise C alone (L-BFGS) until "
+             "it is met, then SLSQP from there");
     a->Visit("max_evaluations", &max_evaluations, Range::Closed(1, 100000),
              "SLSQP evaluations per component at most");
     a->Visit("max_seconds", &max_seconds, Range::Closed(0, 3600),

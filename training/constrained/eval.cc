@@ -264,6 +264,7 @@ ProjectorOptions PlainProjectorOptions(const ExperimentConfig& c, int order) {
   po.solver.max_evaluations = c.constraint.max_evaluations;
   po.solver.max_seconds = c.constraint.max_seconds;
   po.solver.restarts = c.constraint.restarts;
+  po.solver.feasibility_phase = c.constraint.feasibility_phase;
   // The solver accepts C within its tolerance of its target; the target sits `margin` below
   // epsilon, so a tolerance below the margin keeps accepted points compliant.
   po.solver.tolerance = std::min(po.solver.tolerance, 0.5 * c.constraint.margin);
