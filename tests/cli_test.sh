@@ -131,6 +131,16 @@ for k in '"GFCS (1 batch)"' '"GF"' '"RRT-Connect"' success_rate ee_length cspace
 done
 [ "$(wc -l < "$PLAN/problems.csv")" -eq 4 ] || fail "plan problems.csv: expected a header and 3 rows"
 expect_error "already holds a run (summary.json)" plan default --run-dir "$PLAN"
+# Two draws per problem: draw 0 is the single run's (same seed), draw 1 another seed.
+"$BIN" plan default problems.synthetic_count=1 repeats=2 "methods=[{name: G, kind: gfcs}]" \
+  --run-dir "$TMP/plan_repeats" >/dev/null 2>"$TMP/plan_repeats.log" || { cat "$TMP/plan_repeats.log"; fail "plan repeats"; }
+[ "$(wc -l < "$TMP/plan_repeats/problems.csv")" -eq 3 ] || fail "plan repeats=2: expected a header and 2 rows"
+grep -q '"repeats": 2' "$TMP/plan_repeats/summary.json" || fail "plan summary.json lacks repeats"
+draw0() { awk -F, -v m="$2" '$2 == "\"" m "\"" && $NF == 0 {print $3, $4, $6, $7, $11}' "$1"; }
+[ -n "$(draw0 "$PLAN/problems.csv" "GFCS (1 batch)")" ] &&
+  [ "$(draw0 "$PLAN/problems.csv" "GFCS (1 batch)")" = "$(draw0 "$TMP/plan_repeats/problems.csv" G)" ] ||
+  fail "plan repeats: draw 0 differs from the single run"
+expect_error "repeats" plan default repeats=0 --run-dir "$TMP/plan9"
 expect_error "'manipulation' has no export step" export "$PLAN"
 expect_error "--problems: '9-3'" plan default --problems 9-3 --run-dir "$TMP/plan2"
 expect_error "problems.source" plan default problems.source=lidar --run-dir "$TMP/plan3"

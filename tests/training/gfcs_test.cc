@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <optional>
 #include <thread>
 
 #include "core/config.h"
@@ -267,6 +268,50 @@ TEST(GfcsConfig, HeldOutProblemsMayNotOverlapTheTrainingOnes) {
             "model: gfcs\ngfcs: {commands: 1}\n", "one.yaml");
       },
       {"one.yaml", "gfcs.commands"});
+}
+
+// Paired learned-minus-uniform values are per problem, each the mean over the problem's draws.
+TEST(GfcsEval, PairedDifferencesAverageEachProblemsDraws) {
+  std::vector<manipulation::PlanAttempt> attempts;
+  const auto add = [&](const char* method, int problem, int repeat, bool success, double time,
+                       std::optional<double> cost, const char* status = "solved") {
+    manipulation::PlanAttempt a;
+    a.method = method;
+    a.problem = problem;
+    a.repeat = repeat;
+    a.status = status;
+    a.metrics.success = success;
+    a.metrics.time_s = time;
+    a.gfcs_cost = cost;
+    attempts.push_back(a);
+  };
+  // Problem 1, two draws: learned solves both, uniform the first only.
+  add("U", 1, 0, true, 1.0, 3.0);
+  add("L", 1, 0, true, 2.0, 2.0);
+  add("U", 1, 1, false, 1.0, 100.0, "timeout");
+  add("L", 1, 1, true, 4.0, 5.0);
+  // Problem 2, two draws: uniform solves both, learned errors on the second (no time, no cost).
+  add("U", 2, 0, true, 1.0, 4.0);
+  add("L", 2, 0, false, 3.0, 100.0, "timeout");
+  add("U", 2, 1, true, 2.0, 6.0);
+  add("L", 2, 1, false, 0.0, std::nullopt, "error: bad");
+  // Problem 3: only uniform ran (not paired); another method is ignored.
+  add("U", 3, 0, true, 1.0, 1.0);
+  add("X", 1, 0, false, 9.0, 9.0);
+  const gfcs::PairedPerProblem p = gfcs::PairPerProblem(attempts, "U", "L");
+  ASSERT_EQ(p.success.size(), 2u);
+  EXPECT_DOUBLE_EQ(p.success[0], 0.5);   // (0 + 1) / 2
+  EXPECT_DOUBLE_EQ(p.success[1], -1.0);  // (-1 - 1) / 2
+  ASSERT_EQ(p.time.size(), 2u);
+  EXPECT_DOUBLE_EQ(p.time[0], 2.0);  // (1 + 3) / 2
+  EXPECT_DOUBLE_EQ(p.time[1], 2.0);  // the errored draw left out
+  ASSERT_EQ(p.cost.size(), 2u);
+  EXPECT_DOUBLE_EQ(p.cost[0], (-1.0 - 95.0) / 2);
+  EXPECT_DOUBLE_EQ(p.cost[1], 96.0);
+  ASSERT_EQ(p.cost_solved.size(), 1u);  // problem 1's first draw only
+  EXPECT_DOUBLE_EQ(p.cost_solved[0], -1.0);
+  EXPECT_EQ(p.only_learned, 1);
+  EXPECT_EQ(p.only_uniform, 2);
 }
 
 }  // namespace

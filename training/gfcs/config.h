@@ -129,11 +129,17 @@ struct EvalConfig {
   double resolution = 0.05;
   double max_joint_speed = 1.0;
   int plot_problems = 2;
+  /// Draws per problem (the plan harness's repeats): success rates and the paired differences
+  /// (per problem, averaged over its draws) rest on more than one draw of each sampler.
+  int repeats = 1;
 
   template <class A>
   void Serialize(A* a) {
     using config::Range;
     a->Visit("problems", &problems, Range::Any(), "held-out problem sets");
+    a->Visit("repeats", &repeats, Range::Closed(1, 1000),
+             "draws per problem and method (seeds as the plan harness's repeats); paired "
+             "differences average each problem's draws");
     a->Visit("batch_size", &batch_size, Range::Closed(2, 100000), "candidates per batch at test");
     a->Visit("batches", &batches, Range::Any(), "GFCS budgets (batches) compared");
     a->Visit("uniform_share", &uniform_share, Range::Closed(0, 1),

@@ -271,6 +271,7 @@ manipulation::ExperimentConfig EvalPlanConfig(const ExperimentConfig& c,
   mc.resolution = c.eval.resolution;
   mc.max_joint_speed = c.eval.max_joint_speed;
   mc.plot_problems = c.eval.plot_problems;
+  mc.repeats = c.eval.repeats;
   mc.energy_model = energy_model;
   mc.sgld = c.sampler;
   if (c.eval.step_scale > 0) mc.sgld.step_scale = c.eval.step_scale;  // chosen on validation
@@ -330,6 +331,49 @@ std::string ExportRun(const std::string& run_dir) {
   return path;
 }
 
+PairedPerProblem PairPerProblem(const std::vector<manipulation::PlanAttempt>& attempts,
+                                const std::string& uniform, const std::string& learned) {
+  using Pair = std::pair<const manipulation::PlanAttempt*, const manipulation::PlanAttempt*>;
+  std::map<int, std::map<int, Pair>> by_problem;  // problem -> draw -> (uniform, learned)
+  for (const manipulation::PlanAttempt& a : attempts) {
+    if (a.method == uniform) by_problem[a.problem][a.repeat].first = &a;
+    if (a.method == learned) by_problem[a.problem][a.repeat].second = &a;
+  }
+  const auto errored = [](const manipulation::PlanAttempt& a) {
+    return a.status.rfind("error", 0) == 0;
+  };
+  struct Mean {
+    double sum = 0;
+    int n = 0;
+    void Add(double v) { sum += v, ++n; }
+    void Into(std::vector<double>* out) const {
+      if (n > 0) out->push_back(sum / n);
+    }
+  };
+  PairedPerProblem out;
+  for (const auto& [problem, draws] : by_problem) {
+    Mean success, time, cost, cost_solved;
+    for (const auto& [repeat, pair] : draws) {
+      if (!pair.first || !pair.second) continue;
+      const bool su = pair.first->metrics.success, sl = pair.second->metrics.success;
+      out.only_learned += sl && !su;
+      out.only_uniform += su && !sl;
+      success.Add(static_cast<double>(sl) - static_cast<double>(su));
+      if (!errored(*pair.first) && !errored(*pair.second))
+        time.Add(pair.second->metrics.time_s - pair.first->metrics.time_s);
+      if (pair.first->gfcs_cost && pair.second->gfcs_cost) {
+        cost.Add(*pair.second->gfcs_cost - *pair.first->gfcs_cost);
+        if (su && sl) cost_solved.Add(*pair.second->gfcs_cost - *pair.first->gfcs_cost);
+      }
+    }
+    success.Into(&out.success);
+    time.Into(&out.time);
+    cost.Into(&out.cost);
+    cost_solved.Into(&out.cost_solved);
+  }
+  return out;
+}
+
 std::string EvaluateRun(const ExperimentConfig& c, const std::string& run_dir) {
   const std::string artifact = run_dir + "/" + kGfcsArtifact;
   FS_THROW_UNLESS(fs::exists(artifact), run_dir, ": no ", kGfcsArtifact,
@@ -346,6 +390,7 @@ std::string EvaluateRun(const ExperimentConfig& c, const std::string& run_dir) {
         manipulation::RunPlanExperiment(EvalPlanConfig(c, set, artifact), dir);
     os << "    {\"set\": " << JsonString(SetName(set)) << ", \"first\": " << set.first
        << ", \"last\": " << set.last << ", \"problems\": " << report.problems
+       << ", \"repeats\": " << c.eval.repeats
        << ", \"invalid_problems\": " << report.invalid_problems.size()
        << ",\n     \"methods\": [\n";
     for (std::size_t m = 0; m < report.methods.size(); ++m)
@@ -358,33 +403,7 @@ std::string EvaluateRun(const ExperimentConfig& c, const std::string& run_dir) {
       for (std::size_t b = 0; b < c.eval.batches.size(); ++b) {
         const std::string uni = "GFCS uniform (" + BudgetLabel(c.eval.batches[b]) + ")";
         const std::string lea = variant + " (" + BudgetLabel(c.eval.batches[b]) + ")";
-        std::map<int, std::pair<const manipulation::PlanAttempt*, const manipulation::PlanAttempt*>>
-            by_problem;
-        for (const manipulation::PlanAttempt& a : report.attempts) {
-          if (a.method == uni) by_problem[a.problem].first = &a;
-          if (a.method == lea) by_problem[a.problem].second = &a;
-        }
-        // Pairs: every problem both ran; times only where neither errored (an error takes no
-        // time); cost_s over all pairs mixes the penalty of unsolved problems in,
-        // cost_both_solved_s not.
-        std::vector<double> cost, cost_solved, time, success;
-        int only_learned = 0, only_uniform = 0;
-        const auto errored = [](const manipulation::PlanAttempt& a) {
-          return a.status.rfind("error", 0) == 0;
-        };
-        for (const auto& [problem, pair] : by_problem) {
-          if (!pair.first || !pair.second) continue;
-          const bool su = pair.first->metrics.success, sl = pair.second->metrics.success;
-          only_learned += sl && !su;
-          only_uniform += su && !sl;
-          success.push_back(static_cast<double>(sl) - static_cast<double>(su));
-          if (!errored(*pair.first) && !errored(*pair.second))
-            time.push_back(pair.second->metrics.time_s - pair.first->metrics.time_s);
-          if (pair.first->gfcs_cost && pair.second->gfcs_cost) {
-            cost.push_back(*pair.second->gfcs_cost - *pair.first->gfcs_cost);
-            if (su && sl) cost_solved.push_back(cost.back());
-          }
-        }
+        const PairedPerProblem pairs = PairPerProblem(report.attempts, uni, lea);
         const std::uint64_t seed = static_cast<std::uint64_t>(c.seed) + 1000 * i + 10 * b;
         const auto stat = [&](const char* name, const std::vector<double>& d, int k) {
           const PairedDifference p = Bootstrap(d, seed + k);
@@ -392,11 +411,12 @@ std::string EvaluateRun(const ExperimentConfig& c, const std::string& run_dir) {
                  ", \"mean\": " + Num(p.mean) + ", \"ci95\": [" + Num(p.lo) + ", " + Num(p.hi) +
                  "]";
         };
-        os << "       {\"batches\": " << c.eval.batches[b] << ", " << stat("cost_s", cost, 0)
-           << "}, " << stat("cost_both_solved_s", cost_solved, 1) << "}, "
-           << stat("solve_time_s", time, 2) << "}, " << stat("success", success, 3)
-           << ", \"only_learned\": " << only_learned << ", \"only_uniform\": " << only_uniform
-           << "}}" << (b + 1 < c.eval.batches.size() ? "," : "") << "\n";
+        os << "       {\"batches\": " << c.eval.batches[b] << ", " << stat("cost_s", pairs.cost, 0)
+           << "}, " << stat("cost_both_solved_s", pairs.cost_solved, 1) << "}, "
+           << stat("solve_time_s", pairs.time, 2) << "}, " << stat("success", pairs.success, 3)
+           << ", \"only_learned\": " << pairs.only_learned
+           << ", \"only_uniform\": " << pairs.only_uniform << "}}"
+           << (b + 1 < c.eval.batches.size() ? "," : "") << "\n";
       }
     };
     paired("learned_minus_uniform", "GFCS learned");

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "training/gfcs/config.h"
+#include "training/manipulation/plan.h"
 
 namespace foresight::gfcs {
 
@@ -24,6 +25,18 @@ bool TrainRun(const ExperimentConfig& c, const std::string& run_dir, bool resume
 
 /// Writes run_dir/model.h5 from the loop's last checkpoint. @return its path.
 std::string ExportRun(const std::string& run_dir);
+
+/// Paired learned-minus-uniform differences, one value per problem: the mean over the problem's
+/// draws (PlanAttempt::repeat) that both methods ran. success over every pair; time_s where
+/// neither errored (an error takes no time); cost where both have a GFCOP cost (the penalty of an
+/// unsolved problem included), cost_solved where both also solved. The draws of a problem are not
+/// independent samples of the problem set, so intervals resample these per-problem values.
+struct PairedPerProblem {
+  std::vector<double> success, time, cost, cost_solved;
+  int only_learned = 0, only_uniform = 0;  ///< draws solved by one of the two only
+};
+PairedPerProblem PairPerProblem(const std::vector<manipulation::PlanAttempt>& attempts,
+                                const std::string& uniform, const std::string& learned);
 
 /// Held-out evaluation of run_dir/model.h5: run_dir/eval/<set>/ (the plan harness's files) and
 /// run_dir/eval.json (per family and method: success, lengths, LDJ, times; the learned-minus-

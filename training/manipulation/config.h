@@ -117,6 +117,10 @@ struct ReactivityConfig {
 /// and 5 batches), plus RRT-Connect (VAMP's published reference on these problems).
 std::vector<PlanMethodConfig> DefaultPlanMethods();
 
+/// Seed offset between the draws of one problem (ExperimentConfig::repeats); a prime, far beyond
+/// any problem index.
+inline constexpr std::int64_t kRepeatSeedStride = 1000003;
+
 struct ExperimentConfig {
   std::string model = "manipulation";
   std::int64_t seed = 0;
@@ -130,7 +134,11 @@ struct ExperimentConfig {
   double resolution = 0.05;      ///< rad, C-space step of the path validity checks (every method)
   double max_joint_speed = 1.0;  ///< rad/s, timing of planner paths (metrics)
   ReactivityConfig reactivity;
-  int plot_problems = 3;          ///< problems drawn in ee_paths.png
+  int plot_problems = 3;  ///< problems drawn in ee_paths.png
+  /// Draws per problem: every method runs `repeats` times on each problem, draw r with the seed
+  /// seed + i + r kRepeatSeedStride (draw 0 is the single run's), so success rates of randomised
+  /// methods are estimated from more than one draw. Reactivity and pictures use draw 0.
+  int repeats = 1;
   std::string energy_model;       ///< artifact of the learned sampler (a gfcs run's model.h5)
   manipulation::SgldParams sgld;  ///< the learned sampler's SGLD
 
@@ -152,6 +160,9 @@ struct ExperimentConfig {
     a->Visit("reactivity", &reactivity, config::Range::Any(), "obstacles added on solved paths");
     a->Visit("plot_problems", &plot_problems, config::Range::Closed(0, 100),
              "problems drawn in ee_paths.png");
+    a->Visit("repeats", &repeats, config::Range::Closed(1, 1000),
+             "draws per problem and method (draw r seeded seed + i + r * 1000003; 0: the single "
+             "run's)");
     a->Visit("energy_model", &energy_model, config::Range::Any(),
              "artifact of the learned sampler (a gfcs run's model.h5; methods with sampler: "
              "learned)");

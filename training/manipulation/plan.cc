@@ -172,13 +172,13 @@ std::string CsvNumber(const std::optional<double>& v) {
 void WriteProblemsCsv(const std::string& path, const PlanReport& report) {
   std::ostringstream os;
   os << "problem,method,status,success,time_s,ee_length,cspace_length,duration_s,ee_ldj,"
-        "cspace_ldj,gfcs_cost\n";
+        "cspace_ldj,gfcs_cost,repeat\n";
   for (const PlanAttempt& a : report.attempts) {
     const PathMetrics& m = a.metrics;
     os << a.problem << ",\"" << a.method << "\"," << a.status << "," << (m.success ? 1 : 0) << ","
        << m.time_s << "," << CsvNumber(m.ee_length) << "," << CsvNumber(m.cspace_length) << ","
        << CsvNumber(m.duration_s) << "," << CsvNumber(m.ee_ldj.value) << ","
-       << CsvNumber(m.cspace_ldj.value) << "," << CsvNumber(a.gfcs_cost) << "\n";
+       << CsvNumber(m.cspace_ldj.value) << "," << CsvNumber(a.gfcs_cost) << "," << a.repeat << "\n";
   }
   WriteFileAtomically(path, os.str());
 }
@@ -188,7 +188,8 @@ void WriteSummaryJson(const std::string& path, const ExperimentConfig& c,
   std::ostringstream os;
   os << "{\n  \"family\": \""
      << (c.problems.source == ProblemSource::kSynthetic ? "synthetic" : c.problems.family)
-     << "\",\n  \"problems\": " << report.problems << ",\n  \"invalid_problems\": [";
+     << "\",\n  \"problems\": " << report.problems << ",\n  \"repeats\": " << c.repeats
+     << ",\n  \"invalid_problems\": [";
   for (std::size_t i = 0; i < report.invalid_problems.size(); ++i)
     os << (i ? ", " : "") << report.invalid_problems[i];
   os << "],\n  \"methods\": [\n";
@@ -304,103 +305,108 @@ PlanReport RunPlanExperiment(const ExperimentConfig& c, const std::string& run_d
       continue;
     }
     const Fabric fabric(robot, problem.world, c.fabric);
-    const std::uint64_t seed = static_cast<std::uint64_t>(c.seed + problem.index);
     PlanProblemPicture picture;
     picture.problem = problem.index;
     picture.world = &problem.world;
     std::ostringstream line;
     line << "problem " << problem.index << ":";
-    for (std::size_t m = 0; m < c.methods.size(); ++m) {
-      const PlanMethodConfig& method = c.methods[m];
-      Trajectory t;
-      GfcsCandidate best;
-      std::optional<double> attempt_cost;
-      try {
-        switch (method.kind) {
-          case PlanMethodKind::kGfcs: {
-            CommandSampler* sampler = &uniform;
-            double encode_s = 0;  // the world's encoding is part of the learned method's time
-            if (learned[m]) {
-              const auto started = bench::Clock::now();
-              learned[m]->SetWorld(problem.world);
-              encode_s = bench::SecondsSince(started);
-              sampler = &*learned[m];
+    for (int repeat = 0; repeat < c.repeats; ++repeat) {
+      const std::uint64_t seed =
+          static_cast<std::uint64_t>(c.seed + problem.index + repeat * kRepeatSeedStride);
+      if (c.repeats > 1) line << (repeat ? " |" : "") << " draw " << repeat << ":";
+      for (std::size_t m = 0; m < c.methods.size(); ++m) {
+        const PlanMethodConfig& method = c.methods[m];
+        Trajectory t;
+        GfcsCandidate best;
+        std::optional<double> attempt_cost;
+        try {
+          switch (method.kind) {
+            case PlanMethodKind::kGfcs: {
+              CommandSampler* sampler = &uniform;
+              double encode_s = 0;  // the world's encoding is part of the learned method's time
+              if (learned[m]) {
+                const auto started = bench::Clock::now();
+                learned[m]->SetWorld(problem.world);
+                encode_s = bench::SecondsSince(started);
+                sampler = &*learned[m];
+              }
+              t = RunGfcs(fabric, problem, c, method, sampler, seed, &best);
+              t.generation_time_s += encode_s;
+              t.encode_s = encode_s;
+              attempt_cost = best.commands.size() ? best.cost : std::optional<double>();
+              break;
             }
-            t = RunGfcs(fabric, problem, c, method, sampler, seed, &best);
-            t.generation_time_s += encode_s;
-            t.encode_s = encode_s;
-            attempt_cost = best.commands.size() ? best.cost : std::optional<double>();
-            break;
+            case PlanMethodKind::kFabric:
+              t = RunFabric(fabric, problem);
+              break;
+            case PlanMethodKind::kBiEst:
+              t = RunPlanner(PlannerKind::kBiEst, checker, problem, c, method, seed);
+              break;
+            case PlanMethodKind::kBitStar:
+              t = RunPlanner(PlannerKind::kBitStar, checker, problem, c, method, seed);
+              break;
+            case PlanMethodKind::kRrtConnect:
+              t = RunPlanner(PlannerKind::kRrtConnect, checker, problem, c, method, seed);
+              break;
           }
-          case PlanMethodKind::kFabric:
-            t = RunFabric(fabric, problem);
-            break;
-          case PlanMethodKind::kBiEst:
-            t = RunPlanner(PlannerKind::kBiEst, checker, problem, c, method, seed);
-            break;
-          case PlanMethodKind::kBitStar:
-            t = RunPlanner(PlannerKind::kBitStar, checker, problem, c, method, seed);
-            break;
-          case PlanMethodKind::kRrtConnect:
-            t = RunPlanner(PlannerKind::kRrtConnect, checker, problem, c, method, seed);
-            break;
+        } catch (const std::exception& e) {
+          t = Trajectory{};
+          t.status = std::string("error: ") + e.what();
         }
-      } catch (const std::exception& e) {
-        t = Trajectory{};
-        t.status = std::string("error: ") + e.what();
-      }
-      PlanAttempt attempt;
-      attempt.method = method.name;
-      attempt.problem = problem.index;
-      attempt.status = t.status;
-      attempt.gfcs_cost = attempt_cost;
-      if (t.reached) {
-        const std::string verdict = JudgePath(t.joints, problem.goal, checker, c.resolution,
-                                              c.fabric.goal_tolerance + 1e-9);
-        if (!verdict.empty()) {
-          t.reached = false;
-          attempt.status = verdict;
+        PlanAttempt attempt;
+        attempt.method = method.name;
+        attempt.problem = problem.index;
+        attempt.repeat = repeat;
+        attempt.status = t.status;
+        attempt.gfcs_cost = attempt_cost;
+        if (t.reached) {
+          const std::string verdict = JudgePath(t.joints, problem.goal, checker, c.resolution,
+                                                c.fabric.goal_tolerance + 1e-9);
+          if (!verdict.empty()) {
+            t.reached = false;
+            attempt.status = verdict;
+          }
         }
-      }
-      if (t.reached) {
-        attempt.ee_path = EndEffectorPath(t.joints, ee);
-        attempt.metrics = EvaluatePath(t.joints, attempt.ee_path, t.generation_time_s);
-        attempt.metrics.success = true;
-      } else {
-        attempt.metrics = PathMetrics::Failure(t.generation_time_s);
-      }
-      line << " " << method.name << "=" << attempt.status;
-      per_method[m].push_back(attempt.metrics);
-      for (int k = 0; k < kRolloutStatusCount; ++k) candidate_statuses[m][k] += t.candidates[k];
-      work[m].steps += t.steps;
-      work[m].stalled += t.stalled;
-      if (method.kind == PlanMethodKind::kGfcs) {
-        times[m].total.push_back(t.generation_time_s);
-        times[m].encode.push_back(t.encode_s);
-        times[m].sample.push_back(t.sample_s);
-      }
+        if (t.reached) {
+          attempt.ee_path = EndEffectorPath(t.joints, ee);
+          attempt.metrics = EvaluatePath(t.joints, attempt.ee_path, t.generation_time_s);
+          attempt.metrics.success = true;
+        } else {
+          attempt.metrics = PathMetrics::Failure(t.generation_time_s);
+        }
+        line << " " << method.name << "=" << attempt.status;
+        per_method[m].push_back(attempt.metrics);
+        for (int k = 0; k < kRolloutStatusCount; ++k) candidate_statuses[m][k] += t.candidates[k];
+        work[m].steps += t.steps;
+        work[m].stalled += t.stalled;
+        if (method.kind == PlanMethodKind::kGfcs) {
+          times[m].total.push_back(t.generation_time_s);
+          times[m].encode.push_back(t.encode_s);
+          times[m].sample.push_back(t.sample_s);
+        }
 
-      // Reactivity: GFCS's commands re-run by the fabric with obstacles on the solved path.
-      if (c.reactivity.enabled && static_cast<int>(m) == reactive_method &&
-          attempt.metrics.success) {
-        World changed = problem.world;
-        std::mt19937_64 rng(seed);
-        if (AddObstaclesOnPath(attempt.ee_path, c.fabric.dt, c.reactivity, checker, problem.start,
-                               &rng, &changed)) {
-          const Fabric reactive(robot, changed, c.fabric);
-          FabricWorkspace ws = reactive.MakeWorkspace();
-          GfcsQuery query;
-          query.start = problem.start;
-          query.goal = problem.goal;
-          const GfcsCandidate again =
-              EvaluateCommandSequence(reactive, query, best.commands, c.gfcs.penalty, &ws);
-          ++report.reactivity_trials;
-          report.reactivity_successes += again.reached;
+        // Reactivity: GFCS's commands re-run by the fabric with obstacles on the solved path.
+        if (c.reactivity.enabled && repeat == 0 && static_cast<int>(m) == reactive_method &&
+            attempt.metrics.success) {
+          World changed = problem.world;
+          std::mt19937_64 rng(seed);
+          if (AddObstaclesOnPath(attempt.ee_path, c.fabric.dt, c.reactivity, checker, problem.start,
+                                 &rng, &changed)) {
+            const Fabric reactive(robot, changed, c.fabric);
+            FabricWorkspace ws = reactive.MakeWorkspace();
+            GfcsQuery query;
+            query.start = problem.start;
+            query.goal = problem.goal;
+            const GfcsCandidate again =
+                EvaluateCommandSequence(reactive, query, best.commands, c.gfcs.penalty, &ws);
+            ++report.reactivity_trials;
+            report.reactivity_successes += again.reached;
+          }
         }
+        if (repeat == 0 && static_cast<int>(pictures.size()) < c.plot_problems)
+          picture.paths.push_back({method.name, attempt.ee_path});
+        report.attempts.push_back(std::move(attempt));
       }
-      if (static_cast<int>(pictures.size()) < c.plot_problems)
-        picture.paths.push_back({method.name, attempt.ee_path});
-      report.attempts.push_back(std::move(attempt));
     }
     log::Info(line.str());
     if (static_cast<int>(pictures.size()) < c.plot_problems) pictures.push_back(picture);

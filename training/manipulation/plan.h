@@ -33,6 +33,7 @@ std::vector<manipulation::ManipulationProblem> LoadExperimentProblems(
 struct PlanAttempt {
   std::string method;
   int problem = 0;
+  int repeat = 0;      ///< the draw (ExperimentConfig::repeats), 0 for a single run
   std::string status;  ///< solved, or why not (timeout, collision, invalid_path, planner status)
   manipulation::PathMetrics metrics;
   Eigen::Matrix3Xd ee_path;         ///< end-effector positions of the trajectory (empty on failure)
