@@ -147,37 +147,22 @@ bool Evaluate(Problem* pb, const double* x, unsigned n) {
   return true;
 }
 
-double Objective(unsigned n, const double* x, double* grad, void* data) {
-  auto* pb = static_cast<Problem*>(data);
-  ++pb->evaluations;
-  if (!Evaluate(pb, x, n)) {
-    if (grad != nullptr) Eigen::Map<Eigen::VectorXd>(grad, n).setZero();
-    return HUGE_VAL;
-  }
-  if (grad != nullptr) Eigen::Map<Eigen::VectorXd>(grad, n) = pb->kl_grad;
-  return pb->kl;
-}
+/// The NLopt callbacks, one per value of the evaluated point: the KL (SLSQP's objective, counted
+/// as an evaluation), C - epsilon (its constraint) and C (the feasibility phase's objective).
+enum class Value { kKl, kConstraint, kCost };
 
-double Constraint(unsigned n, const double* x, double* grad, void* data) {
+template <Value kValue>
+double Callback(unsigned n, const double* x, double* grad, void* data) {
   auto* pb = static_cast<Problem*>(data);
+  if (kValue != Value::kConstraint) ++pb->evaluations;
   if (!Evaluate(pb, x, n)) {
     if (grad != nullptr) Eigen::Map<Eigen::VectorXd>(grad, n).setZero();
     return HUGE_VAL;
   }
-  if (grad != nullptr) Eigen::Map<Eigen::VectorXd>(grad, n) = pb->c_grad;
-  return pb->c - pb->epsilon;
-}
-
-/// The feasibility phase's objective: C alone.
-double CostObjective(unsigned n, const double* x, double* grad, void* data) {
-  auto* pb = static_cast<Problem*>(data);
-  ++pb->evaluations;
-  if (!Evaluate(pb, x, n)) {
-    if (grad != nullptr) Eigen::Map<Eigen::VectorXd>(grad, n).setZero();
-    return HUGE_VAL;
-  }
-  if (grad != nullptr) Eigen::Map<Eigen::VectorXd>(grad, n) = pb->c_grad;
-  return pb->c;
+  const bool kl = kValue == Value::kKl;
+  if (grad != nullptr) Eigen::Map<Eigen::VectorXd>(grad, n) = kl ? pb->kl_grad : pb->c_grad;
+  if (kl) return pb->kl;
+  return kValue == Value::kConstraint ? pb->c - pb->epsilon : pb->c;
 }
 
 struct OptDeleter {
@@ -229,7 +214,7 @@ bool SeekFeasiblePoint(Problem* pb, const ComponentParams& prior, const Eigen::V
     Eigen::VectorXd theta = pb->fallback;
     nlopt_result r = nlopt_set_lower_bounds(lbfgs.get(), lower.data());
     if (r > 0) r = nlopt_set_upper_bounds(lbfgs.get(), upper.data());
-    if (r > 0) r = nlopt_set_min_objective(lbfgs.get(), CostObjective, pb);
+    if (r > 0) r = nlopt_set_min_objective(lbfgs.get(), Callback<Value::kCost>, pb);
     if (r > 0) r = nlopt_set_stopval(lbfgs.get(), options.epsilon - options.tolerance);
     if (r > 0) r = nlopt_set_xtol_rel(lbfgs.get(), options.xtol_rel);
     if (r > 0) r = nlopt_set_maxeval(lbfgs.get(), options.max_evaluations);
@@ -379,8 +364,10 @@ ProjectionSummary ProjectComponent(const ComponentParams& prior, const Constrain
   theta = theta.cwiseMax(lower).cwiseMin(upper);
   nlopt_result r = nlopt_set_lower_bounds(opt.get(), lower.data());
   if (r > 0) r = nlopt_set_upper_bounds(opt.get(), upper.data());
-  if (r > 0) r = nlopt_set_min_objective(opt.get(), Objective, &pb);
-  if (r > 0) r = nlopt_add_inequality_constraint(opt.get(), Constraint, &pb, options.tolerance);
+  if (r > 0) r = nlopt_set_min_objective(opt.get(), Callback<Value::kKl>, &pb);
+  if (r > 0)
+    r = nlopt_add_inequality_constraint(opt.get(), Callback<Value::kConstraint>, &pb,
+                                        options.tolerance);
   if (r > 0) r = nlopt_set_xtol_rel(opt.get(), options.xtol_rel);
   if (r > 0) r = nlopt_set_maxeval(opt.get(), options.max_evaluations);
   if (r > 0 && options.max_seconds > 0) r = nlopt_set_maxtime(opt.get(), options.max_seconds);
