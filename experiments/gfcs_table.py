@@ -40,6 +40,10 @@ def main():
         print("Rows 'GFCS learned + N % uniform': the run's eval.uniform_share (e.g. "
               "`experiments/gfcs.sh eval.uniform_share=0.25`), a variant evaluated beside the "
               "thesis's sampler; results/gfcs_select.md says whether validation adopted it.\n")
+    repeats = max(st.get("repeats", 1) for st in j["sets"])
+    if repeats > 1:
+        print(f"Every method drew {repeats} times per problem (eval.repeats): success counts are "
+              "over problems x draws; paired differences average each problem's draws.\n")
     loop = j.get("loop") or {}
     if loop:
         print(f"Loop: {loop['solved']}/{loop['solves']} training solves succeeded, "
