@@ -96,11 +96,12 @@ struct Problem {
   // Returned on kInfeasible: the lowest-KL point among those whose C is within `tolerance` of the
   // lowest C seen (the prior at the start), so that a flat constraint does not drag it far away.
   double tolerance = 0;
-  double min_cost = 0;
-  bool fallback_moved = false;
-  Eigen::VectorXd fallback;
-  double fallback_cost = 0;
-  double fallback_kl = 0;
+  struct Fallback {
+    double min_cost = 0;  // lowest C seen
+    bool moved = false;   // x is not the prior
+    Eigen::VectorXd x;
+    double cost = 0, kl = 0;
+  } fallback;
 };
 
 /// Evaluates KL and C (with gradients) at x unless cached. False after a failure (exception or a
@@ -136,13 +137,14 @@ bool Evaluate(Problem* pb, const double* x, unsigned n) {
     pb->best_feasible_kl = pb->kl;
     pb->best_feasible_cost = pb->c;
   }
-  pb->min_cost = std::min(pb->min_cost, pb->c);
-  const bool fallback_stale = pb->fallback_cost > pb->min_cost + pb->tolerance;
-  if (pb->c <= pb->min_cost + pb->tolerance && (fallback_stale || pb->kl < pb->fallback_kl)) {
-    pb->fallback_moved = true;
-    pb->fallback = pb->x;
-    pb->fallback_cost = pb->c;
-    pb->fallback_kl = pb->kl;
+  pb->fallback.min_cost = std::min(pb->fallback.min_cost, pb->c);
+  const bool fallback_stale = pb->fallback.cost > pb->fallback.min_cost + pb->tolerance;
+  if (pb->c <= pb->fallback.min_cost + pb->tolerance &&
+      (fallback_stale || pb->kl < pb->fallback.kl)) {
+    pb->fallback.moved = true;
+    pb->fallback.x = pb->x;
+    pb->fallback.cost = pb->c;
+    pb->fallback.kl = pb->kl;
   }
   return true;
 }
@@ -188,10 +190,7 @@ bool SeekFeasiblePoint(Problem* pb, const ComponentParams& prior, const Eigen::V
   };
   const unsigned n = static_cast<unsigned>(lower.size());
   const int m = prior.basis();
-  const Eigen::VectorXd fallback = pb->fallback;
-  const double min_cost = pb->min_cost, fallback_cost = pb->fallback_cost;
-  const double fallback_kl = pb->fallback_kl;
-  const bool fallback_moved = pb->fallback_moved;
+  const Problem::Fallback fallback = pb->fallback;
 
   std::unique_ptr<nlopt_opt_s, OptDeleter> lbfgs(nlopt_create(NLOPT_LD_LBFGS, n));
   if (!lbfgs) return false;
@@ -211,7 +210,7 @@ bool SeekFeasiblePoint(Problem* pb, const ComponentParams& prior, const Eigen::V
     Evaluate(pb, x.data(), n);
   }
   if (!pb->have_feasible && !pb->failed && !out_of_time()) {
-    Eigen::VectorXd theta = pb->fallback;
+    Eigen::VectorXd theta = pb->fallback.x;
     nlopt_result r = nlopt_set_lower_bounds(lbfgs.get(), lower.data());
     if (r > 0) r = nlopt_set_upper_bounds(lbfgs.get(), upper.data());
     if (r > 0) r = nlopt_set_min_objective(lbfgs.get(), Callback<Value::kCost>, pb);
@@ -222,13 +221,7 @@ bool SeekFeasiblePoint(Problem* pb, const ComponentParams& prior, const Eigen::V
     double c = 0;
     if (r > 0) nlopt_optimize(lbfgs.get(), theta.data(), &c);
   }
-  if (!pb->have_feasible) {
-    pb->fallback = fallback;
-    pb->min_cost = min_cost;
-    pb->fallback_cost = fallback_cost;
-    pb->fallback_kl = fallback_kl;
-    pb->fallback_moved = fallback_moved;
-  }
+  if (!pb->have_feasible) pb->fallback = fallback;
   return pb->have_feasible && !pb->failed;
 }
 
@@ -328,18 +321,18 @@ ProjectionSummary ProjectComponent(const ComponentParams& prior, const Constrain
   pb.feasible_limit = options.epsilon + options.tolerance;
   pb.work.Resize(m);
   pb.tolerance = options.tolerance;
-  pb.min_cost = summary.prior_cost;
-  pb.fallback = theta;
-  pb.fallback_cost = summary.prior_cost;
-  pb.fallback_kl = 0;
+  pb.fallback.min_cost = summary.prior_cost;
+  pb.fallback.x = theta;
+  pb.fallback.cost = summary.prior_cost;
+  pb.fallback.kl = 0;
   if (use_start) {
     theta = start_copy.ToVector();
-    if (start_cost < pb.min_cost) {
-      pb.min_cost = start_cost;
-      pb.fallback = theta;
-      pb.fallback_cost = start_cost;
-      pb.fallback_kl = start_kl;
-      pb.fallback_moved = true;
+    if (start_cost < pb.fallback.min_cost) {
+      pb.fallback.min_cost = start_cost;
+      pb.fallback.x = theta;
+      pb.fallback.cost = start_cost;
+      pb.fallback.kl = start_kl;
+      pb.fallback.moved = true;
     }
     if (start_cost <= pb.feasible_limit) {
       pb.have_feasible = true;
@@ -372,6 +365,16 @@ ProjectionSummary ProjectComponent(const ComponentParams& prior, const Constrain
   if (r > 0) r = nlopt_set_maxeval(opt.get(), options.max_evaluations);
   if (r > 0 && options.max_seconds > 0) r = nlopt_set_maxtime(opt.get(), options.max_seconds);
   double final_kl = 0;
+  const auto out_of_time = [&] {
+    return options.max_seconds > 0 && elapsed() >= options.max_seconds;
+  };
+  // A fresh evaluation budget for another SLSQP attempt, within what is left of max_seconds.
+  const auto renew_budget = [&] {
+    nlopt_result b = nlopt_set_maxeval(opt.get(), options.max_evaluations);
+    if (b > 0 && options.max_seconds > 0)
+      b = nlopt_set_maxtime(opt.get(), options.max_seconds - elapsed());
+    return b;
+  };
   // SLSQP may stop without a feasible point (a line search that cannot make progress from where
   // the linearisation led it); it then restarts from the lowest-cost point seen, each attempt with
   // max_evaluations, all within max_seconds.
@@ -379,11 +382,9 @@ ProjectionSummary ProjectComponent(const ComponentParams& prior, const Constrain
   for (int attempt = 0; set_up && attempt <= options.restarts; ++attempt) {
     if (attempt > 0) {
       if (pb.have_feasible || pb.failed) break;
-      if (options.max_seconds > 0 && elapsed() >= options.max_seconds) break;
-      theta = pb.fallback;
-      r = nlopt_set_maxeval(opt.get(), options.max_evaluations);
-      if (r > 0 && options.max_seconds > 0)
-        r = nlopt_set_maxtime(opt.get(), options.max_seconds - elapsed());
+      if (out_of_time()) break;
+      theta = pb.fallback.x;
+      r = renew_budget();
       if (r <= 0) break;  // a setter failed: judged below like any other stop
     }
     r = nlopt_optimize(opt.get(), theta.data(), &final_kl);
@@ -393,15 +394,13 @@ ProjectionSummary ProjectComponent(const ComponentParams& prior, const Constrain
   // Phase I, then SLSQP again from the feasible point it found.
   if (set_up && options.feasibility_phase && !pb.have_feasible && !pb.failed &&
       r != NLOPT_FORCED_STOP && r != NLOPT_INVALID_ARGS && r != NLOPT_OUT_OF_MEMORY &&
-      !(options.max_seconds > 0 && elapsed() >= options.max_seconds)) {
+      !out_of_time()) {
     const double seconds_left = options.max_seconds > 0 ? options.max_seconds - elapsed() : 0;
     const bool found = SeekFeasiblePoint(&pb, prior_copy, lower, upper, options, seconds_left);
     pb.opt = opt.get();
-    if (found && !(options.max_seconds > 0 && elapsed() >= options.max_seconds)) {
+    if (found && !out_of_time()) {
       theta = pb.best_feasible;
-      r = nlopt_set_maxeval(opt.get(), options.max_evaluations);
-      if (r > 0 && options.max_seconds > 0)
-        r = nlopt_set_maxtime(opt.get(), options.max_seconds - elapsed());
+      r = renew_budget();
       if (r > 0) r = nlopt_optimize(opt.get(), theta.data(), &final_kl);
     }
     if (pb.failed) r = NLOPT_FORCED_STOP;
@@ -423,11 +422,11 @@ ProjectionSummary ProjectComponent(const ComponentParams& prior, const Constrain
       summary.cost = pb.best_feasible_cost;
       *out = ComponentParams::FromVector(pb.best_feasible, m);
     } else {
-      if (!pb.fallback_moved) return finish_with_prior(ProjectionStatus::kInfeasible);
+      if (!pb.fallback.moved) return finish_with_prior(ProjectionStatus::kInfeasible);
       summary.status = ProjectionStatus::kInfeasible;
-      summary.kl = pb.fallback_kl;
-      summary.cost = pb.fallback_cost;
-      *out = ComponentParams::FromVector(pb.fallback, m);
+      summary.kl = pb.fallback.kl;
+      summary.cost = pb.fallback.cost;
+      *out = ComponentParams::FromVector(pb.fallback.x, m);
     }
   } catch (...) {  // not reached: every stored point was finite when evaluated
     return finish_with_prior(ProjectionStatus::kFailed);
