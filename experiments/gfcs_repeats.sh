@@ -5,7 +5,9 @@
 # REPEATS times per problem (seeds as `plan repeats=`; draw 0 is the single evaluation's), the
 # learned sampler at the shipped test step scale. One draw per problem moves a family's count by
 # several problems; the draws separate the sampler's effect from that noise. The loops are not
-# re-run: only their model.h5 and config.yaml are read. About 3 min per run on 2 cores.
+# re-run: only their model.h5 and config.yaml are read. About 3 min per run on 2 cores. A model
+# whose artifact holds the loop's solution memory (loops of this build) also gets the
+# nearest-neighbour sampler's rows (eval.nearest).
 #   experiments/gfcs_repeats.sh                          (runs/gfcs_all, gfcs_seed_1, gfcs_seed_2)
 #   RUNS="runs/gfcs_all" REPEATS=20 experiments/gfcs_repeats.sh
 # Writes runs/gfcs_repeats/<run>/ and results/gfcs_repeats.md.
@@ -25,8 +27,11 @@ for run in $RUNS; do
   mkdir -p "$out"
   cp "$run/config.yaml" "$run/model.h5" "$out/"
   [ ! -f "$run/loop_summary.json" ] || cp "$run/loop_summary.json" "$out/"
+  # A loop of a build before the solution memory (its config has no eval.nearest): no nearest rows.
+  nearest=()
+  grep -q "nearest:" "$run/config.yaml" || nearest=(eval.nearest=false)
   "$BIN" eval "$out" "eval.repeats=$REPEATS" "eval.batches=[1]" "eval.baselines=[]" \
-    "eval.step_scale=$STEP_SCALE" eval.plot_problems=0 > "$out.out" 2>&1 ||
+    "eval.step_scale=$STEP_SCALE" eval.plot_problems=0 "${nearest[@]}" > "$out.out" 2>&1 ||
     { tail -n 20 "$out.out" >&2; echo "failed: see $out.out" >&2; exit 1; }
   seed=$(python3 -c "import yaml; print(yaml.safe_load(open('$out/config.yaml')).get('seed', 0))")
   args+=("$out/eval.json=$seed")
@@ -62,5 +67,33 @@ for i, st0 in enumerate(runs[0][1]["sets"]):
         cells.append(f"{u} / {l} of {n}: {d['mean']:+.3f} [{d['ci95'][0]:+.3f}, {d['ci95'][1]:+.3f}]")
     print(f"| {st0['set']} | " + " | ".join(cells) + " |")
 print("| all | " + " | ".join(f"**{u} / {l}** of {n} ({(l - u) / n:+.3f})" for u, l, n in tot) + " |")
+# The learned sampler's trivial baseline (eval.nearest): the loop's solutions of the nearest
+# training problems, no model. Only for runs whose model.h5 holds the solution memory.
+near = [(seed, j) for seed, j in runs
+        if all(any(m["name"] == "GFCS nearest (1 batch)" for m in st["methods"]) for st in j["sets"])]
+if near:
+    print("\nThe nearest-neighbour sampler (the learned sampler's trivial baseline: the loop's "
+          "solutions of the nearest training problems, no model; docs/gfcs.md). Cells: successful "
+          "draws of the nearest sampler, then the paired nearest - uniform and learned - nearest "
+          "success rates as above.\n")
+    print("| family | " + " | ".join(f"loop seed {s}" for s, _ in near) + " |")
+    print("|---|" + "---|" * len(near))
+    ntot = [[0, 0, 0, 0] for _ in near]
+    def ci(d):
+        return f"{d['mean']:+.3f} [{d['ci95'][0]:+.3f}, {d['ci95'][1]:+.3f}]"
+    for st0 in near[0][1]["sets"]:
+        cells = []
+        for k, (seed, j) in enumerate(near):
+            st = next(s for s in j["sets"] if s["set"] == st0["set"])
+            u, n = counts(st, "GFCS uniform (1 batch)")
+            l, _ = counts(st, "GFCS learned (1 batch)")
+            r, _ = counts(st, "GFCS nearest (1 batch)")
+            ntot[k][0] += u; ntot[k][1] += l; ntot[k][2] += r; ntot[k][3] += n
+            cells.append(f"{r} of {n}: nearest - uniform "
+                         f"{ci(st['nearest_minus_uniform'][0]['success'])}, learned - nearest "
+                         f"{ci(st['learned_minus_nearest'][0]['success'])}")
+        print(f"| {st0['set']} | " + " | ".join(cells) + " |")
+    print("| all | " + " | ".join(f"uniform / learned / nearest **{u} / {l} / {r}** of {n}"
+                                  for u, l, r, n in ntot) + " |")
 PY
 cat results/gfcs_repeats.md

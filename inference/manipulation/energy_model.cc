@@ -87,6 +87,30 @@ EnergyModel::EnergyModel(EnergyModelParts parts) : parts_(std::move(parts)) {
   FS_THROW_UNLESS(AllFinite(p.energy), "EnergyModel: the energy network has non-finite weights");
   for (const auto& l : p.energy.layers())
     max_width_ = std::max(max_width_, static_cast<int>(l.weight.rows()));
+  ValidateMemory();
+}
+
+void EnergyModel::ValidateMemory() const {
+  const SolutionMemory& m = parts_.memory;
+  const Eigen::Index s = m.problem.size();
+  if (s == 0 && m.contexts.cols() == 0 && m.commands.cols() == 0 && m.cost.size() == 0) return;
+  FS_THROW_UNLESS(s > 0, "EnergyModel: the solution memory has contexts but no solutions");
+  FS_THROW_UNLESS(m.contexts.rows() == context_size() && m.contexts.cols() > 0,
+                  "EnergyModel: the solution memory's contexts are ", m.contexts.rows(), " x ",
+                  m.contexts.cols(), ", expected ", context_size(), " rows (the model's context)");
+  FS_THROW_UNLESS(
+      m.commands.rows() == command_size() && m.commands.cols() == s && m.cost.size() == s,
+      "EnergyModel: the solution memory has ", s, " solutions but commands ", m.commands.rows(),
+      " x ", m.commands.cols(), " (expected ", command_size(), " x ", s, ") and ", m.cost.size(),
+      " costs");
+  FS_THROW_UNLESS(m.problem.minCoeff() >= 0 && m.problem.maxCoeff() < m.contexts.cols(),
+                  "EnergyModel: a solution of the memory names problem ",
+                  m.problem.minCoeff() < 0 ? m.problem.minCoeff() : m.problem.maxCoeff(),
+                  ", outside its ", m.contexts.cols(), " contexts");
+  FS_THROW_UNLESS(m.contexts.allFinite() && m.cost.allFinite(),
+                  "EnergyModel: the solution memory has non-finite contexts or costs");
+  FS_THROW_UNLESS(m.commands.allFinite() && m.commands.cwiseAbs().maxCoeff() <= 1.0f,
+                  "EnergyModel: the solution memory's commands must be finite and in [-1, 1]");
 }
 
 EnergyModel EnergyModel::Load(const std::string& artifact_path) {
@@ -108,6 +132,20 @@ EnergyModel EnergyModel::Load(const std::string& artifact_path) {
   const int energy_layers = art.IntAttr("/model", "energy_layers", 1, 100);
   p.encoder = Mlp::Load(f, "/weights/encoder/", LayerNames(encoder_layers));
   p.energy = Mlp::Load(f, "/weights/energy/", LayerNames(energy_layers));
+  if (f.Exists("/memory")) {
+    SolutionMemory& m = p.memory;
+    m.contexts = f.ReadMatrixF("/memory/contexts").transpose();
+    m.commands = f.ReadMatrixF("/memory/commands").transpose();
+    m.cost = f.ReadMatrixF("/memory/cost", -1, 1).col(0);
+    const h5::Array<std::int64_t> problem = f.ReadInt("/memory/problem");
+    FS_THROW_UNLESS(problem.shape.size() == 1, path, ": /memory/problem must be 1-D");
+    m.problem.resize(static_cast<Eigen::Index>(problem.Size()));
+    for (std::size_t i = 0; i < problem.Size(); ++i) {
+      FS_THROW_UNLESS(problem.data[i] >= 0 && problem.data[i] < (1 << 30), path,
+                      ": /memory/problem[", i, "] = ", problem.data[i], " is out of range");
+      m.problem[static_cast<Eigen::Index>(i)] = static_cast<int>(problem.data[i]);
+    }
+  }
   try {
     return EnergyModel(std::move(p));
   } catch (const Error& e) {
@@ -136,6 +174,15 @@ void EnergyModel::Save(const std::string& path, const std::string& config_yaml,
     f->Write("/normalisation/bps_std", p.bps_std.data(), {n_r});
     p.encoder.Save(f, "/weights/encoder/", LayerNames(static_cast<int>(p.encoder.layers().size())));
     p.energy.Save(f, "/weights/energy/", LayerNames(static_cast<int>(p.energy.layers().size())));
+    if (!p.memory.empty()) {
+      f->WriteMatrix("/memory/contexts", p.memory.contexts.transpose());
+      f->WriteMatrix("/memory/commands", p.memory.commands.transpose());
+      const std::vector<std::int64_t> problem(p.memory.problem.data(),
+                                              p.memory.problem.data() + p.memory.problem.size());
+      f->Write("/memory/problem", problem.data(), {problem.size()});
+      f->Write("/memory/cost", p.memory.cost.data(),
+               {static_cast<std::size_t>(p.memory.cost.size())});
+    }
   });
 }
 

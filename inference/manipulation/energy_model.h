@@ -21,6 +21,11 @@
 ///   /weights/encoder/linear<i>/{weight [out x in], bias [out]}, i = 0 .. encoder_layers - 1
 ///   /weights/energy/linear<i>/{weight, bias}, i = 0 .. energy_layers - 1 (the first layer's
 ///         input is [context, u] in that order)
+///   /memory (optional: the loop's solutions, for the nearest-neighbour sampler)
+///         contexts float32 [P x context]  one per solved training problem
+///         problem  int64 [S]              row of `contexts` each solution solved
+///         commands float32 [S x 7n]       the solution's normalised commands
+///         cost     float32 [S]            its GFCOP cost (s)
 ///
 /// Batched evaluation: the first layer's context part W1[:, :context] x_c + b1 is computed once
 /// per call, then each layer is one GEMM over the P particles (float, Eigen's GEMM kernels with a
@@ -46,6 +51,16 @@ namespace foresight::manipulation {
 
 inline constexpr const char* kEnergyModelType = "gfcs_energy";
 
+/// Command sequences that solved the loop's training problems, with those problems' contexts: what
+/// the nearest-neighbour sampler (nearest_sampler.h) retrieves from. Empty: no memory.
+struct SolutionMemory {
+  Eigen::MatrixXf contexts;  ///< [context_size x P] one column per solved training problem
+  Eigen::VectorXi problem;   ///< [S] the column of `contexts` each solution solved
+  Eigen::MatrixXf commands;  ///< [7n x S] normalised commands, in [-1, 1]
+  Eigen::VectorXf cost;      ///< [S] GFCOP cost (s)
+  bool empty() const { return problem.size() == 0; }
+};
+
 struct EnergyModelParts {
   BpsLattice lattice;
   Eigen::VectorXf bps_mean, bps_std;  ///< [N_R] encoder input normalisation: (d - mean) / std
@@ -54,6 +69,7 @@ struct EnergyModelParts {
   JointVector lower = JointVector::Constant(-1), upper = JointVector::Constant(1);  ///< rad
   double velocity_scale = 1;      ///< qd0 / velocity_scale in the context (rad/s)
   int intermediate_commands = 1;  ///< n
+  SolutionMemory memory;          ///< optional (empty: the artifact has no /memory)
 };
 
 class EnergyModel {
@@ -76,7 +92,9 @@ class EnergyModel {
 
   /// Checks shapes and values (Error naming the mismatch): a valid lattice, bps_mean/bps_std of
   /// size N_R with std finite and positive, encoder N_R -> k, energy (21 + k + 7n) -> 1, finite
-  /// weights, finite limits with lower < upper, velocity_scale > 0, n >= 1.
+  /// weights, finite limits with lower < upper, velocity_scale > 0, n >= 1; a memory, if any,
+  /// with contexts of context_size rows, problem indices in range, finite costs and finite
+  /// commands of 7n rows in [-1, 1].
   explicit EnergyModel(EnergyModelParts parts);
   /// Reads a "gfcs_energy" artifact; errors name the file and the dataset or attribute.
   static EnergyModel Load(const std::string& artifact_path);
@@ -113,6 +131,8 @@ class EnergyModel {
   Eigen::VectorXf RadiansToCommands(const Eigen::Ref<const Eigen::VectorXd>& y) const;
 
  private:
+  void ValidateMemory() const;
+
   EnergyModelParts parts_;
   int max_width_ = 0;
 };

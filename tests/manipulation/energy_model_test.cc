@@ -1,7 +1,7 @@
 // The learned sampler's energy engine (torch-free): energies and gradients against an independent
 // double-precision reference with central differences, artifacts, shape errors, no allocation on
 // the hot path, SGLD (schedule, clamping, descent, determinism, non-finite particles) and the
-// LearnedSampler.
+// LearnedSampler; the solution memory and the nearest-neighbour sampler.
 
 #include "inference/manipulation/energy_model.h"
 
@@ -12,6 +12,7 @@
 
 #include "core/h5.h"
 #include "inference/engine/artifact.h"
+#include "inference/manipulation/nearest_sampler.h"
 // Eigen's GEMM takes its packing buffers from malloc (not operator new) when no buffer is given:
 // count malloc too (not under AddressSanitizer, which owns malloc).
 #define FORESIGHT_ALLOC_COUNTER_MALLOC 1
@@ -686,6 +687,136 @@ TEST(LearnedSampler, UniformShareDrawsThatPartOfTheBatchUniformlyInTheLimits) {
   LearnedSampler bad(m, p);
   bad.SetWorld(SomeWorld());
   ExpectErrorContains([&] { bad.Sample(SomeQuery(), 2, 20, &rng, &out); }, {"uniform_share 1.5"});
+}
+
+// --- The solution memory and the nearest-neighbour sampler --------------------------------------
+
+/// Three memory problems: contexts of three queries in SomeWorld (start velocity zero, so those
+/// seven dimensions do not vary), solutions 0-1 of problem 0, 2-4 of problem 2, 5 of problem 1,
+/// costs not in solution order.
+EnergyModelParts PartsWithMemory(std::vector<GfcsQuery>* queries) {
+  EnergyModelParts p = RandomParts(1, {8}, 3);
+  const EnergyModel plain(p);
+  const Eigen::VectorXf enc = plain.EncodeWorld(SomeWorld());
+  queries->clear();
+  SolutionMemory& m = p.memory;
+  m.contexts.resize(plain.context_size(), 3);
+  for (int k = 0; k < 3; ++k) {
+    GfcsQuery q = SomeQuery();
+    q.start_velocity.setZero();
+    q.start[0] += 0.4 * k;
+    q.goal[3] -= 0.3 * k * k;
+    Eigen::VectorXf ctx;
+    plain.Context(q, enc, &ctx);
+    m.contexts.col(k) = ctx;
+    queries->push_back(q);
+  }
+  m.problem.resize(6);
+  m.problem << 0, 0, 2, 2, 2, 1;
+  m.cost.resize(6);
+  m.cost << 3.0f, 1.0f, 2.5f, 0.5f, 1.5f, 4.0f;
+  m.commands = RandomU(7, 6, 77);
+  return p;
+}
+
+TEST(SolutionMemory, RoundTripsThroughTheArtifactAndBadMemoriesAreErrors) {
+  std::vector<GfcsQuery> queries;
+  const EnergyModelParts parts = PartsWithMemory(&queries);
+  TempDir tmp;
+  const std::string path = tmp.File("energy.h5");
+  EnergyModel(parts).Save(path, "model: gfcs_energy\n", 1);
+  const EnergyModel loaded = EnergyModel::Load(path);
+  const SolutionMemory& back = loaded.parts().memory;
+  EXPECT_EQ(back.contexts, parts.memory.contexts);
+  EXPECT_EQ(back.problem, parts.memory.problem);
+  EXPECT_EQ(back.cost, parts.memory.cost);
+  EXPECT_EQ(back.commands, parts.memory.commands);
+  // No memory: no /memory group, and an empty memory back.
+  const std::string plain = tmp.File("plain.h5");
+  EnergyModel(RandomParts(1, {8}, 3)).Save(plain, "model: gfcs_energy\n", 1);
+  EXPECT_FALSE(Artifact::Open(plain, kEnergyModelType).file().Exists("/memory"));
+  EXPECT_TRUE(EnergyModel::Load(plain).parts().memory.empty());
+
+  EnergyModelParts bad = parts;
+  bad.memory.problem[3] = 3;
+  ExpectErrorContains([&] { EnergyModel m(bad); }, {"names problem 3", "outside its 3 contexts"});
+  bad = parts;
+  bad.memory.commands(2, 1) = 1.5f;
+  ExpectErrorContains([&] { EnergyModel m(bad); }, {"memory's commands", "[-1, 1]"});
+  bad = parts;
+  bad.memory.contexts.conservativeResize(bad.memory.contexts.rows() - 1, Eigen::NoChange);
+  ExpectErrorContains([&] { EnergyModel m(bad); }, {"contexts are 25 x 3", "expected 26 rows"});
+  bad = parts;
+  bad.memory.cost.conservativeResize(5);
+  ExpectErrorContains([&] { EnergyModel m(bad); }, {"6 solutions", "5 costs"});
+  const EnergyModel none(RandomParts(1, {8}, 3));
+  ExpectErrorContains([&] { NearestSampler s(none, 4); }, {"no solution memory"});
+}
+
+TEST(NearestSampler, DistancesStandardiseEachDimensionAndWeighTheTwoBlocksEqually) {
+  std::vector<GfcsQuery> queries;
+  const EnergyModel model(PartsWithMemory(&queries));
+  const NearestSampler sampler(model, 4);
+  const Eigen::MatrixXd C = model.parts().memory.contexts.cast<double>();
+  const Eigen::VectorXf x = RandomU(26, 1, 5).col(0);
+  // Reference: population standard deviation per dimension over the 3 problems; dimensions with
+  // none left out; the mean of z^2 over the varying state dimensions (0-20) plus that over the
+  // varying encoding dimensions (21-25).
+  double expected[3] = {0, 0, 0};
+  for (int block = 0; block < 2; ++block) {
+    const int from = block ? 21 : 0, to = block ? 26 : 21;
+    int varying = 0;
+    double sum[3] = {0, 0, 0};
+    for (int i = from; i < to; ++i) {
+      const double mean = (C(i, 0) + C(i, 1) + C(i, 2)) / 3;
+      double var = 0;
+      for (int p = 0; p < 3; ++p) var += (C(i, p) - mean) * (C(i, p) - mean) / 3;
+      if (std::sqrt(var) <= 1e-6) continue;
+      ++varying;
+      for (int p = 0; p < 3; ++p) sum[p] += std::pow((x[i] - C(i, p)) / std::sqrt(var), 2);
+    }
+    // The start velocity (7) and the joints that no query moves do not vary; the encoding (one
+    // world) does not either.
+    EXPECT_EQ(varying, block ? 0 : 2) << "block " << block;
+    for (int p = 0; p < 3; ++p) expected[p] += varying ? sum[p] / varying : 0;
+  }
+  const Eigen::VectorXd d = sampler.Distances(x);
+  for (int p = 0; p < 3; ++p) EXPECT_NEAR(d[p], expected[p], 1e-9 * (1 + expected[p])) << p;
+  EXPECT_NEAR(sampler.Distances(model.parts().memory.contexts.col(1))[1], 0.0, 1e-12);
+}
+
+TEST(NearestSampler, TakesTheNearestProblemsCheapestSolutionsThenFillsUniformly) {
+  std::vector<GfcsQuery> queries;
+  const EnergyModel model(PartsWithMemory(&queries));
+  const SolutionMemory& m = model.parts().memory;
+  NearestSampler sampler(model, 2);
+  std::mt19937_64 rng(1);
+  Eigen::MatrixXd out;
+  ExpectErrorContains([&] { sampler.Sample(queries[0], 1, 3, &rng, &out); }, {"SetWorld"});
+  sampler.SetWorld(SomeWorld());
+  ExpectErrorContains([&] { sampler.Sample(queries[0], 2, 3, &rng, &out); },
+                      {"asked for 2", "sequences of 1"});
+  // Query = problem 2's: problem 2 (distance 0; its two cheapest of three: 3, 4), then problem 1
+  // (nearer than 0 in both varying joints: 5), then problem 0 (1, 0), then uniform draws.
+  sampler.Sample(queries[2], 1, 7, &rng, &out);
+  ASSERT_EQ(out.rows(), 7);
+  ASSERT_EQ(out.cols(), 7);
+  const int expected[5] = {3, 4, 5, 1, 0};
+  for (int c = 0; c < 5; ++c)
+    EXPECT_TRUE(out.col(c).isApprox(model.CommandsToRadians(m.commands.col(expected[c])), 1e-12))
+        << "column " << c;
+  EXPECT_EQ(sampler.last_filled(), 2);
+  EXPECT_EQ(sampler.last_problems(), 3);
+  const JointVector& lo = model.parts().lower;
+  const JointVector& hi = model.parts().upper;
+  for (int c = 5; c < 7; ++c)
+    EXPECT_TRUE(((out.col(c).array() >= lo.array()) && (out.col(c).array() <= hi.array())).all());
+  // A batch the nearest problem fills alone; no draw from the generator.
+  const std::mt19937_64 before = rng;
+  sampler.Sample(queries[2], 1, 1, &rng, &out);
+  EXPECT_TRUE(out.col(0).isApprox(model.CommandsToRadians(m.commands.col(3)), 1e-12));
+  EXPECT_EQ(sampler.last_filled(), 0);
+  EXPECT_TRUE(rng == before);
 }
 
 }  // namespace

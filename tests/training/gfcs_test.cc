@@ -97,6 +97,20 @@ std::vector<Eigen::MatrixXf> EnergyWeights(const std::string& artifact) {
   return out;
 }
 
+/// The solution memories of two artifacts are equal, bit for bit.
+void ExpectTheSameMemory(const std::string& artifact_a, const std::string& artifact_b) {
+  const manipulation::EnergyModel a = manipulation::EnergyModel::Load(artifact_a);
+  const manipulation::EnergyModel b = manipulation::EnergyModel::Load(artifact_b);
+  const manipulation::SolutionMemory &ma = a.parts().memory, &mb = b.parts().memory;
+  ASSERT_FALSE(ma.empty());
+  ASSERT_EQ(ma.problem.size(), mb.problem.size());
+  ASSERT_EQ(ma.contexts.cols(), mb.contexts.cols());
+  EXPECT_EQ(ma.problem, mb.problem);
+  EXPECT_EQ(ma.cost, mb.cost);
+  EXPECT_EQ(ma.commands, mb.commands);
+  EXPECT_EQ(ma.contexts, mb.contexts);
+}
+
 TEST(GfcsLoop, AResumedRunEndsWithTheModelOfAnUninterruptedOne) {
   const gfcs::ExperimentConfig c = TinyConfig();
   testing::TempDir dir;
@@ -122,14 +136,23 @@ TEST(GfcsLoop, AResumedRunEndsWithTheModelOfAnUninterruptedOne) {
   for (std::size_t i = 0; i < a.size(); ++i) EXPECT_TRUE(a[i].isApprox(b[i], 1e-6f)) << i;
   EXPECT_NE(testing::ReadText(whole + "/loop_summary.json").find("\"solves\": 6"),
             std::string::npos);
+  // The solution memory holds every solution found, beyond the buffer, the same after a resume.
+  ExpectTheSameMemory(whole + "/model.h5", broken + "/model.h5");
+  // The held-out evaluation runs the nearest-neighbour sampler on that memory beside the learned
+  // one, with both paired comparisons.
+  const std::string eval = gfcs::EvaluateRun(c, whole);
+  for (const char* key : {"\"GFCS nearest (1 batch)\"", "\"nearest_minus_uniform\"",
+                          "\"learned_minus_nearest\""})
+    EXPECT_NE(eval.find(key), std::string::npos) << key;
 
   // A checkpoint from another config is refused with the key that differs.
   gfcs::ExperimentConfig other = c;
   other.loop.adam_steps = 5;
   gfcs::Encoding enc;
   Mlp energy;
+  manipulation::SolutionMemory memory;
   testing::ExpectErrorContains(
-      [&] { gfcs::LoadLoopResult(other, config::ToYaml(other), whole, &enc, &energy); },
+      [&] { gfcs::LoadLoopResult(other, config::ToYaml(other), whole, &enc, &energy, &memory); },
       {"another config", "adam_steps: 5"});
 }
 
@@ -196,6 +219,7 @@ TEST(GfcsLoop, TwoRanksShareTheSolvesAndEndWithTheModelOfOne) {
   EXPECT_EQ(Round3(log1), Round3(testing::ReadText(d + "/one/log.txt")));
   EXPECT_TRUE(fs::exists(gfcs::LoopCheckpointPath(d + "/two", 1)));
   ExpectTheSameEnergyNet(d + "/one/model.h5", d + "/two/model.h5");
+  ExpectTheSameMemory(d + "/one/model.h5", d + "/two/model.h5");
 }
 
 TEST(GfcsLoop, TwoRanksKilledMidRunResumeToTheModelOfOne) {
@@ -222,6 +246,7 @@ TEST(GfcsLoop, TwoRanksKilledMidRunResumeToTheModelOfOne) {
   ASSERT_EQ(resumed, 0) << testing::ReadText(d + "/r0.out") << testing::ReadText(d + "/q0.out")
                         << testing::ReadText(d + "/q1.out");
   ExpectTheSameEnergyNet(d + "/one/model.h5", d + "/two/model.h5");
+  ExpectTheSameMemory(d + "/one/model.h5", d + "/two/model.h5");
 }
 
 TEST(GfcsLoop, ASignalToOneRankStopsBothAndTheyResumeToTheModelOfOne) {
@@ -251,6 +276,7 @@ TEST(GfcsLoop, ASignalToOneRankStopsBothAndTheyResumeToTheModelOfOne) {
   const int resumed = ResumeTwoRanks(d, env + run);
   ASSERT_EQ(resumed, 0) << testing::ReadText(d + "/q0.out") << testing::ReadText(d + "/q1.out");
   ExpectTheSameEnergyNet(d + "/one/model.h5", d + "/two/model.h5");
+  ExpectTheSameMemory(d + "/one/model.h5", d + "/two/model.h5");
 }
 
 TEST(GfcsConfig, HeldOutProblemsMayNotOverlapTheTrainingOnes) {

@@ -121,6 +121,9 @@ struct EvalConfig {
   /// > 0: the learned sampler is also evaluated with this share of its batch drawn uniformly
   /// (methods[].uniform_share of the plan harness), in rows beside the thesis's pure one.
   double uniform_share = 0;
+  /// The nearest-neighbour sampler (the learned one's trivial baseline: the loop's solutions of
+  /// the nearest training problems, nearest_sampler.h) in rows beside the learned sampler.
+  bool nearest = true;
   /// > 0: the learned sampler's SGLD step scale at evaluation instead of sampler.step_scale (which
   /// the loop's own solves keep); chosen on validation problems (experiments/gfcs_select.sh SGLD=).
   double step_scale = 0;
@@ -145,6 +148,9 @@ struct EvalConfig {
     a->Visit("uniform_share", &uniform_share, Range::Closed(0, 1),
              "> 0: also evaluate the learned sampler with this share of its batch drawn uniformly "
              "in the joint limits (rows 'GFCS learned + uniform'); chosen on validation problems");
+    a->Visit("nearest", &nearest, Range::Any(),
+             "also evaluate the nearest-neighbour sampler (rows 'GFCS nearest': the loop's "
+             "solutions of the nearest training problems, the learned sampler's trivial baseline)");
     a->Visit("step_scale", &step_scale, Range::NonNegative(),
              "> 0: the learned sampler's SGLD step scale at evaluation instead of "
              "sampler.step_scale (the loop keeps that); chosen on validation problems");

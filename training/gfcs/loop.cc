@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <random>
 #include <sstream>
@@ -157,6 +158,39 @@ std::vector<Positive> ReadPositives(torch::serialize::InputArchive* a, const std
   return out;
 }
 
+bool HasKey(torch::serialize::InputArchive* a, const std::string& key) {
+  torch::Tensor t;
+  return a->try_read(key, t);
+}
+
+/// The exported solution memory: the training problems that have a positive (in index order)
+/// with their contexts [context x problems], and every positive.
+manipulation::SolutionMemory MakeMemory(const std::vector<Positive>& positives,
+                                        const Eigen::MatrixXf& contexts) {
+  std::map<int, int> column;  // training problem -> column of the memory's contexts
+  for (const Positive& p : positives) column.emplace(p.problem, 0);
+  manipulation::SolutionMemory m;
+  m.contexts.resize(contexts.rows(), static_cast<Eigen::Index>(column.size()));
+  int k = 0;
+  for (auto& [problem, col] : column) {
+    FS_THROW_UNLESS(problem >= 0 && problem < contexts.cols(), "gfcs loop: a positive of problem ",
+                    problem, " outside the ", contexts.cols(), " training problems");
+    col = k;
+    m.contexts.col(k++) = contexts.col(problem);
+  }
+  const auto n = static_cast<Eigen::Index>(positives.size());
+  m.problem.resize(n);
+  m.cost.resize(n);
+  m.commands.resize(positives.empty() ? 0 : positives.front().u.size(), n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const Positive& p = positives[static_cast<std::size_t>(i)];
+    m.problem[i] = column.at(p.problem);
+    m.cost[i] = p.cost;
+    m.commands.col(i) = p.u;
+  }
+  return m;
+}
+
 torch::Tensor TextTensor(const std::string& s) {
   return torch::from_blob(const_cast<char*>(s.data()), {static_cast<std::int64_t>(s.size())},
                           torch::kUInt8)
@@ -218,6 +252,9 @@ struct LoopState {
   int solves = 0, solved = 0, rounds = 0, dropped = 0, sampler_failures = 0;
   double last_loss = 0;
   std::vector<Positive> buffer;
+  /// every positive the loop found, in solve order (the buffer keeps only the last ones): the
+  /// exported solution memory of the nearest-neighbour sampler
+  std::vector<Positive> memory;
   BlockResult pending;  ///< this rank's results in the current block
 };
 
@@ -254,9 +291,11 @@ class Loop {
 
   LoopStats Run(bool resume, const std::atomic<bool>* interrupt);
   Mlp Energy() const { return net_->net()->ToMlp(); }
+  manipulation::SolutionMemory Memory() const { return MakeMemory(st_.memory, Contexts()); }
 
  private:
   int Total() const { return c_.loop.passes * static_cast<int>(problems_.size()); }
+  Eigen::MatrixXf Contexts() const;
   std::string Serialize(bool with_pending) const;
   void Deserialize(const std::string& bytes, const std::string& source);
   void Save();
@@ -284,6 +323,14 @@ class Loop {
   std::chrono::steady_clock::time_point started_ = std::chrono::steady_clock::now();
 };
 
+Eigen::MatrixXf Loop::Contexts() const {
+  Eigen::MatrixXf out(problems_.front().context.size(),
+                      static_cast<Eigen::Index>(problems_.size()));
+  for (std::size_t p = 0; p < problems_.size(); ++p)
+    out.col(static_cast<Eigen::Index>(p)) = problems_[p].context;
+  return out;
+}
+
 std::string Loop::Where(int s) const {
   const TrainingProblem& p = problems_[static_cast<std::size_t>(s) % problems_.size()];
   return p.family + " #" + std::to_string(p.problem.index);
@@ -302,6 +349,11 @@ std::string Loop::Serialize(bool with_pending) const {
   a.write("pending.counts",
           Int64Tensor({pending.solves, pending.solved, pending.dropped, pending.sampler_failures}));
   WritePositives(&a, "buffer", st_.buffer, CommandSize(c_));
+  WritePositives(&a, "memory", st_.memory, CommandSize(c_));
+  const Eigen::MatrixXf contexts = Contexts();  // [context x P] = row-major [P x context]
+  a.write("memory.contexts", torch::from_blob(const_cast<float*>(contexts.data()),
+                                              {contexts.cols(), contexts.rows()}, torch::kFloat32)
+                                 .clone());
   WritePositives(&a, "pending", pending.positives, CommandSize(c_));
   a.write("encoding.bps_mean", ToTensor(encoding_.bps_mean));
   a.write("encoding.bps_std", ToTensor(encoding_.bps_std));
@@ -353,7 +405,20 @@ void Loop::Deserialize(const std::string& bytes, const std::string& source) {
   st_.pending.sampler_failures = static_cast<int>(t[3].item<std::int64_t>());
   st_.buffer = ReadPositives(&a, "buffer");
   st_.pending.positives = ReadPositives(&a, "pending");
-  for (const auto* list : {&st_.buffer, &st_.pending.positives})
+  FS_THROW_UNLESS(HasKey(&a, "memory.u"), source,
+                  ": the checkpoint has no solution memory (written by an older build); start the "
+                  "run again");
+  st_.memory = ReadPositives(&a, "memory");
+  {
+    const torch::Tensor ct = Read(&a, "memory.contexts").contiguous();
+    const Eigen::MatrixXf here = Contexts();
+    FS_THROW_UNLESS(
+        ct.dim() == 2 && ct.size(0) == here.cols() && ct.size(1) == here.rows() &&
+            Eigen::Map<const Eigen::MatrixXf>(ct.data_ptr<float>(), here.rows(), here.cols())
+                .isApprox(here),
+        source, ": the checkpoint's training problems differ from this run's");
+  }
+  for (const auto* list : {&st_.buffer, &st_.pending.positives, &st_.memory})
     for (const Positive& p : *list)
       FS_THROW_UNLESS(p.problem >= 0 && p.problem < static_cast<int>(problems_.size()) &&
                           p.u.size() == CommandSize(c_),
@@ -496,6 +561,7 @@ void Loop::FinishBlock(int block_end) {
   }
   std::stable_sort(fresh.begin(), fresh.end(),
                    [](const Positive& a, const Positive& b) { return a.solve < b.solve; });
+  st_.memory.insert(st_.memory.end(), fresh.begin(), fresh.end());
   for (Positive& p : fresh) st_.buffer.push_back(std::move(p));
   if (st_.buffer.size() > static_cast<std::size_t>(c_.loop.buffer))
     st_.buffer.erase(st_.buffer.begin(),
@@ -754,18 +820,21 @@ LoopStats RunSelfSupervisedLoop(const ExperimentConfig& c, const std::string& co
                                 const manipulation::RobotModel& robot, const Encoding& encoding,
                                 const std::vector<TrainingProblem>& problems,
                                 const std::string& run_dir, bool resume,
-                                const std::atomic<bool>* interrupt, Mlp* energy) {
+                                const std::atomic<bool>* interrupt, Mlp* energy,
+                                manipulation::SolutionMemory* memory) {
   FS_THROW_UNLESS(!problems.empty(), run_dir, ": no valid training problems");
   fs::create_directories(run_dir + "/checkpoints");
   torch::manual_seed(static_cast<std::uint64_t>(c.seed));
   Loop loop(c, config_yaml, robot, encoding, problems, run_dir);
   const LoopStats stats = loop.Run(resume, interrupt);
   *energy = loop.Energy();
+  *memory = loop.Memory();
   return stats;
 }
 
 void LoadLoopResult(const ExperimentConfig& c, const std::string& config_yaml,
-                    const std::string& run_dir, Encoding* encoding, Mlp* energy) {
+                    const std::string& run_dir, Encoding* encoding, Mlp* energy,
+                    manipulation::SolutionMemory* memory) {
   const std::string path = LoopCheckpointPath(run_dir, 0);
   FS_THROW_UNLESS(fs::exists(path), run_dir,
                   ": no loop checkpoint (the run has not started its loop; continue it with train "
@@ -788,6 +857,13 @@ void LoadLoopResult(const ExperimentConfig& c, const std::string& config_yaml,
   a.read("net", n);
   net->load(n);
   *energy = net->net()->ToMlp();
+  FS_THROW_UNLESS(HasKey(&a, "memory.u"), path,
+                  ": the checkpoint has no solution memory (written by an older build); train the "
+                  "run again");
+  const torch::Tensor contexts = Read(&a, "memory.contexts").contiguous();
+  *memory = MakeMemory(ReadPositives(&a, "memory"),
+                       Eigen::Map<const Eigen::MatrixXf>(contexts.data_ptr<float>(),
+                                                         contexts.size(1), contexts.size(0)));
 }
 
 }  // namespace foresight::gfcs

@@ -71,16 +71,21 @@ manipulation::EnergyModelParts MakeEnergyParts(const ExperimentConfig& c,
                                                const Encoding& encoding, const Mlp& energy);
 
 /// Runs (or resumes: `resume` and a checkpoint exist) the loop in `run_dir` over `problems`
-/// (contexts filled). @return the final network as engine weights in `*energy`.
+/// (contexts filled). @return the final network as engine weights in `*energy`, and every
+/// solution the loop found with its problem's context in `*memory` (the nearest-neighbour
+/// sampler's).
 LoopStats RunSelfSupervisedLoop(const ExperimentConfig& c, const std::string& config_yaml,
                                 const manipulation::RobotModel& robot, const Encoding& encoding,
                                 const std::vector<TrainingProblem>& problems,
                                 const std::string& run_dir, bool resume,
-                                const std::atomic<bool>* interrupt, Mlp* energy);
+                                const std::atomic<bool>* interrupt, Mlp* energy,
+                                manipulation::SolutionMemory* memory);
 
-/// The final energy network and the encoding of a loop checkpoint (for export).
+/// The final energy network, the encoding and the solution memory of a loop checkpoint (for
+/// export).
 void LoadLoopResult(const ExperimentConfig& c, const std::string& config_yaml,
-                    const std::string& run_dir, Encoding* encoding, Mlp* energy);
+                    const std::string& run_dir, Encoding* encoding, Mlp* energy,
+                    manipulation::SolutionMemory* memory);
 
 /// The loop checkpoint of `rank` in `run_dir`.
 std::string LoopCheckpointPath(const std::string& run_dir, int rank);

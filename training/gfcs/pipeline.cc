@@ -181,8 +181,11 @@ void EncodeProblems(const ExperimentConfig& c, const RobotModel& robot, const En
 }
 
 void WriteArtifact(const ExperimentConfig& c, const RobotModel& robot, const Encoding& enc,
-                   const Mlp& energy, const std::string& yaml, const std::string& path) {
-  EnergyModel(MakeEnergyParts(c, robot, enc, energy)).Save(path, yaml, c.seed);
+                   const Mlp& energy, manipulation::SolutionMemory memory, const std::string& yaml,
+                   const std::string& path) {
+  manipulation::EnergyModelParts parts = MakeEnergyParts(c, robot, enc, energy);
+  parts.memory = std::move(memory);
+  EnergyModel(std::move(parts)).Save(path, yaml, c.seed);
   (void)EnergyModel::Load(path);  // the engine loads what was written
 }
 
@@ -266,6 +269,10 @@ manipulation::ExperimentConfig EvalPlanConfig(const ExperimentConfig& c,
       mc.methods.push_back({MixedLabel(c.eval.uniform_share) + " (" + BudgetLabel(b) + ")",
                             manipulation::PlanMethodKind::kGfcs, b, 1.2,
                             manipulation::GfcsSamplerKind::kLearned, c.eval.uniform_share});
+    if (c.eval.nearest)
+      mc.methods.push_back({"GFCS nearest (" + BudgetLabel(b) + ")",
+                            manipulation::PlanMethodKind::kGfcs, b, 1.2,
+                            manipulation::GfcsSamplerKind::kNearest});
   }
   for (const manipulation::PlanMethodConfig& m : c.eval.baselines) mc.methods.push_back(m);
   mc.resolution = c.eval.resolution;
@@ -307,8 +314,9 @@ bool TrainRun(const ExperimentConfig& c, const std::string& run_dir, bool resume
   if (interrupted) return false;
   EncodeProblems(c, robot, enc, &problems);
   Mlp energy;
-  const LoopStats stats =
-      RunSelfSupervisedLoop(c, yaml, robot, enc, problems, run_dir, resume, interrupt, &energy);
+  manipulation::SolutionMemory memory;
+  const LoopStats stats = RunSelfSupervisedLoop(c, yaml, robot, enc, problems, run_dir, resume,
+                                                interrupt, &energy, &memory);
   if (group->rank() == 0)
     WriteFileAtomically(run_dir + "/loop_summary.json", stats.ToJson() + "\n");
   if (stats.interrupted) return false;
@@ -316,7 +324,8 @@ bool TrainRun(const ExperimentConfig& c, const std::string& run_dir, bool resume
             " training rounds; solving ", stats.solve_seconds, " s, negatives ",
             stats.negative_seconds, " s, training ", stats.train_seconds, " s, the whole loop ",
             stats.loop_seconds, " s (this invocation)");
-  if (group->rank() == 0) WriteArtifact(c, robot, enc, energy, yaml, run_dir + "/" + kGfcsArtifact);
+  if (group->rank() == 0)
+    WriteArtifact(c, robot, enc, energy, std::move(memory), yaml, run_dir + "/" + kGfcsArtifact);
   return true;
 }
 
@@ -325,9 +334,10 @@ std::string ExportRun(const std::string& run_dir) {
   const std::string yaml = config::ToYaml(c);
   Encoding enc;
   Mlp energy;
-  LoadLoopResult(c, yaml, run_dir, &enc, &energy);
+  manipulation::SolutionMemory memory;
+  LoadLoopResult(c, yaml, run_dir, &enc, &energy, &memory);
   const std::string path = run_dir + "/" + kGfcsArtifact;
-  WriteArtifact(c, LoadRobot(c), enc, energy, yaml, path);
+  WriteArtifact(c, LoadRobot(c), enc, energy, std::move(memory), yaml, path);
   return path;
 }
 
@@ -397,11 +407,13 @@ std::string EvaluateRun(const ExperimentConfig& c, const std::string& run_dir) {
       os << "       {\"name\": " << JsonString(report.methods[m].method)
          << ", \"metrics\": " << report.methods[m].summary.ToJson() << "}"
          << (m + 1 < report.methods.size() ? "," : "") << "\n";
-    // Paired differences of a learned variant against the uniform sampler, per budget.
-    const auto paired = [&](const std::string& key, const std::string& variant) {
+    // Paired differences of a sampler against a reference sampler, per budget ("only_learned":
+    // solved by the variant only, "only_uniform": by the reference only).
+    const auto paired = [&](const std::string& key, const std::string& variant,
+                            const std::string& reference) {
       os << "     ],\n     \"" << key << "\": [\n";
       for (std::size_t b = 0; b < c.eval.batches.size(); ++b) {
-        const std::string uni = "GFCS uniform (" + BudgetLabel(c.eval.batches[b]) + ")";
+        const std::string uni = reference + " (" + BudgetLabel(c.eval.batches[b]) + ")";
         const std::string lea = variant + " (" + BudgetLabel(c.eval.batches[b]) + ")";
         const PairedPerProblem pairs = PairPerProblem(report.attempts, uni, lea);
         const std::uint64_t seed = static_cast<std::uint64_t>(c.seed) + 1000 * i + 10 * b;
@@ -419,8 +431,13 @@ std::string EvaluateRun(const ExperimentConfig& c, const std::string& run_dir) {
            << (b + 1 < c.eval.batches.size() ? "," : "") << "\n";
       }
     };
-    paired("learned_minus_uniform", "GFCS learned");
-    if (c.eval.uniform_share > 0) paired("mixed_minus_uniform", MixedLabel(c.eval.uniform_share));
+    paired("learned_minus_uniform", "GFCS learned", "GFCS uniform");
+    if (c.eval.uniform_share > 0)
+      paired("mixed_minus_uniform", MixedLabel(c.eval.uniform_share), "GFCS uniform");
+    if (c.eval.nearest) {
+      paired("nearest_minus_uniform", "GFCS nearest", "GFCS uniform");
+      paired("learned_minus_nearest", "GFCS learned", "GFCS nearest");
+    }
     os << "     ]}" << (i + 1 < c.eval.problems.size() ? "," : "") << "\n";
   }
   const std::string loop = ReadText(run_dir + "/loop_summary.json");

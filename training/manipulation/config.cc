@@ -32,9 +32,10 @@ void ExperimentConfig::Validate(const std::string& path) const {
     problems.scene.Validate(path + ": problems.scene");
   FS_THROW_UNLESS(!robot.empty(), path, ": robot: empty (a folder or 'builtin')");
   for (const PlanMethodConfig& m : methods)
-    FS_THROW_UNLESS(m.sampler != GfcsSamplerKind::kLearned || !energy_model.empty(), path,
-                    ": methods: '", m.name,
-                    "' uses the learned sampler, but energy_model (the artifact) is empty");
+    FS_THROW_UNLESS(m.sampler == GfcsSamplerKind::kUniform || !energy_model.empty(), path,
+                    ": methods: '", m.name, "' uses the ",
+                    m.sampler == GfcsSamplerKind::kLearned ? "learned" : "nearest",
+                    " sampler, but energy_model (the artifact) is empty");
   for (const PlanMethodConfig& m : methods)
     FS_THROW_UNLESS(m.uniform_share == 0 ||
                         (m.kind == PlanMethodKind::kGfcs && m.sampler == GfcsSamplerKind::kLearned),

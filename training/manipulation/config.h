@@ -52,7 +52,7 @@ struct ProblemsConfig {
 enum class PlanMethodKind { kGfcs, kFabric, kBiEst, kBitStar, kRrtConnect };
 
 /// Where GFCS's first batch comes from.
-enum class GfcsSamplerKind { kUniform, kLearned };
+enum class GfcsSamplerKind { kUniform, kLearned, kNearest };
 
 /// One row of the comparison table.
 struct PlanMethodConfig {
@@ -82,8 +82,11 @@ struct PlanMethodConfig {
              "planners: time budget (s)");
     a->VisitEnum("sampler", &sampler,
                  config::EnumNames<GfcsSamplerKind>{{GfcsSamplerKind::kUniform, "uniform"},
-                                                    {GfcsSamplerKind::kLearned, "learned"}},
-                 "gfcs: first batch uniform in the joint limits, or SGLD on energy_model");
+                                                    {GfcsSamplerKind::kLearned, "learned"},
+                                                    {GfcsSamplerKind::kNearest, "nearest"}},
+                 "gfcs: first batch uniform in the joint limits, SGLD on energy_model (learned), "
+                 "or the solutions of the nearest training problems in energy_model's memory "
+                 "(nearest: the trivial baseline of learned)");
     a->Visit("uniform_share", &uniform_share, config::Range::Closed(0, 1),
              "gfcs, sampler learned: share of the first batch drawn uniformly in the joint limits "
              "beside the SGLD samples (0: the thesis)");
@@ -165,7 +168,7 @@ struct ExperimentConfig {
              "run's)");
     a->Visit("energy_model", &energy_model, config::Range::Any(),
              "artifact of the learned sampler (a gfcs run's model.h5; methods with sampler: "
-             "learned)");
+             "learned or nearest)");
     a->Visit("sgld", &sgld, config::Range::Any(), "SGLD of the learned sampler");
   }
   /// Cross-field checks; errors name `path` and the key.

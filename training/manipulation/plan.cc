@@ -15,6 +15,7 @@
 #include "inference/manipulation/energy_model.h"
 #include "inference/manipulation/fabric.h"
 #include "inference/manipulation/gfcs.h"
+#include "inference/manipulation/nearest_sampler.h"
 #include "inference/manipulation/planners.h"
 #include "inference/manipulation/synthetic_problems.h"
 #include "inference/manipulation/validity.h"
@@ -274,13 +275,22 @@ PlanReport RunPlanExperiment(const ExperimentConfig& c, const std::string& run_d
   // One learned sampler per method that uses it (each with the method's uniform share).
   std::optional<EnergyModel> energy;
   std::vector<std::optional<LearnedSampler>> learned(c.methods.size());
+  std::vector<std::optional<NearestSampler>> nearest(c.methods.size());
   for (std::size_t m = 0; m < c.methods.size(); ++m) {
     const PlanMethodConfig& method = c.methods[m];
-    if (method.kind != PlanMethodKind::kGfcs || method.sampler != GfcsSamplerKind::kLearned)
+    if (method.kind != PlanMethodKind::kGfcs || method.sampler == GfcsSamplerKind::kUniform)
       continue;
     if (!energy) {
       energy.emplace(EnergyModel::Load(c.energy_model));
       log::Info("learned sampler: ", c.energy_model);
+    }
+    if (method.sampler == GfcsSamplerKind::kNearest) {
+      try {
+        nearest[m].emplace(*energy, c.gfcs.top_m);
+      } catch (const Error& e) {
+        Fail(c.energy_model, ": method '", method.name, "': ", e.what());
+      }
+      continue;
     }
     SgldParams sgld = c.sgld;
     sgld.uniform_share = method.uniform_share;
@@ -329,6 +339,11 @@ PlanReport RunPlanExperiment(const ExperimentConfig& c, const std::string& run_d
                 learned[m]->SetWorld(problem.world);
                 encode_s = bench::SecondsSince(started);
                 sampler = &*learned[m];
+              } else if (nearest[m]) {
+                const auto started = bench::Clock::now();
+                nearest[m]->SetWorld(problem.world);
+                encode_s = bench::SecondsSince(started);
+                sampler = &*nearest[m];
               }
               t = RunGfcs(fabric, problem, c, method, sampler, seed, &best);
               t.generation_time_s += encode_s;
