@@ -141,8 +141,8 @@ TEST(GfcsLoop, AResumedRunEndsWithTheModelOfAnUninterruptedOne) {
   // The held-out evaluation runs the nearest-neighbour sampler on that memory beside the learned
   // one, with both paired comparisons.
   const std::string eval = gfcs::EvaluateRun(c, whole);
-  for (const char* key : {"\"GFCS nearest (1 batch)\"", "\"nearest_minus_uniform\"",
-                          "\"learned_minus_nearest\""})
+  for (const char* key :
+       {"\"GFCS nearest (1 batch)\"", "\"nearest_minus_uniform\"", "\"learned_minus_nearest\""})
     EXPECT_NE(eval.find(key), std::string::npos) << key;
 
   // A checkpoint from another config is refused with the key that differs.
