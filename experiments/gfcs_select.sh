@@ -8,6 +8,8 @@
 # configs' fabric and GFCS settings, which are the same defaults as the loop config's.
 #   experiments/gfcs_select.sh
 #   SHARES="0.25 0.5" experiments/gfcs_select.sh
+#   SHARES= NEAREST_SHARES=0.5 REPEATS=10 RESULT=results/gfcs_select_nearest.md experiments/gfcs_select.sh
+#     (the nearest-neighbour sampler, and batches split between it and the uniform or learned one)
 #   SHARES= PICKS=random RESULT=results/gfcs_select_pick.md experiments/gfcs_select.sh   (which SGLD
 #     survivors fill the batch: a random draw beside the shipped lowest-energy ones)
 #   SHARES= REPEATS=10 RESULT=... experiments/gfcs_select.sh   (10 draws per problem and method, seeds
@@ -80,6 +82,16 @@ methods="{name: uniform, kind: gfcs, batches: 1}, {name: learned, kind: gfcs, ba
 for s in $SHARES; do
   methods+=", {name: \"learned+$s\", kind: gfcs, batches: 1, sampler: learned, uniform_share: $s}"
 done
+# The nearest-neighbour sampler (a model whose artifact holds the loop's solution memory, i.e. a
+# loop of a build that writes eval.nearest), and NEAREST_SHARES="0.5": that share of the batch
+# from the memory, the rest uniform or learned (methods[].nearest_share).
+if grep -q "nearest:" "$RUN/config.yaml"; then
+  methods+=", {name: nearest, kind: gfcs, batches: 1, sampler: nearest}"
+  for s in ${NEAREST_SHARES:-}; do
+    methods+=", {name: \"uniform+nearest $s\", kind: gfcs, batches: 1, nearest_share: $s}"
+    methods+=", {name: \"learned+nearest $s\", kind: gfcs, batches: 1, sampler: learned, nearest_share: $s}"
+  done
+fi
 # PICKS="random": the learned sampler with another choice of SGLD survivors (methods[].sgld_pick).
 for p in ${PICKS:-}; do
   methods+=", {name: \"learned pick $p\", kind: gfcs, batches: 1, sampler: learned, sgld_pick: $p}"
@@ -166,6 +178,15 @@ for n in (n for n in names if n.startswith("learned pick ")):
     margin = totals[n]["ok"] - totals["learned"]["ok"]
     verdict = "adopted" if margin >= 3 else "not adopted"
     print(f"\n`{n}`: {margin:+d} problems against the lowest-energy pick: {verdict} (margin 3).")
+# A batch split between the solution memory and another sampler replaces the plain nearest sampler
+# only by a margin of 3 (rule fixed before the first run of these rows, 2026-12-07).
+mixed = [n for n in names if "+nearest " in n]
+if "nearest" in totals and mixed:
+    best = max(mixed, key=key)
+    margin = totals[best]["ok"] - totals["nearest"]["ok"]
+    verdict = "adopted" if margin >= 3 else "not adopted"
+    print(f"\nBest split batch `{best}`: {margin:+d} against the nearest sampler alone: {verdict} "
+          "(margin 3).")
 PY
 mv "$RESULT.tmp" "$RESULT"
 cat "$RESULT"

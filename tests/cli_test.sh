@@ -151,6 +151,11 @@ expect_error "'GF' sets uniform_share 0.5, which only a gfcs method with sampler
   "methods=[{name: GF, kind: gf, uniform_share: 0.5}]" --run-dir "$TMP/plan7"
 expect_error "'G' uses the nearest sampler, but energy_model (the artifact) is empty" plan default \
   "methods=[{name: G, kind: gfcs, sampler: nearest}]" --run-dir "$TMP/plan10"
+expect_error "'G' sets nearest_share 0.5, which only a gfcs method with sampler: uniform or learned uses" \
+  plan default "methods=[{name: G, kind: gfcs, sampler: nearest, nearest_share: 0.5}]" energy_model=x.h5 \
+  --run-dir "$TMP/plan11"
+expect_error "'G' sets nearest_share, but energy_model" plan default \
+  "methods=[{name: G, kind: gfcs, nearest_share: 0.5}]" --run-dir "$TMP/plan12"
 expect_error "uniform_share" plan default "methods=[{name: G, kind: gfcs, sampler: learned, uniform_share: 2}]" \
   energy_model=x.h5 --run-dir "$TMP/plan8"
 expect_error "missing MBM problems directory" plan configs/manipulation/box.yaml problems.family=no_such_family robot=builtin \

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <limits>
 #include <mutex>
 #include <thread>
@@ -89,6 +90,27 @@ void UniformSampler::Sample(const GfcsQuery& /*query*/, int intermediate_command
     for (int k = 0; k < intermediate_commands; ++k)
       for (int j = 0; j < kDof; ++j)
         (*out)(k * kDof + j, c) = lower_[j] + unit(*rng) * (upper_[j] - lower_[j]);
+}
+
+SplitSampler::SplitSampler(CommandSampler* first, double share, CommandSampler* rest)
+    : first_(first), share_(share), rest_(rest) {
+  FS_THROW_UNLESS(first && rest, "split sampler: both samplers must be given");
+  FS_THROW_UNLESS(share >= 0 && share <= 1, "split sampler: share ", share, " is outside [0, 1]");
+}
+
+void SplitSampler::Sample(const GfcsQuery& query, int intermediate_commands, int count,
+                          std::mt19937_64* rng, Eigen::MatrixXd* out) {
+  FS_THROW_UNLESS(count >= 0, "split sampler: count ", count, " is negative");
+  const int n_first = static_cast<int>(std::lround(share_ * static_cast<double>(count)));
+  out->resize(kDof * intermediate_commands, count);
+  if (n_first > 0) {
+    first_->Sample(query, intermediate_commands, n_first, rng, &part_);
+    out->leftCols(n_first) = part_;
+  }
+  if (count - n_first > 0) {
+    rest_->Sample(query, intermediate_commands, count - n_first, rng, &part_);
+    out->rightCols(count - n_first) = part_;
+  }
 }
 
 GfcsCandidate EvaluateCommandSequence(const Fabric& fabric, const GfcsQuery& query,

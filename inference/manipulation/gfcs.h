@@ -88,6 +88,24 @@ class UniformSampler : public CommandSampler {
   JointVector lower_, upper_;
 };
 
+/// A batch split between two samplers: the first round(share * count) candidates from `first`,
+/// the rest from `rest` (both draw from the caller's generator, in that order). Neither is owned;
+/// both must outlive the split.
+class SplitSampler : public CommandSampler {
+ public:
+  /// share in [0, 1] (else Error).
+  SplitSampler(CommandSampler* first, double share, CommandSampler* rest);
+  std::string name() const override { return first_->name() + "+" + rest_->name(); }
+  void Sample(const GfcsQuery& query, int intermediate_commands, int count, std::mt19937_64* rng,
+              Eigen::MatrixXd* out) override;
+
+ private:
+  CommandSampler* first_;
+  double share_;
+  CommandSampler* rest_;
+  Eigen::MatrixXd part_;
+};
+
 /// One evaluated command sequence.
 struct GfcsCandidate {
   Eigen::VectorXd commands;  ///< y [7n]

@@ -15,6 +15,7 @@
 #include <random>
 #include <utility>
 
+#include "core/error.h"
 #include "inference/manipulation/builtin_panda.h"
 #include "inference/manipulation/gfcs.h"
 #include "inference/manipulation/synthetic_problems.h"
@@ -674,6 +675,46 @@ TEST(Gfcs, BadQueriesAreStatusesNotExceptions) {
   const GfcsSolution s = SolveGfcop(fabric, query, &sampler, GfcsParams{});
   EXPECT_EQ(s.status, GfcsStatus::kError);
   EXPECT_NE(s.message.find("non-finite"), std::string::npos);
+}
+
+/// Returns columns 1000 k + c (k = its call count) and draws one number per call.
+class CountingSampler : public CommandSampler {
+ public:
+  std::string name() const override { return "counting"; }
+  void Sample(const GfcsQuery&, int intermediate_commands, int count, std::mt19937_64* rng,
+              Eigen::MatrixXd* out) override {
+    (*rng)();
+    out->resize(kDof * intermediate_commands, count);
+    for (int c = 0; c < count; ++c) out->col(c).setConstant(1000.0 * calls + c);
+    ++calls;
+  }
+  int calls = 0;
+};
+
+TEST(SplitSampler, TakesTheRoundedShareFromTheFirstAndTheRestFromTheSecond) {
+  CountingSampler a, b;
+  SplitSampler split(&a, 0.3, &b);
+  EXPECT_EQ(split.name(), "counting+counting");
+  std::mt19937_64 rng(4), reference(4);
+  Eigen::MatrixXd out;
+  split.Sample(GfcsQuery{}, 2, 5, &rng, &out);  // round(1.5) = 2 from a, 3 from b
+  ASSERT_EQ(out.rows(), 14);
+  ASSERT_EQ(out.cols(), 5);
+  const double expected[5] = {0, 1, 0, 1, 2};
+  for (int c = 0; c < 5; ++c) EXPECT_EQ(out(0, c), expected[c]) << c;
+  EXPECT_EQ(a.calls, 1);
+  EXPECT_EQ(b.calls, 1);
+  reference();
+  reference();  // one draw each, a's first
+  EXPECT_TRUE(rng == reference);
+  // Shares 0 and 1 call only one of the two.
+  SplitSampler none(&a, 0.0, &b), all(&a, 1.0, &b);
+  none.Sample(GfcsQuery{}, 1, 3, &rng, &out);
+  all.Sample(GfcsQuery{}, 1, 3, &rng, &out);
+  EXPECT_EQ(a.calls, 2);
+  EXPECT_EQ(b.calls, 2);
+  EXPECT_THROW(SplitSampler(&a, 1.5, &b), Error);
+  EXPECT_THROW(SplitSampler(nullptr, 0.5, &b), Error);
 }
 
 }  // namespace

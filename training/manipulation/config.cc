@@ -47,6 +47,15 @@ void ExperimentConfig::Validate(const std::string& path) const {
             (m.kind == PlanMethodKind::kGfcs && m.sampler == GfcsSamplerKind::kLearned),
         path, ": methods: '", m.name,
         "' sets sgld_pick: random, which only a gfcs method with sampler: learned uses");
+  for (const PlanMethodConfig& m : methods) {
+    if (m.nearest_share == 0) continue;
+    FS_THROW_UNLESS(m.kind == PlanMethodKind::kGfcs && m.sampler != GfcsSamplerKind::kNearest, path,
+                    ": methods: '", m.name, "' sets nearest_share ", m.nearest_share,
+                    ", which only a gfcs method with sampler: uniform or learned uses");
+    FS_THROW_UNLESS(!energy_model.empty(), path, ": methods: '", m.name,
+                    "' sets nearest_share, but energy_model (the artifact with the solution "
+                    "memory) is empty");
+  }
   FS_THROW_UNLESS(fabric.t_max >= fabric.dt, path, ": fabric.t_max (", fabric.t_max,
                   ") is below fabric.dt (", fabric.dt, ")");
 }

@@ -66,6 +66,9 @@ struct PlanMethodConfig {
   double uniform_share = 0;
   /// gfcs with the learned sampler: which SGLD survivors fill the batch (SgldParams::pick).
   SgldPick sgld_pick = SgldPick::kLowestEnergy;
+  /// gfcs with sampler uniform or learned: share of the first batch taken from energy_model's
+  /// solution memory as the nearest sampler takes it (SplitSampler), the rest from `sampler`.
+  double nearest_share = 0;
 
   template <class A>
   void Serialize(A* a) {
@@ -95,6 +98,9 @@ struct PlanMethodConfig {
                                              {SgldPick::kRandom, "random"}},
                  "gfcs, sampler learned: the lowest-energy SGLD survivors, or a random draw of "
                  "them (the spread of the SGLD distribution)");
+    a->Visit("nearest_share", &nearest_share, config::Range::Closed(0, 1),
+             "gfcs, sampler uniform or learned: share of the first batch taken from "
+             "energy_model's solution memory as sampler: nearest takes it, the rest from sampler");
   }
 };
 

@@ -278,20 +278,21 @@ PlanReport RunPlanExperiment(const ExperimentConfig& c, const std::string& run_d
   std::vector<std::optional<NearestSampler>> nearest(c.methods.size());
   for (std::size_t m = 0; m < c.methods.size(); ++m) {
     const PlanMethodConfig& method = c.methods[m];
-    if (method.kind != PlanMethodKind::kGfcs || method.sampler == GfcsSamplerKind::kUniform)
+    if (method.kind != PlanMethodKind::kGfcs ||
+        (method.sampler == GfcsSamplerKind::kUniform && method.nearest_share == 0))
       continue;
     if (!energy) {
       energy.emplace(EnergyModel::Load(c.energy_model));
       log::Info("learned sampler: ", c.energy_model);
     }
-    if (method.sampler == GfcsSamplerKind::kNearest) {
+    if (method.sampler == GfcsSamplerKind::kNearest || method.nearest_share > 0) {
       try {
         nearest[m].emplace(*energy, c.gfcs.top_m);
       } catch (const Error& e) {
         Fail(c.energy_model, ": method '", method.name, "': ", e.what());
       }
-      continue;
     }
+    if (method.sampler != GfcsSamplerKind::kLearned) continue;
     SgldParams sgld = c.sgld;
     sgld.uniform_share = method.uniform_share;
     sgld.pick = method.sgld_pick;
@@ -334,17 +335,22 @@ PlanReport RunPlanExperiment(const ExperimentConfig& c, const std::string& run_d
             case PlanMethodKind::kGfcs: {
               CommandSampler* sampler = &uniform;
               double encode_s = 0;  // the world's encoding is part of the learned method's time
+              const auto started = bench::Clock::now();
               if (learned[m]) {
-                const auto started = bench::Clock::now();
                 learned[m]->SetWorld(problem.world);
-                encode_s = bench::SecondsSince(started);
                 sampler = &*learned[m];
-              } else if (nearest[m]) {
-                const auto started = bench::Clock::now();
-                nearest[m]->SetWorld(problem.world);
-                encode_s = bench::SecondsSince(started);
-                sampler = &*nearest[m];
               }
+              std::optional<SplitSampler> split;
+              if (nearest[m]) {
+                nearest[m]->SetWorld(problem.world);
+                if (method.sampler == GfcsSamplerKind::kNearest) {
+                  sampler = &*nearest[m];
+                } else {  // nearest_share of the batch from the memory, the rest from `sampler`
+                  split.emplace(&*nearest[m], method.nearest_share, sampler);
+                  sampler = &*split;
+                }
+              }
+              if (learned[m] || nearest[m]) encode_s = bench::SecondsSince(started);
               t = RunGfcs(fabric, problem, c, method, sampler, seed, &best);
               t.generation_time_s += encode_s;
               t.encode_s = encode_s;
