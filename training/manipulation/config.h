@@ -69,6 +69,9 @@ struct PlanMethodConfig {
   /// gfcs with sampler uniform or learned: share of the first batch taken from energy_model's
   /// solution memory as the nearest sampler takes it (SplitSampler), the rest from `sampler`.
   double nearest_share = 0;
+  /// gfcs with the nearest sampler (or a nearest_share): solutions taken from each memory problem
+  /// (0: gfcs.top_m, the number a loop's solve keeps).
+  int nearest_per_problem = 0;
 
   template <class A>
   void Serialize(A* a) {
@@ -101,6 +104,9 @@ struct PlanMethodConfig {
     a->Visit("nearest_share", &nearest_share, config::Range::Closed(0, 1),
              "gfcs, sampler uniform or learned: share of the first batch taken from "
              "energy_model's solution memory as sampler: nearest takes it, the rest from sampler");
+    a->Visit("nearest_per_problem", &nearest_per_problem, config::Range::Closed(0, 10000),
+             "gfcs, nearest sampler or nearest_share: solutions taken from each nearest memory "
+             "problem (0: gfcs.top_m)");
   }
 };
 
