@@ -287,8 +287,8 @@ PlanReport RunPlanExperiment(const ExperimentConfig& c, const std::string& run_d
     }
     if (method.sampler == GfcsSamplerKind::kNearest || method.nearest_share > 0) {
       try {
-        nearest[m].emplace(*energy, method.nearest_per_problem > 0 ? method.nearest_per_problem
-                                                                   : c.gfcs.top_m);
+        nearest[m].emplace(
+            *energy, method.nearest_per_problem > 0 ? method.nearest_per_problem : c.gfcs.top_m);
       } catch (const Error& e) {
         Fail(c.energy_model, ": method '", method.name, "': ", e.what());
       }
