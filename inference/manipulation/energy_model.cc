@@ -529,11 +529,7 @@ void LearnedSampler::Sample(const GfcsQuery& query, int intermediate_commands, i
       out->col(c) = model_.CommandsToRadians(last_.u.col(picked_[static_cast<std::size_t>(c)]));
   }
   last_filled_ = learned - kept;
-  std::uniform_real_distribution<double> uniform(0.0, 1.0);
-  const JointVector& lo = model_.parts().lower;
-  const JointVector& hi = model_.parts().upper;
-  for (int c = kept; c < count; ++c)
-    for (int d = 0; d < D; ++d) (*out)(d, c) = lo[d % kDof] + (hi - lo)[d % kDof] * uniform(*rng);
+  FillUniform(model_.parts().lower, model_.parts().upper, kept, rng, out);
   last_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 

@@ -82,14 +82,18 @@ UniformSampler::UniformSampler(const JointVector& lower, const JointVector& uppe
                   "uniform sampler: every lower joint limit must be below the upper one");
 }
 
+void FillUniform(const JointVector& lower, const JointVector& upper, Eigen::Index first,
+                 std::mt19937_64* rng, Eigen::MatrixXd* out) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (Eigen::Index c = first; c < out->cols(); ++c)
+    for (Eigen::Index i = 0; i < out->rows(); ++i)
+      (*out)(i, c) = lower[i % kDof] + unit(*rng) * (upper[i % kDof] - lower[i % kDof]);
+}
+
 void UniformSampler::Sample(const GfcsQuery& /*query*/, int intermediate_commands, int count,
                             std::mt19937_64* rng, Eigen::MatrixXd* out) {
   out->resize(kDof * intermediate_commands, count);
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  for (int c = 0; c < count; ++c)
-    for (int k = 0; k < intermediate_commands; ++k)
-      for (int j = 0; j < kDof; ++j)
-        (*out)(k * kDof + j, c) = lower_[j] + unit(*rng) * (upper_[j] - lower_[j]);
+  FillUniform(lower_, upper_, 0, rng, out);
 }
 
 SplitSampler::SplitSampler(CommandSampler* first, double share, CommandSampler* rest)

@@ -77,6 +77,11 @@ class CommandSampler {
                       std::mt19937_64* rng, Eigen::MatrixXd* out) = 0;
 };
 
+/// Columns first .. cols-1 of `out` [7n x cols] drawn uniformly in the joint limits, column by
+/// column, row by row (row i is joint i mod 7): the draws every sampler's uniform part makes.
+void FillUniform(const JointVector& lower, const JointVector& upper, Eigen::Index first,
+                 std::mt19937_64* rng, Eigen::MatrixXd* out);
+
 class UniformSampler : public CommandSampler {
  public:
   UniformSampler(const JointVector& lower, const JointVector& upper);

@@ -87,12 +87,7 @@ void NearestSampler::Sample(const GfcsQuery& query, int intermediate_commands, i
       out->col(c++) = model_.CommandsToRadians(m.commands.col(list[k]));
   }
   last_filled_ = count - c;
-  std::uniform_real_distribution<double> uniform(0.0, 1.0);
-  const JointVector& lo = model_.parts().lower;
-  const JointVector& hi = model_.parts().upper;
-  for (; c < count; ++c)
-    for (Eigen::Index j = 0; j < out->rows(); ++j)
-      (*out)(j, c) = lo[j % kDof] + (hi - lo)[j % kDof] * uniform(*rng);
+  FillUniform(model_.parts().lower, model_.parts().upper, c, rng, out);
 }
 
 }  // namespace foresight::manipulation
