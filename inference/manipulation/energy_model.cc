@@ -473,25 +473,32 @@ SgldResult RunSgld(const EnergyModel& model, const Eigen::VectorXf& context,
 
 // ---------------------------------------------------------------------------------------------
 LearnedSampler::LearnedSampler(const EnergyModel& model, SgldParams params)
-    : model_(model), params_(params) {
+    : ContextSampler(model), params_(params) {
   FS_THROW_UNLESS(params.threads >= 1, "LearnedSampler: threads must be >= 1, got ",
                   params.threads);
 }
 
-void LearnedSampler::SetWorld(const World& world) {
+void ContextSampler::SetWorld(const World& world) {
   encoding_ = model_.EncodeWorld(world);
   has_world_ = true;
+}
+
+const Eigen::VectorXf& ContextSampler::PrepareContext(const char* who, const GfcsQuery& query,
+                                                      int intermediate_commands, int count) {
+  FS_THROW_UNLESS(intermediate_commands == model_.intermediate_commands(), who, ": asked for ",
+                  intermediate_commands, " intermediate commands, the energy model works with ",
+                  model_.intermediate_commands());
+  FS_THROW_UNLESS(has_world_, who, ": call SetWorld before Sample");
+  FS_THROW_UNLESS(count >= 0, who, ": count ", count, " is negative");
+  model_.Context(query, encoding_, &context_);
+  return context_;
 }
 
 void LearnedSampler::Sample(const GfcsQuery& query, int intermediate_commands, int count,
                             std::mt19937_64* rng, Eigen::MatrixXd* out) {
   const auto t0 = std::chrono::steady_clock::now();
-  FS_THROW_UNLESS(intermediate_commands == model_.intermediate_commands(),
-                  "LearnedSampler: asked for ", intermediate_commands,
-                  " intermediate commands, the energy model was trained for ",
-                  model_.intermediate_commands());
-  FS_THROW_UNLESS(has_world_, "LearnedSampler: call SetWorld before Sample");
-  FS_THROW_UNLESS(count >= 0, "LearnedSampler: count ", count, " is negative");
+  const Eigen::VectorXf& context =
+      PrepareContext("LearnedSampler", query, intermediate_commands, count);
   FS_THROW_UNLESS(params_.uniform_share >= 0 && params_.uniform_share <= 1,
                   "LearnedSampler: uniform_share ", params_.uniform_share, " is outside [0, 1]");
   const int learned =
@@ -509,8 +516,7 @@ void LearnedSampler::Sample(const GfcsQuery& query, int intermediate_commands, i
       ws_.clear();
       for (int t = 0; t < threads; ++t) ws_.push_back(model_.MakeWorkspace(per_thread));
     }
-    model_.Context(query, encoding_, &context_);
-    last_ = RunSgld(model_, context_, p, rng, &ws_);
+    last_ = RunSgld(model_, context, p, rng, &ws_);
     const int survivors = static_cast<int>(last_.u.cols());
     kept = std::min<int>(learned, survivors);
     picked_.resize(static_cast<std::size_t>(survivors));

@@ -208,16 +208,38 @@ SgldResult RunSgld(const EnergyModel& model, const Eigen::VectorXf& context,
 int SgldBlockCapacity(int particles, int threads);
 
 // ---------------------------------------------------------------------------------------------
+/// A sampler that reads a problem through the energy model's context (the learned sampler and its
+/// nearest-neighbour baseline): SetWorld encodes the world once per problem, and PrepareContext
+/// checks a Sample call and gives the query's context.
+class ContextSampler : public CommandSampler {
+ public:
+  /// Computes the world encoding once (EnergyModel::EncodeWorld).
+  void SetWorld(const World& world);
+
+ protected:
+  /// `model` must outlive the sampler.
+  explicit ContextSampler(const EnergyModel& model) : model_(model) {}
+  /// Error naming `who` when intermediate_commands != the model's n, SetWorld was not called or
+  /// count < 0; else the context of `query` in the current world.
+  const Eigen::VectorXf& PrepareContext(const char* who, const GfcsQuery& query,
+                                        int intermediate_commands, int count);
+
+  const EnergyModel& model_;
+
+ private:
+  Eigen::VectorXf encoding_, context_;
+  bool has_world_ = false;
+};
+
+// ---------------------------------------------------------------------------------------------
 /// The learned GFCS sampler: SGLD on the energy model, the lowest-energy particles in radians,
 /// on params.threads threads. Call SetWorld once per problem before Sample. Not thread-safe (one
 /// per caller).
-class LearnedSampler : public CommandSampler {
+class LearnedSampler : public ContextSampler {
  public:
   /// `model` must outlive the sampler.
   LearnedSampler(const EnergyModel& model, SgldParams params);
   std::string name() const override { return "learned"; }
-  /// Computes the world encoding once (EnergyModel::EncodeWorld).
-  void SetWorld(const World& world);
   /// Runs SGLD with max(particles, learned) particles, learned = count - round(uniform_share
   /// count); `out` [7n x count] holds `learned` survivors in radians (the lowest-energy ones, or
   /// with params.pick = kRandom a uniform draw without replacement from `rng`, in energy order),
@@ -234,10 +256,7 @@ class LearnedSampler : public CommandSampler {
   double last_seconds() const { return last_seconds_; }  ///< wall time of the last Sample
 
  private:
-  const EnergyModel& model_;
   SgldParams params_;
-  Eigen::VectorXf encoding_, context_;
-  bool has_world_ = false;
   std::vector<EnergyModel::Workspace> ws_;  ///< one per SGLD thread
   SgldResult last_;
   std::vector<int> picked_;  ///< survivor indices (kRandom), reused between calls

@@ -9,7 +9,7 @@
 namespace foresight::manipulation {
 
 NearestSampler::NearestSampler(const EnergyModel& model, int per_problem)
-    : model_(model), per_problem_(per_problem) {
+    : ContextSampler(model), per_problem_(per_problem) {
   FS_THROW_UNLESS(per_problem >= 1, "NearestSampler: per_problem ", per_problem,
                   " must be at least 1");
   const SolutionMemory& m = model.parts().memory;
@@ -43,11 +43,6 @@ NearestSampler::NearestSampler(const EnergyModel& model, int per_problem)
     std::stable_sort(list.begin(), list.end(), [&](int a, int b) { return m.cost[a] < m.cost[b]; });
 }
 
-void NearestSampler::SetWorld(const World& world) {
-  encoding_ = model_.EncodeWorld(world);
-  has_world_ = true;
-}
-
 Eigen::VectorXd NearestSampler::Distances(const Eigen::VectorXf& context) const {
   const Eigen::MatrixXf& contexts = model_.parts().memory.contexts;
   FS_THROW_UNLESS(context.size() == contexts.rows(), "NearestSampler: a context of ",
@@ -63,14 +58,8 @@ Eigen::VectorXd NearestSampler::Distances(const Eigen::VectorXf& context) const 
 
 void NearestSampler::Sample(const GfcsQuery& query, int intermediate_commands, int count,
                             std::mt19937_64* rng, Eigen::MatrixXd* out) {
-  FS_THROW_UNLESS(intermediate_commands == model_.intermediate_commands(),
-                  "NearestSampler: asked for ", intermediate_commands,
-                  " intermediate commands, the memory holds sequences of ",
-                  model_.intermediate_commands());
-  FS_THROW_UNLESS(has_world_, "NearestSampler: call SetWorld before Sample");
-  FS_THROW_UNLESS(count >= 0, "NearestSampler: count ", count, " is negative");
-  model_.Context(query, encoding_, &context_);
-  const Eigen::VectorXd d = Distances(context_);
+  const Eigen::VectorXd d =
+      Distances(PrepareContext("NearestSampler", query, intermediate_commands, count));
   std::vector<int> order(static_cast<std::size_t>(d.size()));
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return d[a] < d[b]; });

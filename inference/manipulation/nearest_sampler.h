@@ -27,14 +27,12 @@
 
 namespace foresight::manipulation {
 
-class NearestSampler : public CommandSampler {
+class NearestSampler : public ContextSampler {
  public:
   /// `model` must outlive the sampler and hold a solution memory (else Error naming what is
   /// missing); per_problem >= 1.
   NearestSampler(const EnergyModel& model, int per_problem);
   std::string name() const override { return "nearest"; }
-  /// Computes the world encoding once (EnergyModel::EncodeWorld).
-  void SetWorld(const World& world);
   /// `out` [7n x count] in radians. Error when intermediate_commands != the model's n or SetWorld
   /// was not called.
   void Sample(const GfcsQuery& query, int intermediate_commands, int count, std::mt19937_64* rng,
@@ -46,13 +44,10 @@ class NearestSampler : public CommandSampler {
   int last_problems() const { return last_problems_; }  ///< memory problems the last batch used
 
  private:
-  const EnergyModel& model_;
   int per_problem_;
   Eigen::VectorXd inv_spread_;  ///< [context] 1 / s_i, 0 for constant dimensions
   Eigen::VectorXd weight_;      ///< [context] the block weight 1 / (varying dims in the block)
   std::vector<std::vector<int>> by_problem_;  ///< solutions of each problem, cheapest first
-  Eigen::VectorXf encoding_, context_;
-  bool has_world_ = false;
   int last_filled_ = 0, last_problems_ = 0;
 };
 

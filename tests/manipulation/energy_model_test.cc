@@ -545,7 +545,7 @@ TEST(LearnedSampler, ReturnsTheLowestEnergyParticlesInRadians) {
   ExpectErrorContains([&] { base->Sample(SomeQuery(), 2, 5, &rng, &out); }, {"SetWorld"});
   s.SetWorld(SomeWorld());
   ExpectErrorContains([&] { base->Sample(SomeQuery(), 1, 5, &rng, &out); },
-                      {"1 intermediate commands", "trained for 2"});
+                      {"1 intermediate commands", "the energy model works with 2"});
   base->Sample(SomeQuery(), 2, 5, &rng, &out);
   ASSERT_EQ(out.rows(), 14);
   ASSERT_EQ(out.cols(), 5);
@@ -795,7 +795,7 @@ TEST(NearestSampler, TakesTheNearestProblemsCheapestSolutionsThenFillsUniformly)
   ExpectErrorContains([&] { sampler.Sample(queries[0], 1, 3, &rng, &out); }, {"SetWorld"});
   sampler.SetWorld(SomeWorld());
   ExpectErrorContains([&] { sampler.Sample(queries[0], 2, 3, &rng, &out); },
-                      {"asked for 2", "sequences of 1"});
+                      {"NearestSampler: asked for 2", "the energy model works with 1"});
   // Query = problem 2's: problem 2 (distance 0; its two cheapest of three: 3, 4), then problem 1
   // (nearer than 0 in both varying joints: 5), then problem 0 (1, 0), then uniform draws.
   sampler.Sample(queries[2], 1, 7, &rng, &out);
