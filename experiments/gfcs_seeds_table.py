@@ -58,6 +58,33 @@ def main():
         cells = [f"{u} / {lr} of {n} ({lr - u:+d})" for u, lr, n in totals]
         diffs = [lr - u for u, lr, _ in totals]
         print("| all | " + " | ".join(cells) + f" | {min(diffs):+d} / {max(diffs):+d}, {sum(diffs):+d} |\n")
+    # The nearest-neighbour sampler (runs whose loop kept its solution memory: eval.nearest).
+    near = [(seed, j) for seed, j in runs
+            if all(successes(st, "GFCS nearest (1 batch)") for st in j["sets"])]
+    if near:
+        print("## The nearest-neighbour sampler (the learned sampler's trivial baseline)\n")
+        print("Runs whose loop kept its solutions (docs/gfcs.md). Cells: solved held-out problems, "
+              "nearest (nearest - learned), 1 batch / 5 batches.\n")
+        print("| family | " + " | ".join(f"seed {s}" for s, _ in near) + " |")
+        print("|---|" + "---|" * len(near))
+        totals = [[0, 0, 0, 0] for _ in near]
+        for f in families:
+            cells = []
+            for i, (_, j) in enumerate(near):
+                st = next(x for x in j["sets"] if x["set"] == f)
+                parts = []
+                for k, b in enumerate(BATCHES):
+                    n, lr = successes(st, f"GFCS nearest ({b})"), successes(st, f"GFCS learned ({b})")
+                    if n is None or lr is None:
+                        parts.append("-")
+                        continue
+                    totals[i][2 * k] += n[0]
+                    totals[i][2 * k + 1] += lr[0]
+                    parts.append(f"{n[0]} ({n[0] - lr[0]:+d})")
+                cells.append(" / ".join(parts))
+            print(f"| {f} | " + " | ".join(cells) + " |")
+        print("| all | " + " | ".join(f"{a} ({a - b:+d}) / {c} ({c - d:+d})" for a, b, c, d in totals)
+              + " |\n")
     print("## The loops\n")
     print("Loop time: the wall time the run recorded; comparable only between runs on an idle "
           "machine.\n")
