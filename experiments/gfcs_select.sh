@@ -9,7 +9,9 @@
 #   experiments/gfcs_select.sh
 #   SHARES="0.25 0.5" experiments/gfcs_select.sh
 #   SHARES= NEAREST_SHARES=0.5 REPEATS=10 RESULT=results/gfcs_select_nearest.md experiments/gfcs_select.sh
-#     (the nearest-neighbour sampler, and batches split between it and the uniform or learned one)
+#     (the nearest-neighbour sampler, and batches split between it and the uniform or learned one;
+#      NEAREST_PER_PROBLEM="1 2": other numbers of solutions per memory problem; SGLD_INIT=memory:
+#      the learned sampler's SGLD started at the nearest sampler's candidates)
 #   SHARES= PICKS=random RESULT=results/gfcs_select_pick.md experiments/gfcs_select.sh   (which SGLD
 #     survivors fill the batch: a random draw beside the shipped lowest-energy ones)
 #   SHARES= REPEATS=10 RESULT=... experiments/gfcs_select.sh   (10 draws per problem and method, seeds
@@ -87,6 +89,10 @@ done
 # from the memory, the rest uniform or learned (methods[].nearest_share).
 if grep -q "nearest:" "$RUN/config.yaml"; then
   methods+=", {name: nearest, kind: gfcs, batches: 1, sampler: nearest}"
+  # SGLD_INIT=memory: the learned sampler with SGLD started at the nearest sampler's candidates
+  if [ "${SGLD_INIT:-}" = memory ]; then
+    methods+=", {name: \"learned from memory\", kind: gfcs, batches: 1, sampler: learned, sgld_init: memory}"
+  fi
   # NEAREST_PER_PROBLEM="1 2": the nearest sampler taking that many solutions per memory problem
   for k in ${NEAREST_PER_PROBLEM:-}; do
     methods+=", {name: \"nearest per problem $k\", kind: gfcs, batches: 1, sampler: nearest, nearest_per_problem: $k}"
@@ -193,6 +199,12 @@ for n in (n for n in names if n.startswith("nearest per problem ")):
     verdict = "adopted" if margin >= near_margin else "not adopted"
     print(f"\n`{n}`: {margin:+d} against the nearest sampler's top-m per problem: {verdict} "
           f"(margin {near_margin}).")
+if "learned from memory" in totals and "nearest" in totals:
+    margin = totals["learned from memory"]["ok"] - totals["nearest"]["ok"]
+    verdict = "adopted" if margin >= near_margin else "not adopted"
+    print(f"\n`learned from memory`: {margin:+d} against the nearest sampler alone, "
+          f"{totals['learned from memory']['ok'] - totals['learned']['ok']:+d} against SGLD from "
+          f"uniform starts: {verdict} (margin {near_margin} against the nearest sampler).")
 mixed = [n for n in names if "+nearest " in n]
 if "nearest" in totals and mixed:
     best = max(mixed, key=key)

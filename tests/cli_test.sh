@@ -156,6 +156,8 @@ expect_error "'G' sets nearest_share 0.5, which only a gfcs method with sampler:
   --run-dir "$TMP/plan11"
 expect_error "'G' sets nearest_share, but energy_model" plan default \
   "methods=[{name: G, kind: gfcs, nearest_share: 0.5}]" --run-dir "$TMP/plan12"
+expect_error "'G' sets sgld_init: memory, which only a gfcs method with sampler: learned uses" plan default \
+  "methods=[{name: G, kind: gfcs, sgld_init: memory}]" --run-dir "$TMP/plan13"
 expect_error "uniform_share" plan default "methods=[{name: G, kind: gfcs, sampler: learned, uniform_share: 2}]" \
   energy_model=x.h5 --run-dir "$TMP/plan8"
 expect_error "missing MBM problems directory" plan configs/manipulation/box.yaml problems.family=no_such_family robot=builtin \

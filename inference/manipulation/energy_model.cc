@@ -389,7 +389,7 @@ namespace {
 
 SgldResult RunSgldOn(const EnergyModel& model, const Eigen::VectorXf& context,
                      const SgldParams& params, std::mt19937_64* rng,
-                     EnergyModel::Workspace* const* ws, int threads) {
+                     EnergyModel::Workspace* const* ws, int threads, const Eigen::MatrixXf* start) {
   const int P = params.particles, D = model.command_size();
   FS_THROW_UNLESS(
       P >= 1 && params.steps >= 0 && std::isfinite(params.step_scale) && params.step_scale > 0 &&
@@ -402,8 +402,16 @@ SgldResult RunSgldOn(const EnergyModel& model, const Eigen::VectorXf& context,
     FS_THROW_UNLESS(ws[t]->max_particles >= per_thread, "RunSgld: ", per_thread,
                     " particles per thread for a workspace made for ", ws[t]->max_particles);
   Eigen::MatrixXf u(D, P);
-  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
-  for (Eigen::Index i = 0; i < u.size(); ++i) u.data()[i] = static_cast<float>(uniform(*rng));
+  if (start) {
+    FS_THROW_UNLESS(start->rows() == D && start->cols() == P && start->allFinite() &&
+                        start->cwiseAbs().maxCoeff() <= 1.0f,
+                    "RunSgld: the start particles are ", start->rows(), " x ", start->cols(),
+                    ", expected ", D, " x ", P, ", finite and in [-1, 1]");
+    u = *start;
+  } else {
+    std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+    for (Eigen::Index i = 0; i < u.size(); ++i) u.data()[i] = static_cast<float>(uniform(*rng));
+  }
   std::normal_distribution<double> normal(0.0, 1.0);
   Eigen::VectorXf E;
   Eigen::MatrixXf G;
@@ -459,16 +467,17 @@ SgldResult RunSgldOn(const EnergyModel& model, const Eigen::VectorXf& context,
 }  // namespace
 
 SgldResult RunSgld(const EnergyModel& model, const Eigen::VectorXf& context,
-                   const SgldParams& params, std::mt19937_64* rng, EnergyModel::Workspace* ws) {
-  return RunSgldOn(model, context, params, rng, &ws, 1);
+                   const SgldParams& params, std::mt19937_64* rng, EnergyModel::Workspace* ws,
+                   const Eigen::MatrixXf* start) {
+  return RunSgldOn(model, context, params, rng, &ws, 1, start);
 }
 
 SgldResult RunSgld(const EnergyModel& model, const Eigen::VectorXf& context,
                    const SgldParams& params, std::mt19937_64* rng,
-                   std::vector<EnergyModel::Workspace>* workspaces) {
+                   std::vector<EnergyModel::Workspace>* workspaces, const Eigen::MatrixXf* start) {
   std::vector<EnergyModel::Workspace*> ws;
   for (EnergyModel::Workspace& w : *workspaces) ws.push_back(&w);
-  return RunSgldOn(model, context, params, rng, ws.data(), static_cast<int>(ws.size()));
+  return RunSgldOn(model, context, params, rng, ws.data(), static_cast<int>(ws.size()), start);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -516,7 +525,16 @@ void LearnedSampler::Sample(const GfcsQuery& query, int intermediate_commands, i
       ws_.clear();
       for (int t = 0; t < threads; ++t) ws_.push_back(model_.MakeWorkspace(per_thread));
     }
-    last_ = RunSgld(model_, context, p, rng, &ws_);
+    const Eigen::MatrixXf* start = nullptr;
+    if (start_) {  // particles start at another sampler's candidates instead of uniform draws
+      start_->Sample(query, intermediate_commands, p.particles, rng, &start_radians_);
+      start_u_.resize(model_.command_size(), p.particles);
+      for (int c = 0; c < p.particles; ++c)
+        start_u_.col(c) =
+            model_.RadiansToCommands(start_radians_.col(c)).cwiseMax(-1.0f).cwiseMin(1.0f);
+      start = &start_u_;
+    }
+    last_ = RunSgld(model_, context, p, rng, &ws_, start);
     const int survivors = static_cast<int>(last_.u.cols());
     kept = std::min<int>(learned, survivors);
     picked_.resize(static_cast<std::size_t>(survivors));

@@ -195,15 +195,19 @@ struct SgldResult {
 /// A particle whose energy or gradient is non-finite (at any step or at the end) is dropped; more
 /// than max_dropped_share * particles dropped throws Error (count, share, limit). Deterministic
 /// for a given rng state. `ws` must hold at least params.particles particles (else Error).
+/// `start` [7n x particles] (finite, in [-1, 1]; else Error): the particles' starting points
+/// instead of uniform draws (which then draw nothing from rng).
 SgldResult RunSgld(const EnergyModel& model, const Eigen::VectorXf& context,
-                   const SgldParams& params, std::mt19937_64* rng, EnergyModel::Workspace* ws);
+                   const SgldParams& params, std::mt19937_64* rng, EnergyModel::Workspace* ws,
+                   const Eigen::MatrixXf* start = nullptr);
 /// The same on `workspaces->size()` threads (the calling one and size - 1 started per step), each
 /// workspace holding at least SgldBlockCapacity(particles, size) particles; params.threads is not
 /// read. The particles are split into blocks that start at multiples of 8, so that every
 /// particle's evaluation is the one it gets undivided: the result equals RunSgld's on one thread.
 SgldResult RunSgld(const EnergyModel& model, const Eigen::VectorXf& context,
                    const SgldParams& params, std::mt19937_64* rng,
-                   std::vector<EnergyModel::Workspace>* workspaces);
+                   std::vector<EnergyModel::Workspace>* workspaces,
+                   const Eigen::MatrixXf* start = nullptr);
 /// The most particles one of `threads` workspaces receives from RunSgld.
 int SgldBlockCapacity(int particles, int threads);
 
@@ -250,6 +254,10 @@ class LearnedSampler : public ContextSampler {
   void Sample(const GfcsQuery& query, int intermediate_commands, int count, std::mt19937_64* rng,
               Eigen::MatrixXd* out) override;
 
+  /// SGLD's particles start at `start`'s candidates for the query (e.g. the nearest sampler's: the
+  /// energy model refines retrieved solutions) instead of uniform draws; null: uniform (thesis).
+  /// `start` must outlive the sampler's use and have its world set by the caller.
+  void SetStart(CommandSampler* start) { start_ = start; }
   const SgldResult& last_result() const { return last_; }
   int last_dropped() const { return last_.dropped; }
   int last_filled() const { return last_filled_; }
@@ -257,6 +265,9 @@ class LearnedSampler : public ContextSampler {
 
  private:
   SgldParams params_;
+  CommandSampler* start_ = nullptr;
+  Eigen::MatrixXd start_radians_;
+  Eigen::MatrixXf start_u_;
   std::vector<EnergyModel::Workspace> ws_;  ///< one per SGLD thread
   SgldResult last_;
   std::vector<int> picked_;  ///< survivor indices (kRandom), reused between calls

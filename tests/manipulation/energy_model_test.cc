@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <random>
 
@@ -817,6 +818,51 @@ TEST(NearestSampler, TakesTheNearestProblemsCheapestSolutionsThenFillsUniformly)
   EXPECT_TRUE(out.col(0).isApprox(model.CommandsToRadians(m.commands.col(3)), 1e-12));
   EXPECT_EQ(sampler.last_filled(), 0);
   EXPECT_TRUE(rng == before);
+}
+
+TEST(LearnedSampler, SgldCanStartAtAnotherSamplersCandidates) {
+  std::vector<GfcsQuery> queries;
+  const EnergyModel model(PartsWithMemory(&queries));
+  NearestSampler nearest(model, 4);
+  nearest.SetWorld(SomeWorld());
+  SgldParams params;
+  params.particles = 3;
+  params.steps = 0;  // no Langevin step: the survivors are the start points, by energy
+  LearnedSampler learned(model, params);
+  learned.SetWorld(SomeWorld());
+  learned.SetStart(&nearest);
+  std::mt19937_64 rng(2);
+  Eigen::MatrixXd out, expected;
+  learned.Sample(queries[2], 1, 3, &rng, &out);
+  std::mt19937_64 unused(2);
+  nearest.Sample(queries[2], 1, 3, &unused, &expected);
+  // The same three candidates, in the order of their energies.
+  Eigen::VectorXf E;
+  Eigen::MatrixXf u(7, 3);
+  for (int c = 0; c < 3; ++c) u.col(c) = model.RadiansToCommands(expected.col(c));
+  auto ws = model.MakeWorkspace(3);
+  Eigen::VectorXf context;
+  model.Context(queries[2], model.EncodeWorld(SomeWorld()), &context);
+  model.EnergyAndGradient(context, u, &E, nullptr, &ws);
+  std::vector<int> order = {0, 1, 2};
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return E[a] < E[b]; });
+  for (int c = 0; c < 3; ++c) EXPECT_TRUE(out.col(c).isApprox(expected.col(order[c]), 1e-5)) << c;
+  // With steps the particles move from there, deterministically for a seed.
+  params.steps = 5;
+  LearnedSampler moving(model, params);
+  moving.SetWorld(SomeWorld());
+  moving.SetStart(&nearest);
+  std::mt19937_64 a(3), b(3);
+  Eigen::MatrixXd first, second;
+  moving.Sample(queries[2], 1, 3, &a, &first);
+  moving.Sample(queries[2], 1, 3, &b, &second);
+  EXPECT_EQ(first, second);
+  EXPECT_FALSE(first.isApprox(out, 1e-9));
+  // Start points of the wrong shape are an error.
+  Eigen::MatrixXf bad = Eigen::MatrixXf::Zero(7, 2);
+  auto ws3 = model.MakeWorkspace(3);
+  ExpectErrorContains([&] { RunSgld(model, context, params, &a, &ws3, &bad); },
+                      {"start particles are 7 x 2", "expected 7 x 3"});
 }
 
 }  // namespace

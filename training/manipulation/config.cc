@@ -48,10 +48,17 @@ void ExperimentConfig::Validate(const std::string& path) const {
         path, ": methods: '", m.name,
         "' sets sgld_pick: random, which only a gfcs method with sampler: learned uses");
   for (const PlanMethodConfig& m : methods)
+    FS_THROW_UNLESS(m.nearest_per_problem == 0 || m.sampler == GfcsSamplerKind::kNearest ||
+                        m.nearest_share > 0 || m.sgld_init == SgldInit::kMemory,
+                    path, ": methods: '", m.name, "' sets nearest_per_problem ",
+                    m.nearest_per_problem,
+                    ", which only the nearest sampler, a nearest_share or sgld_init: memory uses");
+  for (const PlanMethodConfig& m : methods)
     FS_THROW_UNLESS(
-        m.nearest_per_problem == 0 || m.sampler == GfcsSamplerKind::kNearest || m.nearest_share > 0,
-        path, ": methods: '", m.name, "' sets nearest_per_problem ", m.nearest_per_problem,
-        ", which only the nearest sampler or a nearest_share uses");
+        m.sgld_init == SgldInit::kUniform ||
+            (m.kind == PlanMethodKind::kGfcs && m.sampler == GfcsSamplerKind::kLearned),
+        path, ": methods: '", m.name,
+        "' sets sgld_init: memory, which only a gfcs method with sampler: learned uses");
   for (const PlanMethodConfig& m : methods) {
     if (m.nearest_share == 0) continue;
     FS_THROW_UNLESS(m.kind == PlanMethodKind::kGfcs && m.sampler != GfcsSamplerKind::kNearest, path,

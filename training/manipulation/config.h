@@ -53,6 +53,8 @@ enum class PlanMethodKind { kGfcs, kFabric, kBiEst, kBitStar, kRrtConnect };
 
 /// Where GFCS's first batch comes from.
 enum class GfcsSamplerKind { kUniform, kLearned, kNearest };
+/// Where the learned sampler's SGLD particles start.
+enum class SgldInit { kUniform, kMemory };
 
 /// One row of the comparison table.
 struct PlanMethodConfig {
@@ -72,6 +74,9 @@ struct PlanMethodConfig {
   /// gfcs with the nearest sampler (or a nearest_share): solutions taken from each memory problem
   /// (0: gfcs.top_m, the number a loop's solve keeps).
   int nearest_per_problem = 0;
+  /// gfcs with the learned sampler: SGLD's particles start uniform (the thesis) or at the nearest
+  /// sampler's candidates from energy_model's solution memory (LearnedSampler::SetStart).
+  SgldInit sgld_init = SgldInit::kUniform;
 
   template <class A>
   void Serialize(A* a) {
@@ -107,6 +112,11 @@ struct PlanMethodConfig {
     a->Visit("nearest_per_problem", &nearest_per_problem, config::Range::Closed(0, 10000),
              "gfcs, nearest sampler or nearest_share: solutions taken from each nearest memory "
              "problem (0: gfcs.top_m)");
+    a->VisitEnum(
+        "sgld_init", &sgld_init,
+        config::EnumNames<SgldInit>{{SgldInit::kUniform, "uniform"}, {SgldInit::kMemory, "memory"}},
+        "gfcs, sampler learned: SGLD particles start uniform in the joint limits (the "
+        "thesis) or at the nearest sampler's candidates from energy_model's memory");
   }
 };
 

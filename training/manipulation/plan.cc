@@ -285,7 +285,8 @@ PlanReport RunPlanExperiment(const ExperimentConfig& c, const std::string& run_d
       energy.emplace(EnergyModel::Load(c.energy_model));
       log::Info("learned sampler: ", c.energy_model);
     }
-    if (method.sampler == GfcsSamplerKind::kNearest || method.nearest_share > 0) {
+    if (method.sampler == GfcsSamplerKind::kNearest || method.nearest_share > 0 ||
+        method.sgld_init == SgldInit::kMemory) {
       try {
         nearest[m].emplace(
             *energy, method.nearest_per_problem > 0 ? method.nearest_per_problem : c.gfcs.top_m);
@@ -298,6 +299,7 @@ PlanReport RunPlanExperiment(const ExperimentConfig& c, const std::string& run_d
     sgld.uniform_share = method.uniform_share;
     sgld.pick = method.sgld_pick;
     learned[m].emplace(*energy, sgld);
+    if (method.sgld_init == SgldInit::kMemory) learned[m]->SetStart(&*nearest[m]);
   }
 
   // Reactivity is measured on the first GFCS method's solutions.
@@ -346,7 +348,8 @@ PlanReport RunPlanExperiment(const ExperimentConfig& c, const std::string& run_d
                 nearest[m]->SetWorld(problem.world);
                 if (method.sampler == GfcsSamplerKind::kNearest) {
                   sampler = &*nearest[m];
-                } else {  // nearest_share of the batch from the memory, the rest from `sampler`
+                } else if (method.nearest_share > 0) {  // that share from the memory, the rest
+                                                        // from `sampler`
                   split.emplace(&*nearest[m], method.nearest_share, sampler);
                   sampler = &*split;
                 }
