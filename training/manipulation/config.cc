@@ -36,29 +36,22 @@ void ExperimentConfig::Validate(const std::string& path) const {
                     ": methods: '", m.name, "' uses the ",
                     m.sampler == GfcsSamplerKind::kLearned ? "learned" : "nearest",
                     " sampler, but energy_model (the artifact) is empty");
-  for (const PlanMethodConfig& m : methods)
-    FS_THROW_UNLESS(m.uniform_share == 0 ||
-                        (m.kind == PlanMethodKind::kGfcs && m.sampler == GfcsSamplerKind::kLearned),
-                    path, ": methods: '", m.name, "' sets uniform_share ", m.uniform_share,
-                    ", which only a gfcs method with sampler: learned uses");
-  for (const PlanMethodConfig& m : methods)
-    FS_THROW_UNLESS(
-        m.sgld_pick == SgldPick::kLowestEnergy ||
-            (m.kind == PlanMethodKind::kGfcs && m.sampler == GfcsSamplerKind::kLearned),
-        path, ": methods: '", m.name,
-        "' sets sgld_pick: random, which only a gfcs method with sampler: learned uses");
-  for (const PlanMethodConfig& m : methods)
+  // Options of the learned sampler: set only on a gfcs method with sampler: learned.
+  for (const PlanMethodConfig& m : methods) {
+    const bool learned = m.kind == PlanMethodKind::kGfcs && m.sampler == GfcsSamplerKind::kLearned;
+    const auto learned_only = [&](bool set, const auto&... what) {
+      FS_THROW_UNLESS(!set || learned, path, ": methods: '", m.name, "' sets ", what...,
+                      ", which only a gfcs method with sampler: learned uses");
+    };
+    learned_only(m.uniform_share != 0, "uniform_share ", m.uniform_share);
+    learned_only(m.sgld_pick != SgldPick::kLowestEnergy, "sgld_pick: random");
+    learned_only(m.sgld_init != SgldInit::kUniform, "sgld_init: memory");
     FS_THROW_UNLESS(m.nearest_per_problem == 0 || m.sampler == GfcsSamplerKind::kNearest ||
                         m.nearest_share > 0 || m.sgld_init == SgldInit::kMemory,
                     path, ": methods: '", m.name, "' sets nearest_per_problem ",
                     m.nearest_per_problem,
                     ", which only the nearest sampler, a nearest_share or sgld_init: memory uses");
-  for (const PlanMethodConfig& m : methods)
-    FS_THROW_UNLESS(
-        m.sgld_init == SgldInit::kUniform ||
-            (m.kind == PlanMethodKind::kGfcs && m.sampler == GfcsSamplerKind::kLearned),
-        path, ": methods: '", m.name,
-        "' sets sgld_init: memory, which only a gfcs method with sampler: learned uses");
+  }
   for (const PlanMethodConfig& m : methods) {
     if (m.nearest_share == 0) continue;
     FS_THROW_UNLESS(m.kind == PlanMethodKind::kGfcs && m.sampler != GfcsSamplerKind::kNearest, path,
