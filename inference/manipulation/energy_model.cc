@@ -487,8 +487,12 @@ LearnedSampler::LearnedSampler(const EnergyModel& model, SgldParams params)
                   params.threads);
 }
 
-void ContextSampler::SetWorld(const World& world) {
-  encoding_ = model_.EncodeWorld(world);
+void ContextSampler::SetWorld(const World& world) { SetEncoding(model_.EncodeWorld(world)); }
+
+void ContextSampler::SetEncoding(const Eigen::VectorXf& encoding) {
+  FS_THROW_UNLESS(encoding.size() == model_.encoding_size(), "ContextSampler: an encoding of ",
+                  encoding.size(), " entries, the model's encoder gives ", model_.encoding_size());
+  encoding_ = encoding;
   has_world_ = true;
 }
 

@@ -219,6 +219,10 @@ class ContextSampler : public CommandSampler {
  public:
   /// Computes the world encoding once (EnergyModel::EncodeWorld).
   void SetWorld(const World& world);
+  /// The same with an encoding computed already (another sampler's encoding(); Error if its
+  /// size is not the model's).
+  void SetEncoding(const Eigen::VectorXf& encoding);
+  const Eigen::VectorXf& encoding() const { return encoding_; }
 
  protected:
   /// `model` must outlive the sampler.

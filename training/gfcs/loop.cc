@@ -114,6 +114,17 @@ Eigen::VectorXf ToVector(const torch::Tensor& t) {
   const torch::Tensor c = t.contiguous().to(torch::kFloat32);
   return Eigen::Map<const Eigen::VectorXf>(c.data_ptr<float>(), c.numel());
 }
+/// Columns of `m` [rows x cols] as the rows of a [cols x rows] tensor, and back (same memory
+/// layout: column-major rows x cols is row-major cols x rows).
+torch::Tensor ColumnsTensor(const Eigen::MatrixXf& m) {
+  return torch::from_blob(const_cast<float*>(m.data()), {m.cols(), m.rows()}, torch::kFloat32)
+      .clone();
+}
+Eigen::MatrixXf TensorColumns(const torch::Tensor& t) {
+  const torch::Tensor c = t.contiguous().to(torch::kFloat32);
+  FS_THROW_UNLESS(c.dim() == 2, "loop checkpoint: expected a 2-D tensor, got ", c.dim(), "-D");
+  return Eigen::Map<const Eigen::MatrixXf>(c.data_ptr<float>(), c.size(1), c.size(0));
+}
 torch::Tensor Int64Tensor(const std::vector<std::int64_t>& v) {
   return torch::tensor(v, torch::kInt64);
 }
@@ -158,9 +169,16 @@ std::vector<Positive> ReadPositives(torch::serialize::InputArchive* a, const std
   return out;
 }
 
-bool HasKey(torch::serialize::InputArchive* a, const std::string& key) {
+/// The solution memory of a checkpoint: every positive, and the contexts of all training problems
+/// [context x problems] in `*contexts`. Error naming `source` for a checkpoint of an older build.
+std::vector<Positive> ReadMemory(torch::serialize::InputArchive* a, const std::string& source,
+                                 Eigen::MatrixXf* contexts) {
   torch::Tensor t;
-  return a->try_read(key, t);
+  FS_THROW_UNLESS(a->try_read("memory.u", t), source,
+                  ": the checkpoint has no solution memory (written by an older build); train the "
+                  "run again");
+  *contexts = TensorColumns(Read(a, "memory.contexts"));
+  return ReadPositives(a, "memory");
 }
 
 /// The exported solution memory: the training problems that have a positive (in index order)
@@ -350,10 +368,7 @@ std::string Loop::Serialize(bool with_pending) const {
           Int64Tensor({pending.solves, pending.solved, pending.dropped, pending.sampler_failures}));
   WritePositives(&a, "buffer", st_.buffer, CommandSize(c_));
   WritePositives(&a, "memory", st_.memory, CommandSize(c_));
-  const Eigen::MatrixXf contexts = Contexts();  // [context x P] = row-major [P x context]
-  a.write("memory.contexts", torch::from_blob(const_cast<float*>(contexts.data()),
-                                              {contexts.cols(), contexts.rows()}, torch::kFloat32)
-                                 .clone());
+  a.write("memory.contexts", ColumnsTensor(Contexts()));
   WritePositives(&a, "pending", pending.positives, CommandSize(c_));
   a.write("encoding.bps_mean", ToTensor(encoding_.bps_mean));
   a.write("encoding.bps_std", ToTensor(encoding_.bps_std));
@@ -405,19 +420,12 @@ void Loop::Deserialize(const std::string& bytes, const std::string& source) {
   st_.pending.sampler_failures = static_cast<int>(t[3].item<std::int64_t>());
   st_.buffer = ReadPositives(&a, "buffer");
   st_.pending.positives = ReadPositives(&a, "pending");
-  FS_THROW_UNLESS(HasKey(&a, "memory.u"), source,
-                  ": the checkpoint has no solution memory (written by an older build); start the "
-                  "run again");
-  st_.memory = ReadPositives(&a, "memory");
-  {
-    const torch::Tensor ct = Read(&a, "memory.contexts").contiguous();
-    const Eigen::MatrixXf here = Contexts();
-    FS_THROW_UNLESS(
-        ct.dim() == 2 && ct.size(0) == here.cols() && ct.size(1) == here.rows() &&
-            Eigen::Map<const Eigen::MatrixXf>(ct.data_ptr<float>(), here.rows(), here.cols())
-                .isApprox(here),
-        source, ": the checkpoint's training problems differ from this run's");
-  }
+  Eigen::MatrixXf contexts;
+  st_.memory = ReadMemory(&a, source, &contexts);
+  const Eigen::MatrixXf here = Contexts();
+  FS_THROW_UNLESS(
+      contexts.rows() == here.rows() && contexts.cols() == here.cols() && contexts.isApprox(here),
+      source, ": the checkpoint's training problems differ from this run's");
   for (const auto* list : {&st_.buffer, &st_.pending.positives, &st_.memory})
     for (const Positive& p : *list)
       FS_THROW_UNLESS(p.problem >= 0 && p.problem < static_cast<int>(problems_.size()) &&
@@ -857,13 +865,9 @@ void LoadLoopResult(const ExperimentConfig& c, const std::string& config_yaml,
   a.read("net", n);
   net->load(n);
   *energy = net->net()->ToMlp();
-  FS_THROW_UNLESS(HasKey(&a, "memory.u"), path,
-                  ": the checkpoint has no solution memory (written by an older build); train the "
-                  "run again");
-  const torch::Tensor contexts = Read(&a, "memory.contexts").contiguous();
-  *memory = MakeMemory(ReadPositives(&a, "memory"),
-                       Eigen::Map<const Eigen::MatrixXf>(contexts.data_ptr<float>(),
-                                                         contexts.size(1), contexts.size(0)));
+  Eigen::MatrixXf contexts;
+  const std::vector<Positive> positives = ReadMemory(&a, path, &contexts);
+  *memory = MakeMemory(positives, contexts);
 }
 
 }  // namespace foresight::gfcs

@@ -283,7 +283,7 @@ PlanReport RunPlanExperiment(const ExperimentConfig& c, const std::string& run_d
       continue;
     if (!energy) {
       energy.emplace(EnergyModel::Load(c.energy_model));
-      log::Info("learned sampler: ", c.energy_model);
+      log::Info("energy model (learned and nearest samplers): ", c.energy_model);
     }
     if (method.sampler == GfcsSamplerKind::kNearest || method.nearest_share > 0 ||
         method.sgld_init == SgldInit::kMemory) {
@@ -339,13 +339,17 @@ PlanReport RunPlanExperiment(const ExperimentConfig& c, const std::string& run_d
               CommandSampler* sampler = &uniform;
               double encode_s = 0;  // the world's encoding is part of the learned method's time
               const auto started = bench::Clock::now();
+              // One encoding of the world per method, shared by its two samplers.
+              if (nearest[m]) nearest[m]->SetWorld(problem.world);
               if (learned[m]) {
-                learned[m]->SetWorld(problem.world);
+                if (nearest[m])
+                  learned[m]->SetEncoding(nearest[m]->encoding());
+                else
+                  learned[m]->SetWorld(problem.world);
                 sampler = &*learned[m];
               }
               std::optional<SplitSampler> split;
               if (nearest[m]) {
-                nearest[m]->SetWorld(problem.world);
                 if (method.sampler == GfcsSamplerKind::kNearest) {
                   sampler = &*nearest[m];
                 } else if (method.nearest_share > 0) {  // that share from the memory, the rest
