@@ -117,6 +117,13 @@ void SplitSampler::Sample(const GfcsQuery& query, int intermediate_commands, int
   }
 }
 
+const config::EnumNames<GfcsRestart>& GfcsRestartNames() {
+  static const config::EnumNames<GfcsRestart> names = {{GfcsRestart::kNone, "none"},
+                                                       {GfcsRestart::kSampler, "sampler"},
+                                                       {GfcsRestart::kUniform, "uniform"}};
+  return names;
+}
+
 GfcsCandidate EvaluateCommandSequence(const Fabric& fabric, const GfcsQuery& query,
                                       const Eigen::VectorXd& commands, double penalty,
                                       FabricWorkspace* ws, std::vector<JointVector>* path,
@@ -198,6 +205,7 @@ GfcsSolution SolveGfcop(const Fabric& fabric, const GfcsQuery& query, CommandSam
     const Eigen::VectorXd mean0 = 0.5 * (options.lower + options.upper);
     optim::CmaEs es(mean0, options);
     es.Inject(candidates);
+    UniformSampler uniform(limits.lower, limits.upper);
     for (int b = 0; b < params.batches; ++b) {
       const Eigen::MatrixXd& asked = es.Ask();
       // CMA-ES ranks every cost it is told: only the last batch (told nothing) is pruned.
@@ -208,7 +216,19 @@ GfcsSolution SolveGfcop(const Fabric& fabric, const GfcsQuery& query, CommandSam
       for (std::size_t i = 0; i < batch.size(); ++i)
         costs[static_cast<Eigen::Index>(i)] = batch[i].cost;
       all.insert(all.end(), batch.begin(), batch.end());
-      if (b + 1 < params.batches && es.Tell(costs) != optim::CmaEsStatus::kRunning) break;
+      if (last) break;
+      const bool reached_nothing = std::none_of(batch.begin(), batch.end(),
+                                                [](const GfcsCandidate& c) { return c.reached; });
+      if (reached_nothing && params.restart != GfcsRestart::kNone) {
+        CommandSampler* fresh = params.restart == GfcsRestart::kSampler ? sampler : &uniform;
+        fresh->Sample(query, intermediate, params.batch_size, &rng, &candidates);
+        ++solution.restarts;
+        options.seed = static_cast<std::uint64_t>(params.seed) + 7919ULL * solution.restarts;
+        es = optim::CmaEs(mean0, options);
+        es.Inject(candidates);
+      } else if (es.Tell(costs) != optim::CmaEsStatus::kRunning) {
+        break;
+      }
     }
   }
   solution.evaluations = static_cast<int>(all.size());

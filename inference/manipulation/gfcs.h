@@ -28,6 +28,18 @@
 
 namespace foresight::manipulation {
 
+/// What SolveGfcop does after a batch in which no candidate reached the goal (not in the thesis).
+/// Such a batch's costs rank failures only, by the time their rollouts took before the last one
+/// timed out, which says nothing about where the goal is reachable from: CMA-ES told those costs
+/// moves towards candidates that fail quickly. A restart instead draws the next batch afresh and
+/// starts a new CMA-ES run at it.
+enum class GfcsRestart {
+  kNone,     ///< tell CMA-ES every batch (the thesis's Algorithm "SolveGFCOP")
+  kSampler,  ///< the next batch from the sampler again (a fresh draw)
+  kUniform,  ///< the next batch uniform in the joint limits
+};
+const config::EnumNames<GfcsRestart>& GfcsRestartNames();
+
 struct GfcsParams {
   int commands = 2;       ///< n + 1 (thesis: two commands per problem)
   int batch_size = 20;    ///< candidates per batch (thesis at test time: 20)
@@ -40,6 +52,7 @@ struct GfcsParams {
   /// Stop a candidate of the last batch once its rollout time exceeds the m-th best cost the
   /// batch has finished (its cost can only be higher). The top m are the same as without it.
   bool prune = true;
+  GfcsRestart restart = GfcsRestart::kNone;  ///< after a batch that reached nothing
 
   template <class A>
   void Serialize(A* a) {
@@ -56,6 +69,9 @@ struct GfcsParams {
     a->Visit("prune", &prune, config::Range::Any(),
              "stop last-batch candidates whose time already exceeds the top_m-th best cost "
              "(same top_m, less time)");
+    a->VisitEnum("restart", &restart, GfcsRestartNames(),
+                 "after a batch in which no candidate reached the goal: none (tell CMA-ES, the "
+                 "thesis), sampler or uniform (draw the next batch afresh, new CMA-ES run)");
   }
 };
 
@@ -161,6 +177,7 @@ struct GfcsSolution {
   double solve_time_s = 0;          ///< wall time of SolveGfcop
   /// Of solve_time_s, the sampler's first batch (SGLD for the learned sampler; 0 without one).
   double sample_time_s = 0;
+  int restarts = 0;  ///< batches drawn afresh after a batch that reached nothing (restart)
   bool solved() const { return status == GfcsStatus::kSolved; }
 };
 

@@ -666,6 +666,63 @@ TEST(Gfcs, PruningKeepsTheTopCandidatesOfAnUnprunedSolve) {
                                   << " batches: the test did not test pruning there";
 }
 
+/// A uniform sampler that records every batch it draws.
+class RecordingSampler : public CommandSampler {
+ public:
+  RecordingSampler() : uniform_(Panda().limits().lower, Panda().limits().upper) {}
+  std::string name() const override { return "recording"; }
+  void Sample(const GfcsQuery& query, int intermediate_commands, int count, std::mt19937_64* rng,
+              Eigen::MatrixXd* out) override {
+    uniform_.Sample(query, intermediate_commands, count, rng, out);
+    draws.push_back(*out);
+  }
+  std::vector<Eigen::MatrixXd> draws;
+
+ private:
+  UniformSampler uniform_;
+};
+
+TEST(Gfcs, ABatchThatReachedNothingRestartsFromAFreshDraw) {
+  const ManipulationProblem problem = SyntheticProblem(5);
+  GfcsParams params;
+  params.batch_size = 6;
+  params.batches = 3;
+  params.top_m = 18;  // every evaluated candidate
+  params.threads = 1;
+  params.prune = false;
+  // 0.05 s per command: no candidate reaches the goal, so every batch reaches nothing.
+  FabricParams short_rollouts;
+  short_rollouts.t_max = 0.05;
+  const Fabric hopeless(Panda(), problem.world, short_rollouts);
+  for (const GfcsRestart restart :
+       {GfcsRestart::kNone, GfcsRestart::kSampler, GfcsRestart::kUniform}) {
+    params.restart = restart;
+    RecordingSampler sampler;
+    const GfcsSolution s = SolveGfcop(hopeless, QueryOf(problem), &sampler, params);
+    ASSERT_EQ(s.status, GfcsStatus::kNotSolved) << s.message;
+    EXPECT_EQ(s.evaluations, 18);
+    EXPECT_EQ(s.restarts, restart == GfcsRestart::kNone ? 0 : 2);
+    // kSampler draws every batch from the sampler; the others only the first.
+    EXPECT_EQ(sampler.draws.size(), restart == GfcsRestart::kSampler ? 3u : 1u);
+    // Each drawn batch was evaluated as drawn (uniform draws lie inside the box CMA-ES projects
+    // on).
+    for (const Eigen::MatrixXd& draw : sampler.draws)
+      for (Eigen::Index c = 0; c < draw.cols(); ++c)
+        EXPECT_TRUE(std::any_of(s.top.begin(), s.top.end(),
+                                [&](const GfcsCandidate& t) { return t.commands == draw.col(c); }))
+            << GfcsRestartNames()[static_cast<std::size_t>(restart)].second << ", column " << c;
+  }
+  // A batch that reached the goal is told to CMA-ES as in the thesis: no restart.
+  const World empty;
+  const Fabric fabric(Panda(), empty, FabricParams{});
+  params.restart = GfcsRestart::kSampler;
+  RecordingSampler sampler;
+  const GfcsSolution s = SolveGfcop(fabric, QueryOf(problem), &sampler, params);
+  ASSERT_TRUE(s.solved());
+  EXPECT_EQ(s.restarts, 0);
+  EXPECT_EQ(sampler.draws.size(), 1u);
+}
+
 TEST(Gfcs, BadQueriesAreStatusesNotExceptions) {
   const World world;
   const Fabric fabric(Panda(), world, FabricParams{});
