@@ -155,6 +155,8 @@ print(f"Problems {first}-{last} of each family, GFCS with 1 batch of 20, energy 
       "problem carries the penalty M = 100 s). Rule: the share (or loop setting) with the most "
       "successes over all families, ties to the lower mean cost; the held-out problems 51-75 are "
       "not read.\n")
+if os.environ.get("SGLD"):
+    print(f"Every learned row samples with `{os.environ['SGLD']}` (SGLD=) instead of the loop's SGLD settings.\n")
 for i, setting in enumerate(settings, 1):
     print(f"- `learned [loop {i}]`: the same loop trained with `{setting}` "
           f"(`{run}_{i}/model.h5`), sampled with the same SGLD settings as `learned`")
