@@ -45,19 +45,26 @@ double RankingAuc(const std::vector<double>& score, const std::vector<int>& labe
   return positives && negatives ? wins / (static_cast<double>(positives) * negatives) : -1.0;
 }
 
-/// Whether each column of `y` reaches the goal, rolled out on `threads` threads.
+/// Whether each column of `y` reaches the goal, rolled out on `threads` threads. An error in a
+/// thread is rethrown here.
 std::vector<int> Reached(const fm::Fabric& fabric, const fm::GfcsQuery& query,
                          const Eigen::MatrixXd& y, int threads) {
   std::vector<int> reached(static_cast<std::size_t>(y.cols()), 0);
+  std::vector<std::string> errors(static_cast<std::size_t>(threads));
   std::vector<std::thread> pool;
   for (int t = 0; t < threads; ++t)
     pool.emplace_back([&, t] {
-      fm::FabricWorkspace ws = fabric.MakeWorkspace();
-      for (Eigen::Index c = t; c < y.cols(); c += threads)
-        reached[static_cast<std::size_t>(c)] =
-            fm::EvaluateCommandSequence(fabric, query, y.col(c), 100.0, &ws).reached;
+      try {
+        fm::FabricWorkspace ws = fabric.MakeWorkspace();
+        for (Eigen::Index c = t; c < y.cols(); c += threads)
+          reached[static_cast<std::size_t>(c)] =
+              fm::EvaluateCommandSequence(fabric, query, y.col(c), 100.0, &ws).reached;
+      } catch (const std::exception& e) {
+        errors[static_cast<std::size_t>(t)] = e.what();
+      }
     });
   for (std::thread& th : pool) th.join();
+  for (const std::string& e : errors) FS_THROW_UNLESS(e.empty(), "rollouts: ", e);
   return reached;
 }
 
@@ -160,11 +167,12 @@ int main(int argc, char** argv) {
         s.solved_lowest_energy += lowest;
       }
       const double n = std::max(1, s.auc_problems);
+      char nearest_auc[32] = "-";
+      if (memory) std::snprintf(nearest_auc, sizeof(nearest_auc), "%.3f", s.auc_nearest / n);
       std::printf("| %s | %d | %.3f | %.3f (%d problems) | %s | %d | %d |\n", family.c_str(),
                   s.problems, static_cast<double>(s.reaching) / std::max(1, s.candidates),
-                  s.auc_energy / n, s.auc_problems,
-                  memory ? std::to_string(s.auc_nearest / n).substr(0, 5).c_str() : "-",
-                  s.solved_uniform, s.solved_lowest_energy);
+                  s.auc_energy / n, s.auc_problems, nearest_auc, s.solved_uniform,
+                  s.solved_lowest_energy);
       std::fflush(stdout);
     }
   } catch (const std::exception& e) {

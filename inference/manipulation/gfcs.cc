@@ -119,7 +119,6 @@ void SplitSampler::Sample(const GfcsQuery& query, int intermediate_commands, int
 
 const config::EnumNames<GfcsRestart>& GfcsRestartNames() {
   static const config::EnumNames<GfcsRestart> names = {{GfcsRestart::kNone, "none"},
-                                                       {GfcsRestart::kSampler, "sampler"},
                                                        {GfcsRestart::kUniform, "uniform"}};
   return names;
 }
@@ -219,9 +218,8 @@ GfcsSolution SolveGfcop(const Fabric& fabric, const GfcsQuery& query, CommandSam
       if (last) break;
       const bool reached_nothing = std::none_of(batch.begin(), batch.end(),
                                                 [](const GfcsCandidate& c) { return c.reached; });
-      if (reached_nothing && params.restart != GfcsRestart::kNone) {
-        CommandSampler* fresh = params.restart == GfcsRestart::kSampler ? sampler : &uniform;
-        fresh->Sample(query, intermediate, params.batch_size, &rng, &candidates);
+      if (reached_nothing && params.restart == GfcsRestart::kUniform) {
+        uniform.Sample(query, intermediate, params.batch_size, &rng, &candidates);
         ++solution.restarts;
         options.seed = static_cast<std::uint64_t>(params.seed) + 7919ULL * solution.restarts;
         es = optim::CmaEs(mean0, options);

@@ -31,12 +31,12 @@ namespace foresight::manipulation {
 /// What SolveGfcop does after a batch in which no candidate reached the goal (not in the thesis).
 /// Such a batch's costs rank failures only, by the time their rollouts took before the last one
 /// timed out, which says nothing about where the goal is reachable from: CMA-ES told those costs
-/// moves towards candidates that fail quickly. A restart instead draws the next batch afresh and
-/// starts a new CMA-ES run at it.
+/// moves towards candidates that fail quickly. A restart instead draws the next batch uniformly in
+/// the joint limits and starts a new CMA-ES run at it (also after a batch of a run that had reached
+/// the goal earlier: the decision is per batch).
 enum class GfcsRestart {
   kNone,     ///< tell CMA-ES every batch (the thesis's Algorithm "SolveGFCOP")
-  kSampler,  ///< the next batch from the sampler again (a fresh draw)
-  kUniform,  ///< the next batch uniform in the joint limits
+  kUniform,  ///< the next batch uniform in the joint limits, a new CMA-ES run
 };
 const config::EnumNames<GfcsRestart>& GfcsRestartNames();
 
@@ -71,7 +71,7 @@ struct GfcsParams {
              "(same top_m, less time)");
     a->VisitEnum("restart", &restart, GfcsRestartNames(),
                  "after a batch in which no candidate reached the goal: none (tell CMA-ES, the "
-                 "thesis), sampler or uniform (draw the next batch afresh, new CMA-ES run)");
+                 "thesis) or uniform (draw the next batch uniformly, new CMA-ES run)");
   }
 };
 
@@ -182,7 +182,9 @@ struct GfcsSolution {
 };
 
 /// SolveGFCOP: the first batch from `sampler`, later batches from CMA-ES (which is told the first
-/// batch's costs), candidates of a batch rolled out on `params.threads` threads.
+/// batch's costs; with params.restart uniform, a batch that reached nothing is followed by a
+/// uniform batch and a new CMA-ES run instead), candidates of a batch rolled out on
+/// `params.threads` threads.
 GfcsSolution SolveGfcop(const Fabric& fabric, const GfcsQuery& query, CommandSampler* sampler,
                         const GfcsParams& params);
 

@@ -682,7 +682,7 @@ class RecordingSampler : public CommandSampler {
   UniformSampler uniform_;
 };
 
-TEST(Gfcs, ABatchThatReachedNothingRestartsFromAFreshDraw) {
+TEST(Gfcs, ABatchThatReachedNothingRestartsFromAUniformDraw) {
   const ManipulationProblem problem = SyntheticProblem(5);
   GfcsParams params;
   params.batch_size = 6;
@@ -690,37 +690,53 @@ TEST(Gfcs, ABatchThatReachedNothingRestartsFromAFreshDraw) {
   params.top_m = 18;  // every evaluated candidate
   params.threads = 1;
   params.prune = false;
+  params.seed = 11;
   // 0.05 s per command: no candidate reaches the goal, so every batch reaches nothing.
   FabricParams short_rollouts;
   short_rollouts.t_max = 0.05;
   const Fabric hopeless(Panda(), problem.world, short_rollouts);
-  for (const GfcsRestart restart :
-       {GfcsRestart::kNone, GfcsRestart::kSampler, GfcsRestart::kUniform}) {
+  for (const GfcsRestart restart : {GfcsRestart::kNone, GfcsRestart::kUniform}) {
     params.restart = restart;
     RecordingSampler sampler;
     const GfcsSolution s = SolveGfcop(hopeless, QueryOf(problem), &sampler, params);
     ASSERT_EQ(s.status, GfcsStatus::kNotSolved) << s.message;
     EXPECT_EQ(s.evaluations, 18);
     EXPECT_EQ(s.restarts, restart == GfcsRestart::kNone ? 0 : 2);
-    // kSampler draws every batch from the sampler; the others only the first.
-    EXPECT_EQ(sampler.draws.size(), restart == GfcsRestart::kSampler ? 3u : 1u);
-    // Each drawn batch was evaluated as drawn (uniform draws lie inside the box CMA-ES projects
-    // on).
-    for (const Eigen::MatrixXd& draw : sampler.draws)
+    ASSERT_EQ(sampler.draws.size(), 1u);  // the solve's sampler draws the first batch only
+    // The first batch, and with restarts the two uniform batches drawn after it from the solve's
+    // generator, were evaluated as drawn (uniform draws lie inside the box CMA-ES projects onto).
+    std::mt19937_64 replay(static_cast<std::uint64_t>(params.seed));
+    UniformSampler uniform(Panda().limits().lower, Panda().limits().upper);
+    const int drawn = restart == GfcsRestart::kNone ? 1 : 3;
+    for (int batch = 0; batch < drawn; ++batch) {
+      Eigen::MatrixXd draw;
+      uniform.Sample(QueryOf(problem), 1, params.batch_size, &replay, &draw);
+      if (batch == 0) {
+        EXPECT_EQ(draw, sampler.draws.front());
+      }
       for (Eigen::Index c = 0; c < draw.cols(); ++c)
         EXPECT_TRUE(std::any_of(s.top.begin(), s.top.end(),
                                 [&](const GfcsCandidate& t) { return t.commands == draw.col(c); }))
-            << GfcsRestartNames()[static_cast<std::size_t>(restart)].second << ", column " << c;
+            << "restart " << static_cast<int>(restart) << ", batch " << batch << ", column " << c;
+    }
   }
-  // A batch that reached the goal is told to CMA-ES as in the thesis: no restart.
+  // Batches that reached the goal are told to CMA-ES as in the thesis: the same solve as without
+  // restarts.
   const World empty;
   const Fabric fabric(Panda(), empty, FabricParams{});
-  params.restart = GfcsRestart::kSampler;
-  RecordingSampler sampler;
-  const GfcsSolution s = SolveGfcop(fabric, QueryOf(problem), &sampler, params);
-  ASSERT_TRUE(s.solved());
-  EXPECT_EQ(s.restarts, 0);
-  EXPECT_EQ(sampler.draws.size(), 1u);
+  GfcsSolution with[2];
+  for (const GfcsRestart restart : {GfcsRestart::kNone, GfcsRestart::kUniform}) {
+    params.restart = restart;
+    RecordingSampler sampler;
+    with[static_cast<int>(restart)] = SolveGfcop(fabric, QueryOf(problem), &sampler, params);
+  }
+  ASSERT_TRUE(with[1].solved());
+  EXPECT_EQ(with[1].restarts, 0);
+  ASSERT_EQ(with[0].top.size(), with[1].top.size());
+  for (std::size_t i = 0; i < with[0].top.size(); ++i) {
+    EXPECT_EQ(with[0].top[i].commands, with[1].top[i].commands) << i;
+    EXPECT_EQ(with[0].top[i].cost, with[1].top[i].cost) << i;
+  }
 }
 
 TEST(Gfcs, BadQueriesAreStatusesNotExceptions) {
