@@ -126,7 +126,7 @@ done
 check_json "$PLAN/summary.json"
 for k in '"GFCS (1 batch)"' '"GF"' '"RRT-Connect"' success_rate ee_length cspace_length time_s ee_ldj cspace_ldj \
          candidate_statuses '"reached"' '"timeout"' '"collision"' time_median_s first_batch_sampling \
-         integration_steps stalled_rollouts; do
+         integration_steps stalled_rollouts restarts; do
   grep -q "$k" "$PLAN/summary.json" || fail "plan summary.json lacks $k"
 done
 [ "$(wc -l < "$PLAN/problems.csv")" -eq 4 ] || fail "plan problems.csv: expected a header and 3 rows"

@@ -37,6 +37,7 @@ struct Trajectory {
   double encode_s = 0, sample_s = 0;  ///< GFCS: of generation_time_s, encoding and first batch
   long long steps = 0;                ///< GFCS: fabric integration steps of the solve
   int stalled = 0;                    ///< GFCS: rollouts ended by the stall test
+  int restarts = 0;                   ///< GFCS: batches drawn afresh (gfcs.restart)
 };
 
 TimedPath ToTimedPath(const std::vector<JointVector>& states, double dt) {
@@ -66,6 +67,7 @@ Trajectory RunGfcs(const Fabric& fabric, const ManipulationProblem& problem,
   t.candidates = solution.candidate_statuses;
   t.steps = solution.integration_steps;
   t.stalled = solution.stalled_rollouts;
+  t.restarts = solution.restarts;
   if (solution.status == GfcsStatus::kError) {
     t.status = "error: " + solution.message;
     return t;
@@ -204,6 +206,7 @@ void WriteSummaryJson(const std::string& path, const ExperimentConfig& c,
            << "\": " << report.methods[i].candidate_statuses[k];
       os << "}, \"integration_steps\": " << report.methods[i].work.steps
          << ", \"stalled_rollouts\": " << report.methods[i].work.stalled
+         << ", \"restarts\": " << report.methods[i].work.restarts
          << ", \"time_median_s\": {\"total\": " << report.methods[i].median_total_s
          << ", \"encode\": " << report.methods[i].median_encode_s
          << ", \"first_batch_sampling\": " << report.methods[i].median_sample_s << "}";
@@ -408,6 +411,7 @@ PlanReport RunPlanExperiment(const ExperimentConfig& c, const std::string& run_d
         for (int k = 0; k < kRolloutStatusCount; ++k) candidate_statuses[m][k] += t.candidates[k];
         work[m].steps += t.steps;
         work[m].stalled += t.stalled;
+        work[m].restarts += t.restarts;
         if (method.kind == PlanMethodKind::kGfcs) {
           times[m].total.push_back(t.generation_time_s);
           times[m].encode.push_back(t.encode_s);

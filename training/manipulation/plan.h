@@ -44,6 +44,7 @@ struct PlanAttempt {
 struct GfcsWork {
   long long steps = 0;  ///< integration steps of every evaluated candidate
   int stalled = 0;      ///< rollouts ended by the fabric's stall test (fabric.stall_window)
+  int restarts = 0;     ///< batches drawn afresh after a batch that reached nothing (gfcs.restart)
 };
 
 struct PlanMethodResult {
@@ -56,7 +57,7 @@ struct PlanMethodResult {
   /// sampler) and the sampler's first batch (SGLD for the learned sampler), in s (summary.json
   /// "time_median_s"; medians, so the parts need not add up to the total).
   double median_total_s = 0, median_encode_s = 0, median_sample_s = 0;
-  GfcsWork work;  ///< summary.json "integration_steps", "stalled_rollouts"
+  GfcsWork work;  ///< summary.json "integration_steps", "stalled_rollouts", "restarts"
 };
 
 struct PlanReport {
