@@ -3,8 +3,8 @@
 # candidates per problem, the ranking AUC of -E (0.5 = no information) beside the nearest-neighbour
 # baseline's, and how many problems the 20 lowest-energy candidates solve against the first 20
 # (build/bin/gfcs_energy_ranking). Two models: the validation loop (problems 1-40, as
-# experiments/gfcs_select.sh trains it) on problems 41-50, and experiments/gfcs.sh's loop (1-50)
-# on the held-out 51-75. Writes results/gfcs_energy_ranking.md. Needs both run directories.
+# experiments/gfcs_select.sh trains it) on problems 41-50 and on 31-40 (its own training problems),
+# and experiments/gfcs.sh's loop (1-50) on the held-out 51-75. Writes results/gfcs_energy_ranking.md. Needs both run directories.
 #   experiments/gfcs_energy_ranking.sh
 # About 10 minutes on 2 cores.
 set -euo pipefail
@@ -32,6 +32,10 @@ done
   echo "## Validation: loop on problems 1-40, problems 41-50"
   echo
   "$BIN_DIR/gfcs_energy_ranking" --model "$VALIDATION/model.h5" --data "$DATA" --first 41 --last 50
+  echo
+  echo "## The same loop on problems 31-40, which it trained on (is it a training signal or a generalisation gap?)"
+  echo
+  "$BIN_DIR/gfcs_energy_ranking" --model "$VALIDATION/model.h5" --data "$DATA" --first 31 --last 40
   echo
   echo "## Held out: loop on problems 1-50 (experiments/gfcs.sh), problems 51-75"
   echo
