@@ -14,6 +14,7 @@
 //   gfcs_energy_ranking --model runs/gfcs_all/model.h5 --data ../shared/data --first 51 --last 75
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <cstdint>
 #include <cstdio>
 #include <iostream>
 #include <numeric>
@@ -21,6 +22,7 @@
 #include <thread>
 #include <vector>
 
+#include "core/binary_metrics.h"
 #include "core/error.h"
 #include "inference/manipulation/energy_model.h"
 #include "inference/manipulation/fabric.h"
@@ -32,24 +34,19 @@ namespace fm = foresight::manipulation;
 
 namespace {
 
-/// P(score of a positive > score of a negative), ties counted half; -1 without both classes.
-double RankingAuc(const std::vector<double>& score, const std::vector<int>& label) {
-  double wins = 0;
-  long positives = 0, negatives = 0;
-  for (std::size_t i = 0; i < label.size(); ++i) {
-    (label[i] ? positives : negatives) += 1;
-    if (!label[i]) continue;
-    for (std::size_t j = 0; j < label.size(); ++j)
-      if (!label[j]) wins += score[i] > score[j] ? 1.0 : (score[i] == score[j] ? 0.5 : 0.0);
-  }
-  return positives && negatives ? wins / (static_cast<double>(positives) * negatives) : -1.0;
+/// P(score of a positive > score of a negative) with ties counted half (core's ROC AUC); -1
+/// without both classes.
+double RankingAuc(const std::vector<double>& score, const std::vector<std::uint8_t>& label) {
+  const bool both = std::count(label.begin(), label.end(), 1) > 0 &&
+                    std::count(label.begin(), label.end(), 0) > 0;
+  return both ? foresight::EvaluateBinary(score, label).auc : -1.0;
 }
 
 /// Whether each column of `y` reaches the goal, rolled out on `threads` threads. An error in a
 /// thread is rethrown here.
-std::vector<int> Reached(const fm::Fabric& fabric, const fm::GfcsQuery& query,
-                         const Eigen::MatrixXd& y, int threads) {
-  std::vector<int> reached(static_cast<std::size_t>(y.cols()), 0);
+std::vector<std::uint8_t> Reached(const fm::Fabric& fabric, const fm::GfcsQuery& query,
+                                  const Eigen::MatrixXd& y, int threads) {
+  std::vector<std::uint8_t> reached(static_cast<std::size_t>(y.cols()), 0);
   std::vector<std::string> errors(static_cast<std::size_t>(threads));
   std::vector<std::thread> pool;
   for (int t = 0; t < threads; ++t)
@@ -130,7 +127,7 @@ int main(int argc, char** argv) {
         for (int c = 0; c < candidates; ++c) u.col(c) = model.RadiansToCommands(y.col(c));
         Eigen::VectorXf energy;
         model.EnergyAndGradient(context, u, &energy, nullptr, &ews);
-        const std::vector<int> reached = Reached(fabric, query, y, threads);
+        const std::vector<std::uint8_t> reached = Reached(fabric, query, y, threads);
 
         std::vector<double> minus_energy(reached.size()), minus_distance(reached.size(), 0.0);
         for (int c = 0; c < candidates; ++c) minus_energy[c] = -energy[c];

@@ -15,6 +15,7 @@
 #include <random>
 
 #include "inference/otnet/map_encoding.h"
+#include "tests/otnet/scoped_cv_threads.h"
 #define FORESIGHT_ALLOC_COUNTER_MALLOC  // count Eigen's and OpenCV's malloc too
 #include "tests/alloc_counter.h"        // replaces operator new: one per binary
 
@@ -59,18 +60,6 @@ struct Fixture {
   std::vector<BinaryGrid> queries;
   MapEncoder::Workspace ws;
   Eigen::VectorXd distances, phi;
-};
-
-/// Restores OpenCV's thread count at scope exit.
-class ScopedCvThreads {
- public:
-  explicit ScopedCvThreads(int threads) : saved_(cv::getNumThreads()) {
-    cv::setNumThreads(threads);
-  }
-  ~ScopedCvThreads() { cv::setNumThreads(saved_); }
-
- private:
-  int saved_;
 };
 
 TEST(MapEncoderHotPath, AllocatesNothingAfterWarmUpWithSerialOpenCv) {

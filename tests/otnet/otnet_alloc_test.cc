@@ -8,10 +8,10 @@
 
 #include <gtest/gtest.h>
 
-#include <opencv2/core.hpp>
 #include <random>
 
 #include "inference/otnet/otnet_model.h"
+#include "tests/otnet/scoped_cv_threads.h"
 #define FORESIGHT_ALLOC_COUNTER_MALLOC  // count Eigen's malloc too
 #include "tests/alloc_counter.h"        // replaces operator new: one per binary
 
@@ -68,8 +68,7 @@ TEST(OtnetAlloc, HotPathsAllocateNothingAfterSetUp) {
 #ifndef FORESIGHT_COUNTS_MALLOC
   GTEST_SKIP() << "malloc is not counted in this build (neither glibc nor AddressSanitizer)";
 #endif
-  const int saved_threads = cv::getNumThreads();
-  cv::setNumThreads(0);  // 0: OpenCV runs parallel_for_ bodies in the caller
+  const ScopedCvThreads serial(0);  // 0: OpenCV runs parallel_for_ bodies in the caller
   for (const MixtureFamily family : {MixtureFamily::kNormal, MixtureFamily::kLaplace}) {
     const OtnetModel model = Model(family);
     OtnetModel::Workspace ws = model.MakeWorkspace(50, 100);
@@ -118,7 +117,6 @@ TEST(OtnetAlloc, HotPathsAllocateNothingAfterSetUp) {
     }
     EXPECT_GT(stats[0].rejected + stats[1].rejected + stats[2].rejected, 0);  // rejection ran
   }
-  cv::setNumThreads(saved_threads);
 }
 
 }  // namespace
