@@ -191,6 +191,7 @@ GfcsSolution SolveGfcop(const Fabric& fabric, const GfcsQuery& query, CommandSam
     candidates.resize(0, 1);
     EvaluateBatch(fabric, query, candidates, params.penalty, /*prune_m=*/0, &workspaces, &batch);
     all = batch;
+    solution.first_batch = batch;
   } else {
     const auto sample_started = bench::Clock::now();
     sampler->Sample(query, intermediate, params.batch_size, &rng, &candidates);
@@ -215,6 +216,7 @@ GfcsSolution SolveGfcop(const Fabric& fabric, const GfcsQuery& query, CommandSam
       for (std::size_t i = 0; i < batch.size(); ++i)
         costs[static_cast<Eigen::Index>(i)] = batch[i].cost;
       all.insert(all.end(), batch.begin(), batch.end());
+      if (b == 0) solution.first_batch = batch;
       if (last) break;
       const bool reached_nothing = std::none_of(batch.begin(), batch.end(),
                                                 [](const GfcsCandidate& c) { return c.reached; });

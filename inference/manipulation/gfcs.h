@@ -166,6 +166,9 @@ struct GfcsSolution {
   GfcsStatus status = GfcsStatus::kNotSolved;
   std::string message;
   std::vector<GfcsCandidate> top;  ///< best first, at most top_m
+  /// The sampler's batch (the first) as evaluated, in draw order: which of the sampler's own
+  /// proposals reached the goal and which failed (the self-supervised loop's labelled failures).
+  std::vector<GfcsCandidate> first_batch;
   int evaluations = 0;
   int pruned = 0;  ///< of the evaluations, stopped early (GfcsParams::prune)
   /// Every evaluated candidate's last status (a candidate reached the goal iff it is counted in

@@ -1,5 +1,7 @@
 #include "models/gfcs/gfcs_nets.h"
 
+#include <limits>
+
 #include "core/error.h"
 
 namespace foresight::gfcs {
@@ -67,10 +69,19 @@ torch::Tensor EnergyNetImpl::forward(const torch::Tensor& context, const torch::
   return net_->forward(x.reshape({b * k, x.size(2)})).reshape({b, k});
 }
 
-torch::Tensor InfoNceLoss(const torch::Tensor& energy_pos, const torch::Tensor& energy_neg) {
-  const torch::Tensor all = torch::cat({energy_pos.unsqueeze(1), energy_neg}, 1);  // [B, 1 + N]
+torch::Tensor InfoNceLoss(const torch::Tensor& energy_pos, const torch::Tensor& energy_neg,
+                          const torch::Tensor& valid) {
+  torch::Tensor logits = -torch::cat({energy_pos.unsqueeze(1), energy_neg}, 1);  // [B, 1 + N]
+  if (valid.defined()) {
+    FS_THROW_UNLESS(valid.sizes() == energy_neg.sizes() && valid.scalar_type() == torch::kBool,
+                    "InfoNCE: the mask must be bool and shaped as the negatives' energies");
+    // An absent negative's logit is -inf: exp(-inf) = 0 in the sum and in its gradient (the
+    // positive's logit is finite, so logsumexp's maximum is).
+    const torch::Tensor keep = torch::cat({torch::ones_like(valid.narrow(1, 0, 1)), valid}, 1);
+    logits = logits.masked_fill(keep.logical_not(), -std::numeric_limits<float>::infinity());
+  }
   // -log softmax(-E)_0 = E_pos + logsumexp(-E)
-  return (energy_pos + torch::logsumexp(-all, 1)).mean();
+  return (energy_pos + torch::logsumexp(logits, 1)).mean();
 }
 
 BpsAutoencoderImpl::BpsAutoencoderImpl(int inputs, int hidden, int encoding) {

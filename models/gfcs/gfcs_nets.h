@@ -41,8 +41,10 @@ TORCH_MODULE(EnergyNet);
 
 /// InfoNCE (thesis eq. "lossimpli", errata: low energy is good), mean over the B positives:
 /// -log( e^{-E_pos} / (e^{-E_pos} + sum_k e^{-E_neg,k}) ).
-/// @param energy_pos [B]; @param energy_neg [B, N].
-torch::Tensor InfoNceLoss(const torch::Tensor& energy_pos, const torch::Tensor& energy_neg);
+/// @param energy_pos [B]; @param energy_neg [B, N]; @param valid undefined (every negative
+/// counts) or bool [B, N]: the negatives that count (the others leave the sum, as if absent).
+torch::Tensor InfoNceLoss(const torch::Tensor& energy_pos, const torch::Tensor& energy_neg,
+                          const torch::Tensor& valid = {});
 
 /// Encoder N_R -> hidden -> encoding, decoder back; trained on reconstruction error.
 class BpsAutoencoderImpl : public torch::nn::Module {

@@ -600,6 +600,41 @@ TEST(Gfcs, SolveIsDeterministicSortedAndBeatsOrMatchesItsFirstBatch) {
   EXPECT_LE(a.sample_time_s, a.solve_time_s);
 }
 
+TEST(Gfcs, TheFirstBatchIsTheSamplersDrawsAsEvaluated) {
+  const ManipulationProblem problem = SyntheticProblem(5);
+  const Fabric fabric(Panda(), problem.world, FabricParams{});
+  const GfcsQuery query = QueryOf(problem);
+  GfcsParams params;
+  params.batch_size = 6;
+  params.batches = 2;
+  params.threads = 2;
+  params.seed = 9;
+  params.prune = false;
+  UniformSampler sampler(Panda().limits().lower, Panda().limits().upper);
+  const GfcsSolution s = SolveGfcop(fabric, query, &sampler, params);
+  ASSERT_NE(s.status, GfcsStatus::kError) << s.message;
+  // The sampler's draws from a generator seeded as the solve's, in draw order, each priced as a
+  // lone evaluation prices it.
+  std::mt19937_64 rng(static_cast<std::uint64_t>(params.seed));
+  Eigen::MatrixXd drawn;
+  sampler.Sample(query, params.commands - 1, params.batch_size, &rng, &drawn);
+  ASSERT_EQ(s.first_batch.size(), static_cast<std::size_t>(params.batch_size));
+  FabricWorkspace ws = fabric.MakeWorkspace();
+  int reached = 0;
+  for (int c = 0; c < params.batch_size; ++c) {
+    const GfcsCandidate& got = s.first_batch[static_cast<std::size_t>(c)];
+    EXPECT_EQ(got.commands, drawn.col(c)) << "column " << c;
+    const GfcsCandidate alone =
+        EvaluateCommandSequence(fabric, query, drawn.col(c), params.penalty, &ws);
+    EXPECT_EQ(got.cost, alone.cost) << "column " << c;
+    EXPECT_EQ(got.reached, alone.reached) << "column " << c;
+    EXPECT_FALSE(got.pruned);
+    reached += got.reached;
+  }
+  // A solve whose first batch reached the goal is solved.
+  if (reached > 0) EXPECT_TRUE(s.solved());
+}
+
 TEST(Gfcs, APrunedCandidateCostsMoreThanItsBound) {
   const ManipulationProblem problem = SyntheticProblem(3);
   const Fabric fabric(Panda(), problem.world, FabricParams{});

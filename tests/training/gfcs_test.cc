@@ -42,6 +42,36 @@ TEST(InfoNce, MatchesTheDefinitionPerPositive) {
             gfcs::InfoNceLoss(pos, neg).item<double>());
 }
 
+TEST(InfoNce, AMaskedNegativeIsAsIfAbsentInTheLossAndItsGradient) {
+  torch::manual_seed(4);
+  const torch::Tensor pos = torch::randn({3}, torch::kFloat64).requires_grad_();
+  const torch::Tensor neg = (torch::randn({3, 5}, torch::kFloat64) * 2).requires_grad_();
+  // Row j keeps its first 5 - j negatives (row 2: three).
+  torch::Tensor valid = torch::ones({3, 5}, torch::kBool);
+  for (int j = 1; j < 3; ++j) valid[j].slice(0, 5 - j, 5).fill_(false);
+  const torch::Tensor masked = gfcs::InfoNceLoss(pos, neg, valid);
+  masked.backward();
+  // The same rows without their masked negatives, one by one (each row's loss over 3 rows).
+  double expected = 0;
+  for (int j = 0; j < 3; ++j) {
+    const torch::Tensor p = pos.detach()[j].unsqueeze(0);
+    const torch::Tensor n = neg.detach()[j].slice(0, 0, 5 - j).unsqueeze(0);
+    expected += gfcs::InfoNceLoss(p, n).item<double>() / 3;
+  }
+  EXPECT_NEAR(masked.item<double>(), expected, 1e-12);
+  // No gradient reaches a masked negative; the others' is finite.
+  EXPECT_TRUE(torch::isfinite(neg.grad()).all().item<bool>());
+  EXPECT_TRUE(torch::isfinite(pos.grad()).all().item<bool>());
+  EXPECT_EQ(neg.grad().masked_select(valid.logical_not()).abs().max().item<double>(), 0.0);
+  EXPECT_GT(neg.grad().masked_select(valid).abs().min().item<double>(), 0.0);
+  // An all-true mask is the unmasked loss.
+  EXPECT_NEAR(gfcs::InfoNceLoss(pos.detach(), neg.detach(), torch::ones({3, 5}, torch::kBool))
+                  .item<double>(),
+              gfcs::InfoNceLoss(pos.detach(), neg.detach()).item<double>(), 1e-15);
+  EXPECT_THROW(gfcs::InfoNceLoss(pos.detach(), neg.detach(), torch::ones({3, 4}, torch::kBool)),
+               Error);
+}
+
 TEST(EnergyNet, TheEngineComputesWhatLibTorchTrained) {
   torch::manual_seed(5);
   const int encoding = 6, commands = 14, context = 21 + encoding;
@@ -112,7 +142,8 @@ void ExpectTheSameMemory(const std::string& artifact_a, const std::string& artif
 }
 
 TEST(GfcsLoop, AResumedRunEndsWithTheModelOfAnUninterruptedOne) {
-  const gfcs::ExperimentConfig c = TinyConfig();
+  gfcs::ExperimentConfig c = TinyConfig();
+  c.loop.failure_negatives = 2;  // the kept failures are loop state too
   testing::TempDir dir;
   const std::string whole = dir.File("whole"), broken = dir.File("broken");
   ASSERT_TRUE(gfcs::TrainRun(c, whole, false, nullptr));
@@ -134,8 +165,15 @@ TEST(GfcsLoop, AResumedRunEndsWithTheModelOfAnUninterruptedOne) {
   const auto a = EnergyWeights(whole + "/model.h5"), b = EnergyWeights(broken + "/model.h5");
   ASSERT_EQ(a.size(), b.size());
   for (std::size_t i = 0; i < a.size(); ++i) EXPECT_TRUE(a[i].isApprox(b[i], 1e-6f)) << i;
-  EXPECT_NE(testing::ReadText(whole + "/loop_summary.json").find("\"solves\": 6"),
-            std::string::npos);
+  const std::string summary = testing::ReadText(whole + "/loop_summary.json");
+  EXPECT_NE(summary.find("\"solves\": 6"), std::string::npos) << summary;
+  // The sampler's failures were kept and trained against: at most 2 per solve.
+  const auto kept_at = summary.find("\"failures_kept\": ");
+  ASSERT_NE(kept_at, std::string::npos) << summary;
+  const int kept = std::atoi(summary.c_str() + kept_at + 17);
+  EXPECT_GT(kept, 0) << summary;
+  EXPECT_LE(kept, 2 * 6);
+  EXPECT_NE(testing::ReadText(whole + "/log.txt").find("failure slots filled"), std::string::npos);
   // The solution memory holds every solution found, beyond the buffer, the same after a resume.
   ExpectTheSameMemory(whole + "/model.h5", broken + "/model.h5");
   // The held-out evaluation runs the nearest-neighbour sampler on that memory beside the learned
@@ -226,7 +264,8 @@ TEST(GfcsLoop, TwoRanksKilledMidRunResumeToTheModelOfOne) {
   gfcs::ExperimentConfig c = TinyConfig();
   c.loop.threads = 1;
   c.autoencoder.train.threads = 1;
-  c.loop.passes = 4;  // 12 solves, 6 blocks
+  c.loop.passes = 4;             // 12 solves, 6 blocks
+  c.loop.failure_negatives = 2;  // kept failures are gathered, checkpointed and resumed alike
   testing::TempDir dir;
   const std::string cli = FORESIGHT_CLI, d = dir.path();
   ASSERT_TRUE(TrainTheReferenceOnOneRank(c, d));

@@ -64,6 +64,11 @@ struct LoopConfig {
   double learning_rate = 1e-4;
   int batch_positives = 64;  ///< positives per Adam step (each with its negatives)
   int negatives = 16;        ///< N_neg SGLD negatives per positive, drawn before each round
+  /// > 0 (not in the thesis): each solve keeps up to this many of its sampler's first-batch
+  /// candidates that did not reach the goal (draw order), and each positive is trained against up
+  /// to this many of its own problem's kept failures beside its SGLD negatives: the InfoNCE then
+  /// also ranks the sampler's labelled mistakes above the solutions of the same problem.
+  int failure_negatives = 0;
   manipulation::SgldParams negative_sgld;  ///< SGLD of the negatives (particles, threads: unused)
   bool reached_only = true;                ///< only candidates that reach the goal become positives
   int batches = 30;                        ///< GFCS while training: batches ...
@@ -89,6 +94,10 @@ struct LoopConfig {
     a->Visit("batch_positives", &batch_positives, Range::Closed(1, 1000000),
              "positives per Adam step");
     a->Visit("negatives", &negatives, Range::Closed(1, 100000), "SGLD negatives per positive");
+    a->Visit("failure_negatives", &failure_negatives, Range::Closed(0, 100000),
+             "> 0: per solve, keep up to this many first-batch candidates that failed; per "
+             "positive, up to this many of its problem's kept failures as extra InfoNCE negatives "
+             "(0: SGLD negatives only, the thesis)");
     a->Visit("negative_sgld", &negative_sgld, Range::Any(),
              "SGLD drawing the negatives (its particles and threads keys are unused: loop.threads "
              "share the buffer entries)");

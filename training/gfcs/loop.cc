@@ -40,7 +40,7 @@ std::uint64_t StreamSeed(std::int64_t seed, std::uint64_t what, std::uint64_t k,
   z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
   return z ^ (z >> 31);
 }
-constexpr std::uint64_t kNegativeStream = 1, kBatchStream = 2;
+constexpr std::uint64_t kNegativeStream = 1, kBatchStream = 2, kFailureStream = 3;
 /// The rendezvous store's flag by which an interrupted rank stops the others between solves.
 constexpr const char* kStopFlag = "gfcs_loop_stop";
 
@@ -55,11 +55,46 @@ std::int64_t GetInt(const std::string& s, std::size_t* at) {
   return v;
 }
 
-/// What one rank contributes to a block: its solves and their positives.
+/// What one rank contributes to a block: its solves, their positives and (loop.failure_negatives)
+/// their sampler's labelled failures.
 struct BlockResult {
   int solves = 0, solved = 0, dropped = 0, sampler_failures = 0;
-  std::vector<Positive> positives;
+  std::vector<Positive> positives, failures;
 };
+
+void PackList(std::string* s, const std::vector<Positive>& list) {
+  PutInt(s, static_cast<std::int64_t>(list.size()));
+  for (const Positive& p : list) {
+    PutInt(s, p.problem);
+    PutInt(s, p.solve);
+    float cost = p.cost;
+    s->append(reinterpret_cast<const char*>(&cost), sizeof cost);
+    PutInt(s, p.u.size());
+    s->append(reinterpret_cast<const char*>(p.u.data()), sizeof(float) * p.u.size());
+  }
+}
+
+std::vector<Positive> UnpackList(const std::string& s, std::size_t* at) {
+  std::vector<Positive> list;
+  const std::int64_t n = GetInt(s, at);
+  FS_THROW_UNLESS(n >= 0, "gfcs loop: a gather message with ", n, " entries");
+  for (std::int64_t i = 0; i < n; ++i) {
+    Positive p;
+    p.problem = static_cast<int>(GetInt(s, at));
+    p.solve = static_cast<int>(GetInt(s, at));
+    FS_THROW_UNLESS(*at + sizeof(float) <= s.size(), "gfcs loop: truncated gather message");
+    std::memcpy(&p.cost, s.data() + *at, sizeof(float));
+    *at += sizeof(float);
+    const std::int64_t d = GetInt(s, at);
+    FS_THROW_UNLESS(d >= 0 && *at + sizeof(float) * d <= s.size(),
+                    "gfcs loop: truncated gather message");
+    p.u.resize(d);
+    std::memcpy(p.u.data(), s.data() + *at, sizeof(float) * d);
+    *at += sizeof(float) * d;
+    list.push_back(std::move(p));
+  }
+  return list;
+}
 
 std::string Pack(const BlockResult& r) {
   std::string s;
@@ -67,15 +102,8 @@ std::string Pack(const BlockResult& r) {
   PutInt(&s, r.solved);
   PutInt(&s, r.dropped);
   PutInt(&s, r.sampler_failures);
-  PutInt(&s, static_cast<std::int64_t>(r.positives.size()));
-  for (const Positive& p : r.positives) {
-    PutInt(&s, p.problem);
-    PutInt(&s, p.solve);
-    float cost = p.cost;
-    s.append(reinterpret_cast<const char*>(&cost), sizeof cost);
-    PutInt(&s, p.u.size());
-    s.append(reinterpret_cast<const char*>(p.u.data()), sizeof(float) * p.u.size());
-  }
+  PackList(&s, r.positives);
+  PackList(&s, r.failures);
   return s;
 }
 
@@ -86,22 +114,8 @@ BlockResult Unpack(const std::string& s) {
   r.solved = static_cast<int>(GetInt(s, &at));
   r.dropped = static_cast<int>(GetInt(s, &at));
   r.sampler_failures = static_cast<int>(GetInt(s, &at));
-  const std::int64_t n = GetInt(s, &at);
-  for (std::int64_t i = 0; i < n; ++i) {
-    Positive p;
-    p.problem = static_cast<int>(GetInt(s, &at));
-    p.solve = static_cast<int>(GetInt(s, &at));
-    FS_THROW_UNLESS(at + sizeof(float) <= s.size(), "gfcs loop: truncated gather message");
-    std::memcpy(&p.cost, s.data() + at, sizeof(float));
-    at += sizeof(float);
-    const std::int64_t d = GetInt(s, &at);
-    FS_THROW_UNLESS(d >= 0 && at + sizeof(float) * d <= s.size(),
-                    "gfcs loop: truncated gather message");
-    p.u.resize(d);
-    std::memcpy(p.u.data(), s.data() + at, sizeof(float) * d);
-    at += sizeof(float) * d;
-    r.positives.push_back(std::move(p));
-  }
+  r.positives = UnpackList(s, &at);
+  r.failures = UnpackList(s, &at);
   return r;
 }
 
@@ -273,6 +287,9 @@ struct LoopState {
   /// every positive the loop found, in solve order (the buffer keeps only the last ones): the
   /// exported solution memory of the nearest-neighbour sampler
   std::vector<Positive> memory;
+  /// the sampler's first-batch candidates that did not reach the goal, up to
+  /// loop.failure_negatives per solve, in solve order (empty when that is 0)
+  std::vector<Positive> failures;
   BlockResult pending;  ///< this rank's results in the current block
 };
 
@@ -370,6 +387,8 @@ std::string Loop::Serialize(bool with_pending) const {
   WritePositives(&a, "memory", st_.memory, CommandSize(c_));
   a.write("memory.contexts", ColumnsTensor(Contexts()));
   WritePositives(&a, "pending", pending.positives, CommandSize(c_));
+  WritePositives(&a, "failures", st_.failures, CommandSize(c_));
+  WritePositives(&a, "pending.failures", pending.failures, CommandSize(c_));
   a.write("encoding.bps_mean", ToTensor(encoding_.bps_mean));
   a.write("encoding.bps_std", ToTensor(encoding_.bps_std));
   WriteMlp(&a, "encoding.encoder", encoding_.encoder);
@@ -420,13 +439,16 @@ void Loop::Deserialize(const std::string& bytes, const std::string& source) {
   st_.pending.sampler_failures = static_cast<int>(t[3].item<std::int64_t>());
   st_.buffer = ReadPositives(&a, "buffer");
   st_.pending.positives = ReadPositives(&a, "pending");
+  st_.failures = ReadPositives(&a, "failures");
+  st_.pending.failures = ReadPositives(&a, "pending.failures");
   Eigen::MatrixXf contexts;
   st_.memory = ReadMemory(&a, source, &contexts);
   const Eigen::MatrixXf here = Contexts();
   FS_THROW_UNLESS(
       contexts.rows() == here.rows() && contexts.cols() == here.cols() && contexts.isApprox(here),
       source, ": the checkpoint's training problems differ from this run's");
-  for (const auto* list : {&st_.buffer, &st_.pending.positives, &st_.memory})
+  for (const auto* list :
+       {&st_.buffer, &st_.pending.positives, &st_.memory, &st_.failures, &st_.pending.failures})
     for (const Positive& p : *list)
       FS_THROW_UNLESS(p.problem >= 0 && p.problem < static_cast<int>(problems_.size()) &&
                           p.u.size() == CommandSize(c_),
@@ -544,6 +566,19 @@ void Loop::Solve(int s) {
     pos.u = Normalise(cand.commands, robot_.limits());
     st_.pending.positives.push_back(std::move(pos));
   }
+  // The sampler's own proposals that failed (fully evaluated: a pruned one's outcome is unknown).
+  int kept = 0;
+  for (const manipulation::GfcsCandidate& cand : sol.first_batch) {
+    if (kept >= c_.loop.failure_negatives) break;
+    if (cand.reached || cand.pruned) continue;
+    Positive fail;
+    fail.problem = static_cast<int>(static_cast<std::size_t>(s) % problems_.size());
+    fail.solve = s;
+    fail.cost = static_cast<float>(cand.cost);
+    fail.u = Normalise(cand.commands, robot_.limits());
+    st_.pending.failures.push_back(std::move(fail));
+    ++kept;
+  }
   const double secs = Seconds(started);
   stats_.solve_seconds += secs;
   const int total = c_.loop.passes * static_cast<int>(problems_.size());
@@ -558,7 +593,7 @@ void Loop::Solve(int s) {
 void Loop::FinishBlock(int block_end) {
   // Every rank's results, merged in solve order: the buffer does not depend on the rank count.
   const std::vector<std::string> parts = group_->AllGatherBytes(Pack(st_.pending));
-  std::vector<Positive> fresh;
+  std::vector<Positive> fresh, failed;
   for (const std::string& part : parts) {
     BlockResult r = Unpack(part);
     st_.solves += r.solves;
@@ -566,9 +601,12 @@ void Loop::FinishBlock(int block_end) {
     st_.dropped += r.dropped;
     st_.sampler_failures += r.sampler_failures;
     for (Positive& p : r.positives) fresh.push_back(std::move(p));
+    for (Positive& p : r.failures) failed.push_back(std::move(p));
   }
-  std::stable_sort(fresh.begin(), fresh.end(),
-                   [](const Positive& a, const Positive& b) { return a.solve < b.solve; });
+  const auto by_solve = [](const Positive& a, const Positive& b) { return a.solve < b.solve; };
+  std::stable_sort(fresh.begin(), fresh.end(), by_solve);
+  std::stable_sort(failed.begin(), failed.end(), by_solve);
+  for (Positive& p : failed) st_.failures.push_back(std::move(p));
   st_.memory.insert(st_.memory.end(), fresh.begin(), fresh.end());
   for (Positive& p : fresh) st_.buffer.push_back(std::move(p));
   if (st_.buffer.size() > static_cast<std::size_t>(c_.loop.buffer))
@@ -667,11 +705,20 @@ void Loop::TrainRound() {
   st_.dropped += round_dropped;
   stats_.negative_seconds += Seconds(neg_started);
 
-  // InfoNCE over the buffer, each positive against its own negatives.
+  // InfoNCE over the buffer, each positive against its own negatives: its SGLD ones, then
+  // (loop.failure_negatives) up to that many of its problem's kept failures, drawn without
+  // replacement; a problem with fewer leaves the rest of its slots masked out.
   const auto train_started = std::chrono::steady_clock::now();
   const int context_size = static_cast<int>(problems_.front().context.size());
+  const int n_fail = c_.loop.failure_negatives;
   torch::Tensor ctx = torch::empty({b_total, context_size}, torch::kFloat32);
-  torch::Tensor u_all = torch::empty({b_total, 1 + n_neg, dim}, torch::kFloat32);
+  torch::Tensor u_all = torch::zeros({b_total, 1 + n_neg + n_fail, dim}, torch::kFloat32);
+  torch::Tensor valid;  // undefined without failure negatives: every negative counts
+  std::map<int, std::vector<int>> failures_of;  // problem -> indices into st_.failures
+  for (std::size_t i = 0; i < st_.failures.size(); ++i)
+    failures_of[st_.failures[i].problem].push_back(static_cast<int>(i));
+  if (n_fail > 0) valid = torch::ones({b_total, n_neg + n_fail}, torch::kBool);
+  int failure_slots = 0;
   for (int j = 0; j < b_total; ++j) {
     const Positive& pos = st_.buffer[static_cast<std::size_t>(j)];
     ctx[j] = ToTensor(problems_[static_cast<std::size_t>(pos.problem)].context);
@@ -679,6 +726,20 @@ void Loop::TrainRound() {
     const Eigen::MatrixXf& neg = negatives[static_cast<std::size_t>(j)];
     u_all[j].slice(0, 1, 1 + n_neg) =
         torch::from_blob(const_cast<float*>(neg.data()), {n_neg, dim}, torch::kFloat32).clone();
+    if (n_fail == 0) continue;
+    auto found = failures_of.find(pos.problem);
+    std::vector<int> own_failures = found == failures_of.end() ? std::vector<int>{} : found->second;
+    std::mt19937_64 pick_rng(StreamSeed(c_.seed, kFailureStream, round, j));
+    const int take = std::min<int>(n_fail, static_cast<int>(own_failures.size()));
+    for (int k = 0; k < take; ++k) {  // a partial Fisher-Yates shuffle: k distinct failures
+      std::uniform_int_distribution<int> pick(k, static_cast<int>(own_failures.size()) - 1);
+      std::swap(own_failures[static_cast<std::size_t>(k)],
+                own_failures[static_cast<std::size_t>(pick(pick_rng))]);
+      u_all[j][1 + n_neg + k] = ToTensor(
+          st_.failures[static_cast<std::size_t>(own_failures[static_cast<std::size_t>(k)])].u);
+    }
+    if (take < n_fail) valid[j].slice(0, n_neg + take, n_neg + n_fail).fill_(false);
+    failure_slots += take;
   }
   std::mt19937_64 rng(StreamSeed(c_.seed, kBatchStream, round));
   const int batch = std::min(c_.loop.batch_positives, b_total);
@@ -708,7 +769,10 @@ void Loop::TrainRound() {
           std::vector<std::int64_t>(order.begin() + from, order.begin() + to), torch::kInt64);
       const torch::Tensor e = net_->forward(ctx.index_select(0, idx), u_all.index_select(0, idx));
       const double weight = static_cast<double>(to - from) / batch;
-      const torch::Tensor part = InfoNceLoss(e.select(1, 0), e.slice(1, 1)) * weight;
+      const torch::Tensor part =
+          InfoNceLoss(e.select(1, 0), e.slice(1, 1),
+                      valid.defined() ? valid.index_select(0, idx) : torch::Tensor()) *
+          weight;
       part.backward();
       local_loss += part.item<float>();
     }
@@ -722,8 +786,11 @@ void Loop::TrainRound() {
   net_->eval();
   st_.last_loss = c_.loop.adam_steps > 0 ? loss_sum / c_.loop.adam_steps : st_.last_loss;
   stats_.train_seconds += Seconds(train_started);
-  log::Info("training round ", round + 1, ": ", b_total, " positives x ", n_neg, " negatives, ",
-            c_.loop.adam_steps, " Adam steps, mean InfoNCE ", st_.last_loss);
+  log::Info("training round ", round + 1, ": ", b_total, " positives x ", n_neg, " negatives",
+            n_fail > 0 ? " (+ " + std::to_string(failure_slots) + " of " +
+                             std::to_string(b_total * n_fail) + " failure slots filled)"
+                       : std::string(),
+            ", ", c_.loop.adam_steps, " Adam steps, mean InfoNCE ", st_.last_loss);
 }
 
 LoopStats Loop::Run(bool resume, const std::atomic<bool>* interrupt) {
@@ -786,6 +853,7 @@ LoopStats Loop::Run(bool resume, const std::atomic<bool>* interrupt) {
   stats_.last_loss = st_.last_loss;
   stats_.dropped_particles = st_.dropped;
   stats_.sampler_failures = st_.sampler_failures;
+  stats_.failures_kept = static_cast<int>(st_.failures.size());
   return stats_;
 }
 
@@ -797,9 +865,9 @@ std::string LoopStats::ToJson() const {
      << ", \"success_rate\": " << (solves ? static_cast<double>(solved) / solves : 0.0)
      << ", \"training_rounds\": " << rounds << ", \"last_loss\": " << last_loss
      << ", \"dropped_particles\": " << dropped_particles
-     << ", \"sampler_failures\": " << sampler_failures << ", \"solve_seconds\": " << solve_seconds
-     << ", \"negative_seconds\": " << negative_seconds << ", \"train_seconds\": " << train_seconds
-     << ", \"loop_seconds\": " << loop_seconds
+     << ", \"sampler_failures\": " << sampler_failures << ", \"failures_kept\": " << failures_kept
+     << ", \"solve_seconds\": " << solve_seconds << ", \"negative_seconds\": " << negative_seconds
+     << ", \"train_seconds\": " << train_seconds << ", \"loop_seconds\": " << loop_seconds
      << ", \"interrupted\": " << (interrupted ? "true" : "false") << "}";
   return os.str();
 }

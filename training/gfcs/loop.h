@@ -44,7 +44,8 @@ struct Encoding {
   Mlp encoder;
 };
 
-/// One positive: a command sequence (normalised to [-1, 1]) that solved `problem`.
+/// One positive: a command sequence (normalised to [-1, 1]) that solved `problem` (the same
+/// record holds a kept failure, loop.failure_negatives: a first-batch candidate that did not).
 struct Positive {
   int problem = 0;  ///< index into the training problems
   int solve = 0;    ///< the solve that produced it
@@ -61,6 +62,8 @@ struct LoopStats {
   double loop_seconds = 0;
   int dropped_particles = 0;  ///< non-finite SGLD particles (sampler and negatives)
   int sampler_failures = 0;   ///< solves where the learned sampler failed (uniform instead)
+  /// first-batch failures kept as negatives (loop.failure_negatives), over the whole loop
+  int failures_kept = 0;
   bool interrupted = false;
   std::string ToJson() const;
 };
