@@ -6,16 +6,19 @@
 # experiments/gfcs_select.sh trains it) on problems 41-50 and on 31-40 (its own training problems),
 # and experiments/gfcs.sh's loop (1-50) on the held-out 51-75. Writes results/gfcs_energy_ranking.md. Needs both run directories.
 #   experiments/gfcs_energy_ranking.sh
+#   VALIDATION=runs/gfcs_select_loop_1-40_1 HELD_OUT= RESULT=results/gfcs_energy_ranking_failures.md \
+#     experiments/gfcs_energy_ranking.sh   (another validation loop, e.g. one of gfcs_select.sh's
+#     settings; HELD_OUT empty: no held-out part)
 # About 10 minutes on 2 cores.
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BIN_DIR="$(dirname "${FORESIGHT_BIN:-$ROOT/build/bin/foresight}")"
 DATA="${FORESIGHT_DATA:-$ROOT/../shared/data}"
 VALIDATION="${VALIDATION:-$ROOT/runs/gfcs_select_loop_1-40}"
-HELD_OUT="${HELD_OUT:-$ROOT/runs/gfcs_all}"
+HELD_OUT="${HELD_OUT-$ROOT/runs/gfcs_all}"
 RESULT="${RESULT:-results/gfcs_energy_ranking.md}"
 cd "$ROOT"
-for run in "$VALIDATION" "$HELD_OUT"; do
+for run in "$VALIDATION" ${HELD_OUT:+"$HELD_OUT"}; do
   [ -f "$run/model.h5" ] || { echo "$run/model.h5 missing (experiments/gfcs_select.sh, experiments/gfcs.sh)" >&2; exit 1; }
 done
 {
@@ -29,7 +32,7 @@ done
   echo "sampler would return (the trivial baseline). The last two columns: problems solved by the first 20"
   echo "candidates, and by the 20 lowest-energy ones of the 200 (selection by the energy, no SGLD)."
   echo
-  echo "## Validation: loop on problems 1-40, problems 41-50"
+  echo "## Validation: loop on problems 1-40 (\`${VALIDATION#"$ROOT"/}\`), problems 41-50"
   echo
   "$BIN_DIR/gfcs_energy_ranking" --model "$VALIDATION/model.h5" --data "$DATA" --first 41 --last 50
   echo
@@ -37,9 +40,11 @@ done
   echo
   "$BIN_DIR/gfcs_energy_ranking" --model "$VALIDATION/model.h5" --data "$DATA" --first 31 --last 40
   echo
-  echo "## Held out: loop on problems 1-50 (experiments/gfcs.sh), problems 51-75"
-  echo
-  "$BIN_DIR/gfcs_energy_ranking" --model "$HELD_OUT/model.h5" --data "$DATA" --first 51 --last 75
+  if [ -n "$HELD_OUT" ]; then
+    echo "## Held out: loop on problems 1-50 (experiments/gfcs.sh), problems 51-75"
+    echo
+    "$BIN_DIR/gfcs_energy_ranking" --model "$HELD_OUT/model.h5" --data "$DATA" --first 51 --last 75
+  fi
 } > "$RESULT.tmp"
 mv "$RESULT.tmp" "$RESULT"
 cat "$RESULT"
