@@ -65,6 +65,9 @@ TEST(ImitationHotPaths, AllocateNothingAfterSetUp) {
   ComposedWorkspace<2> c1 = fx.composed_one[0].MakeWorkspace();
   ComposedWorkspace<2> c2 = fx.composed_two[0].MakeWorkspace();
   const ObstacleTransform<2> obstacle(fx.field, {0.05, 10});
+  OccupancyField<2> table = fx.field;  // the bicubic table's path (obstacle.map_table_spacing)
+  table.Tabulate(0.01);
+  const ObstacleTransform<2> tabulated(table, {0.05, 10});
   std::mt19937_64 rng(4);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   Eigen::Matrix2Xd points(2, 100);
@@ -84,6 +87,10 @@ TEST(ImitationHotPaths, AllocateNothingAfterSetUp) {
       sink += v.p + v.gradient.sum() + v.hessian.sum() + fx.field.Probability(y, ows.get());
       sink += obstacle.Forward(y, ows.get(), &j).sum();
       if (obstacle.Inverse(y, ows.get(), &x)) sink += x.sum();
+      table.Evaluate(y, ows.get(), true, &v);
+      sink += v.p + v.hessian.sum() + table.Probability(y, ows.get());
+      sink += tabulated.Forward(y, ows.get(), &j).sum();
+      if (tabulated.Inverse(y, ows.get(), &x)) sink += x.sum();
       sink += fx.composed_one[0].Velocity(y, &c1).sum() + fx.composed_two[0].Velocity(y, &c2).sum();
       sink += fx.composed_two[0].Inner(y, &c2).sum();
     }

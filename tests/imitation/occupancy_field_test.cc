@@ -5,8 +5,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
+#include <utility>
+#include <vector>
 
 #include "inference/mapping/hinge_map.h"
 #include "models/imitation/occupancy_fit.h"
@@ -177,6 +180,140 @@ TEST(OccupancyField, BadInputIsAnError) {
       {"obstacle map", "3 weights", "49"});
   testing::ExpectErrorContains(
       [&] { OccupancyField<2> f(grid, Eigen::VectorXd::Zero(49), std::nan("")); }, {"bias"});
+}
+
+// ---- the bicubic table ------------------------------------------------------------------------
+
+// The error bounds of the C1 bicubic Hermite interpolant of f: O(h^4) for f, O(h^3) for grad f,
+// O(h^2) for Hess f, against the kernel width sigma = 1 / sqrt(2 gamma): the errors at h = sigma /
+// 8 and at h / 2 fall by at least 2^4 - 40 %, 2^3 - 40 %, 2^2 - 40 %, and at h = sigma / 16 the
+// table is within 1e-5 (p), 1e-3 (grad p) and 3e-2 (Hess p) of the exact field relative to each
+// quantity's largest size over the points. Every point inside the support; the field's weights are
+// random, so it has no special shape.
+TEST(OccupancyFieldTable, ConvergesToTheExactFieldAtTheBicubicRates) {
+  RbfGridSpec<2> spec;
+  spec.lower = Vec<2>(-0.3, -0.2);
+  spec.counts = {7, 6};
+  spec.spacing = 0.1;
+  spec.gamma = 60;
+  spec.cutoff_radius = 0.6;  // gamma r^2 = 21.6: truncation 4e-10
+  const RbfGrid<2> grid(spec);
+  std::mt19937_64 rng(11);
+  const OccupancyField<2> exact = RandomField(grid, 1.5, &rng);
+  auto ws = exact.MakeWorkspace();
+  std::vector<Vec<2>> points;
+  for (int n = 0; n < 400; ++n) points.push_back(RandomPoint<2>(&rng, -0.45, 0.45));
+  const double sigma = 1 / std::sqrt(2 * spec.gamma);
+  // Largest error of p, grad p and Hess p over the points, and each quantity's largest size.
+  struct Errors {
+    double p = 0, grad = 0, hess = 0;
+  };
+  Errors size;
+  const auto errors = [&](double h) {
+    OccupancyField<2> table = exact;
+    table.Tabulate(h);
+    EXPECT_EQ(table.table_spacing(), h);
+    Errors e;
+    for (const Vec<2>& s : points) {
+      OccupancyValue<2> a, b;
+      exact.Evaluate(s, ws.get(), true, &a);
+      table.Evaluate(s, ws.get(), true, &b);
+      e.p = std::max(e.p, std::abs(a.p - b.p));
+      e.grad = std::max(e.grad, (a.gradient - b.gradient).norm());
+      e.hess = std::max(e.hess, (a.hessian - b.hessian).norm());
+      EXPECT_EQ(table.Probability(s, ws.get()), b.p);
+      EXPECT_TRUE(testing::MatricesNear(b.hessian, b.hessian.transpose(), 1e-12));
+      size.p = std::max(size.p, a.p);
+      size.grad = std::max(size.grad, a.gradient.norm());
+      size.hess = std::max(size.hess, a.hessian.norm());
+    }
+    return e;
+  };
+  const Errors coarse = errors(sigma / 8), fine = errors(sigma / 16);
+  EXPECT_GT(coarse.p / fine.p, 16 * 0.6);
+  EXPECT_GT(coarse.grad / fine.grad, 8 * 0.6);
+  EXPECT_GT(coarse.hess / fine.hess, 4 * 0.6);
+  EXPECT_LT(fine.p, 1e-5 * size.p);
+  EXPECT_LT(fine.grad, 1e-3 * size.grad);
+  EXPECT_LT(fine.hess, 3e-2 * size.hess);
+  // Outside the support the table is not read: the exact field's value there (bias only).
+  OccupancyField<2> table = exact;
+  table.Tabulate(sigma / 8);
+  OccupancyValue<2> out;
+  table.Evaluate(Vec<2>(5, 5), ws.get(), true, &out);
+  EXPECT_EQ(out.p, 1 / (1 + std::exp(0.3)));
+  EXPECT_EQ(out.gradient.norm(), 0.0);
+  // Spacing 0 removes the table.
+  table.Tabulate(0);
+  EXPECT_EQ(table.table_spacing(), 0.0);
+  OccupancyValue<2> a, b;
+  table.Evaluate(points[0], ws.get(), true, &a);
+  exact.Evaluate(points[0], ws.get(), true, &b);
+  EXPECT_EQ(a.p, b.p);
+}
+
+// At the nodes the table returns the exact logit and gradient; across a cell edge p and grad p are
+// continuous (C1), and the Hessian is that of the interpolant (finite differences of its gradient).
+TEST(OccupancyFieldTable, ExactAtTheNodesContinuousAcrossCellsAndItsOwnDerivatives) {
+  const RbfGrid<2> grid(SmoothGrid<2>());
+  std::mt19937_64 rng(12);
+  const OccupancyField<2> exact = RandomField(grid, 1.5, &rng);
+  OccupancyField<2> table = exact;
+  const double h = 0.02;
+  table.Tabulate(h);
+  auto ws = exact.MakeWorkspace();
+  // The table's nodes sit at lower - cutoff + h (i, j).
+  const Vec<2> origin = grid.spec().lower.array() - grid.spec().cutoff_radius;
+  for (const auto& [i, j] : {std::pair{40, 50}, std::pair{61, 47}, std::pair{55, 55}}) {
+    const Vec<2> node = origin + h * Vec<2>(i, j);
+    OccupancyValue<2> a, b;
+    exact.Evaluate(node, ws.get(), false, &a);
+    table.Evaluate(node, ws.get(), false, &b);
+    EXPECT_NEAR(a.p, b.p, 1e-14);
+    EXPECT_TRUE(testing::MatricesNear(a.gradient, b.gradient, 1e-12));
+    // Either side of the cell edge x = node_x.
+    OccupancyValue<2> left, right;
+    const Vec<2> edge = node + Vec<2>(0, 0.37 * h);
+    table.Evaluate(edge - Vec<2>(1e-9, 0), ws.get(), false, &left);
+    table.Evaluate(edge + Vec<2>(1e-9, 0), ws.get(), false, &right);
+    // p changes by its slope over the 2e-9 between the two points, nothing more (no jump).
+    EXPECT_NEAR(right.p - left.p, 2e-9 * left.gradient[0], 1e-13);
+    EXPECT_TRUE(
+        testing::MatricesNear(left.gradient, right.gradient, 1e-6 * (1 + left.gradient.norm())));
+  }
+  for (int n = 0; n < 20; ++n) {
+    const Vec<2> s = RandomPoint<2>(&rng, -0.15, 0.15);
+    OccupancyValue<2> v, plus, minus;
+    table.Evaluate(s, ws.get(), true, &v);
+    Mat<2> hess_fd;
+    Vec<2> grad_fd;
+    const double d = 1e-6;
+    for (int a = 0; a < 2; ++a) {
+      Vec<2> e = Vec<2>::Zero();
+      e[a] = d;
+      table.Evaluate(s + e, ws.get(), false, &plus);
+      table.Evaluate(s - e, ws.get(), false, &minus);
+      grad_fd[a] = (plus.p - minus.p) / (2 * d);
+      hess_fd.col(a) = (plus.gradient - minus.gradient) / (2 * d);
+    }
+    EXPECT_TRUE(testing::MatricesNear(v.gradient, grad_fd, 1e-7 * (1 + v.gradient.norm())));
+    EXPECT_TRUE(testing::MatricesNear(v.hessian, hess_fd, 1e-5 * (1 + v.hessian.norm())));
+  }
+}
+
+TEST(OccupancyFieldTable, BadInputIsAnError) {
+  const RbfGrid<2> grid(SmoothGrid<2>());
+  OccupancyField<2> field(grid, Eigen::VectorXd::Zero(grid.size()), 0, "obstacle map");
+  testing::ExpectErrorContains([&] { field.Tabulate(-0.1, "obstacle map"); },
+                               {"obstacle map", "spacing -0.1"});
+  testing::ExpectErrorContains([&] { field.Tabulate(std::nan(""), "obstacle map"); },
+                               {"obstacle map", "spacing"});
+  testing::ExpectErrorContains([&] { field.Tabulate(1e-5, "obstacle map"); },
+                               {"obstacle map", "2^22"});
+  const RbfGrid<3> grid3(SmoothGrid<3>());
+  OccupancyField<3> field3(grid3, Eigen::VectorXd::Zero(grid3.size()), 0);
+  testing::ExpectErrorContains([&] { field3.Tabulate(0.01, "arm map"); }, {"arm map", "2-D"});
+  EXPECT_NO_THROW(field3.Tabulate(0));
 }
 
 // ---- occupancy fit ----------------------------------------------------------------------------

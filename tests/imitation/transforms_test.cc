@@ -111,6 +111,34 @@ TEST(ObstacleTransform, JacobianAndInverse) {
   }
 }
 
+// Through a tabulated map (OccupancyField::Tabulate) the transform is the Euler map of the
+// interpolated field: its Jacobian is still exact (central differences), its inverse still
+// round-trips, and it stays within the table's error of the transform on the exact map.
+TEST(ObstacleTransform, ATabulatedMapKeepsAnExactJacobianAndInverse) {
+  const OccupancyField<2> exact = RandomField(Grid2(), 0.5, 1);
+  OccupancyField<2> table = exact;
+  table.Tabulate(0.004);  // sigma = 1 / sqrt(240) = 0.065: about sigma / 16
+  const ObstacleTransform<2> psi(table, {0.02, 10}), psi_exact(exact, {0.02, 10});
+  auto ws = psi.MakeWorkspace();
+  std::mt19937_64 rng(8);
+  double moved = 0, apart = 0;
+  for (int n = 0; n < 30; ++n) {
+    const Vec<2> y = RandomPoint<2>(&rng, -0.7, 0.7);
+    Mat<2> j;
+    const Vec<2> x = psi.Forward(y, ws.get(), &j);
+    const Mat<2> fd =
+        FiniteDifferenceJacobian<2>([&](const Vec<2>& s) { return psi.Forward(s, ws.get()); }, y);
+    EXPECT_TRUE(testing::MatricesNear(j, fd, 1e-6 * (1 + j.norm())));
+    Vec<2> back;
+    ASSERT_TRUE(psi.Inverse(x, ws.get(), &back));
+    EXPECT_LE((back - y).norm(), 1e-10);
+    moved = std::max(moved, (x - y).norm());
+    apart = std::max(apart, (x - psi_exact.Forward(y, ws.get())).norm());
+  }
+  EXPECT_GT(moved, 0.01);
+  EXPECT_LT(apart, 1e-4 * moved);
+}
+
 // The goal gate: psi_o fixes the goal exactly, the gated field's Jacobian and the transform's
 // match central differences, and the inverse round-trips.
 TEST(ObstacleTransform, GoalGateFixesTheGoalAndItsJacobiansMatch) {

@@ -192,10 +192,14 @@ struct ObstacleConfig {
   // A soft map (kernel width ~ the obstacle's radius, strong ridge): its gradient reaches across
   // the obstacle, so the flow can push whole paths out; gamma * cutoff^2 = 18 keeps the truncated
   // kernel at 1.5e-8 (a smooth, invertible flow).
-  double map_spacing = 0.06;     ///< inducing-state spacing of the map
-  double map_gamma = 200;        ///< its kernel exp(-gamma d^2)
-  double map_cutoff = 0.3;       ///< its cut-off
-  double map_l2 = 1;             ///< ridge penalty of the logistic regression
+  double map_spacing = 0.06;  ///< inducing-state spacing of the map
+  double map_gamma = 200;     ///< its kernel exp(-gamma d^2)
+  double map_cutoff = 0.3;    ///< its cut-off
+  double map_l2 = 1;          ///< ridge penalty of the logistic regression
+  /// 2-D: > 0 evaluates the fitted map through a bicubic Hermite table of its logit with nodes
+  /// this far apart (OccupancyField::Tabulate; selection, rollouts and metrics all use it); 0: the
+  /// exact feature sums. Task space does not read it.
+  double map_table_spacing = 0;
   double map_inflate = 0.01;     ///< samples within this distance of the obstacle are occupied
   double sample_spacing = 0.01;  ///< occupancy samples on a lattice around the obstacle
   double sample_margin = 0.1;    ///< lattice margin around the obstacle
@@ -244,6 +248,8 @@ struct ObstacleConfig {
     a->Visit("map_gamma", &map_gamma, Range::Positive(), "occupancy map kernel");
     a->Visit("map_cutoff", &map_cutoff, Range::Positive(), "occupancy map cut-off");
     a->Visit("map_l2", &map_l2, Range::Positive(), "occupancy map ridge penalty");
+    a->Visit("map_table_spacing", &map_table_spacing, Range::NonNegative(),
+             "2-D: node spacing of a bicubic table the map is evaluated through (0: exact sums)");
     a->Visit("map_inflate", &map_inflate, Range::NonNegative(),
              "samples this close to the obstacle are labelled occupied (safety margin)");
     a->Visit("sample_spacing", &sample_spacing, Range::Positive(), "occupancy sample lattice");
