@@ -557,26 +557,22 @@ void Loop::Solve(int s) {
   ++st_.pending.solves;
   st_.pending.solved += sol.solved();
   const std::size_t before = st_.pending.positives.size();
-  for (const manipulation::GfcsCandidate& cand : sol.top) {
-    if (c_.loop.reached_only && !cand.reached) continue;
-    Positive pos;
-    pos.problem = static_cast<int>(static_cast<std::size_t>(s) % problems_.size());
-    pos.solve = s;
-    pos.cost = static_cast<float>(cand.cost);
-    pos.u = Normalise(cand.commands, robot_.limits());
-    st_.pending.positives.push_back(std::move(pos));
-  }
+  const auto record = [&](const manipulation::GfcsCandidate& cand, std::vector<Positive>* list) {
+    Positive entry;
+    entry.problem = static_cast<int>(static_cast<std::size_t>(s) % problems_.size());
+    entry.solve = s;
+    entry.cost = static_cast<float>(cand.cost);
+    entry.u = Normalise(cand.commands, robot_.limits());
+    list->push_back(std::move(entry));
+  };
+  for (const manipulation::GfcsCandidate& cand : sol.top)
+    if (cand.reached || !c_.loop.reached_only) record(cand, &st_.pending.positives);
   // The sampler's own proposals that failed (fully evaluated: a pruned one's outcome is unknown).
   int kept = 0;
   for (const manipulation::GfcsCandidate& cand : sol.first_batch) {
     if (kept >= c_.loop.failure_negatives) break;
     if (cand.reached || cand.pruned) continue;
-    Positive fail;
-    fail.problem = static_cast<int>(static_cast<std::size_t>(s) % problems_.size());
-    fail.solve = s;
-    fail.cost = static_cast<float>(cand.cost);
-    fail.u = Normalise(cand.commands, robot_.limits());
-    st_.pending.failures.push_back(std::move(fail));
+    record(cand, &st_.pending.failures);
     ++kept;
   }
   const double secs = Seconds(started);
