@@ -3,10 +3,10 @@
 /// problem with the current sampler, keep the top solutions in a buffer, every `train_every`
 /// solves draw SGLD negatives and train the energy model with InfoNCE, then sample by SGLD on it.
 ///
-/// Resumable: after every `checkpoint_every` solves the whole state (buffer, model, optimiser,
-/// counters, encoder) is written atomically to checkpoints/loop[.rank<r>].pt. Every random stream
-/// is derived from (seed, counter) - solve s uses seed + s, training round k and its negatives use
-/// (seed, k) - so a resumed run draws exactly what an uninterrupted one would.
+/// Resumable: after every `checkpoint_every` solves the whole state (buffer, kept failures, model,
+/// optimiser, counters, encoder) is written atomically to checkpoints/loop[.rank<r>].pt. Every
+/// random stream is derived from (seed, counter) - solve s uses seed + s, training round k and its
+/// negatives use (seed, k) - so a resumed run draws exactly what an uninterrupted one would.
 ///
 /// Ranks (training/distributed.h): the solves of a block of `train_every` are dealt round-robin
 /// over the ranks and the new positives gathered in solve order; the negatives are dealt over the
