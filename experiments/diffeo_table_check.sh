@@ -13,6 +13,10 @@ TABLE="$ROOT/runs/diffeo_lasa"
 EXACT="$ROOT/runs/diffeo_lasa_exact"
 cd "$ROOT"
 [ -f "$TABLE/eval.json" ] || { echo "$TABLE/eval.json missing: run experiments/diffeo.sh first" >&2; exit 1; }
+grep -q avoid_step_us_exact_map "$TABLE/eval.json" || {
+  echo "$TABLE was evaluated with the exact map (no obstacle.map_table_spacing): nothing to compare" >&2
+  exit 1
+}
 if [[ "${REUSE:-0}" != 1 || ! -f "$EXACT/eval.json" ]]; then
   rm -rf "$EXACT"
   "$BIN" train configs/diffeo/lasa.yaml --run-dir "$EXACT" obstacle.map_table_spacing=0 \

@@ -241,7 +241,7 @@ TEST(OccupancyFieldTable, ConvergesToTheExactFieldAtTheBicubicRates) {
   table.Tabulate(sigma / 8);
   OccupancyValue<2> out;
   table.Evaluate(Vec<2>(5, 5), ws.get(), true, &out);
-  EXPECT_EQ(out.p, 1 / (1 + std::exp(0.3)));
+  EXPECT_DOUBLE_EQ(out.p, 1 / (1 + std::exp(0.3)));
   EXPECT_EQ(out.gradient.norm(), 0.0);
   // Spacing 0 removes the table.
   table.Tabulate(0);

@@ -121,8 +121,9 @@ std::vector<Row> Imitation(const DiffeoBenchOptions& a, const ImitationSystem<D>
           {"imitation step, LibTorch (batch 1)", libtorch, "same weights, no autograd"}};
 }
 
-/// One step of the composed 2-D system, the obstacle map evaluated exactly and through the bicubic
-/// table of the LASA config (obstacle.map_table_spacing), same flow and points.
+/// One step of the composed 2-D system, the obstacle map (ObstacleConfig's default map settings)
+/// evaluated exactly and through a bicubic table with nodes `table_spacing` apart (by default the
+/// LASA config's obstacle.map_table_spacing), same flow and points.
 std::vector<Row> Composed2d(const DiffeoBenchOptions& a, const ImitationSystem<2>& s,
                             double table_spacing) {
   // A disc between the middle of the grid and the goal, mapped as the evaluation does.
