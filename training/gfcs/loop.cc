@@ -41,6 +41,15 @@ std::uint64_t StreamSeed(std::int64_t seed, std::uint64_t what, std::uint64_t k,
   return z ^ (z >> 31);
 }
 constexpr std::uint64_t kNegativeStream = 1, kBatchStream = 2, kFailureStream = 3;
+/// Moves k distinct entries of `v`, drawn uniformly, to its first k places (a partial
+/// Fisher-Yates shuffle; the draws of `rng` are the same for any element type).
+template <class T>
+void ShuffleHead(std::vector<T>* v, int k, std::mt19937_64* rng) {
+  for (int i = 0; i < k; ++i) {
+    std::uniform_int_distribution<int> pick(i, static_cast<int>(v->size()) - 1);
+    std::swap((*v)[static_cast<std::size_t>(i)], (*v)[static_cast<std::size_t>(pick(*rng))]);
+  }
+}
 /// The rendezvous store's flag by which an interrupted rank stops the others between solves.
 constexpr const char* kStopFlag = "gfcs_loop_stop";
 
@@ -727,13 +736,10 @@ void Loop::TrainRound() {
     std::vector<int> own_failures = found == failures_of.end() ? std::vector<int>{} : found->second;
     std::mt19937_64 pick_rng(StreamSeed(c_.seed, kFailureStream, round, j));
     const int take = std::min<int>(n_fail, static_cast<int>(own_failures.size()));
-    for (int k = 0; k < take; ++k) {  // a partial Fisher-Yates shuffle: k distinct failures
-      std::uniform_int_distribution<int> pick(k, static_cast<int>(own_failures.size()) - 1);
-      std::swap(own_failures[static_cast<std::size_t>(k)],
-                own_failures[static_cast<std::size_t>(pick(pick_rng))]);
+    ShuffleHead(&own_failures, take, &pick_rng);
+    for (int k = 0; k < take; ++k)
       u_all[j][1 + n_neg + k] = ToTensor(
           st_.failures[static_cast<std::size_t>(own_failures[static_cast<std::size_t>(k)])].u);
-    }
     if (take < n_fail) valid[j].slice(0, n_neg + take, n_neg + n_fail).fill_(false);
     failure_slots += take;
   }
@@ -746,10 +752,7 @@ void Loop::TrainRound() {
   for (int step = 0; step < c_.loop.adam_steps; ++step) {
     // A batch without replacement (a fresh permutation's head), identical on every rank.
     std::iota(order.begin(), order.end(), 0);
-    for (int i = 0; i < batch; ++i) {
-      std::uniform_int_distribution<int> pick(i, b_total - 1);
-      std::swap(order[static_cast<std::size_t>(i)], order[static_cast<std::size_t>(pick(rng))]);
-    }
+    ShuffleHead(&order, batch, &rng);
     adam_.zero_grad();
     // The batch's mean loss as a weighted sum over fixed shards (shard s: positives [batch s / K,
     // batch (s + 1) / K) of this step's draw), each with its own backward; over several ranks,
